@@ -1,0 +1,198 @@
+"""Scenarios: a grid, robots with starts and goals, timing, network faults, policy options.
+
+A :class:`Scenario` is plain data; files become scenarios in :mod:`mrmp.io`.
+:func:`scenario_problems` checks the meaning of a scenario (cells on the grid,
+not on obstacles, no shared starts or goals, reachable goals) and names each
+problem by its field path, which the I/O layer turns into a file and line.
+
+Examples
+--------
+>>> from mrmp.core.grid import Grid
+>>> swap = Scenario(Grid(5, 5), (RobotSpec("A", (0, 2), (4, 2)), RobotSpec("B", (4, 2), (0, 2))))
+>>> [robot.heading.name for robot in swap.robots]
+['NORTH', 'NORTH']
+>>> scenario_problems(swap)
+[]
+>>> bad = Scenario(Grid(5, 5), (RobotSpec("A", (0, 2), (9, 2)),))
+>>> [str(problem) for problem in scenario_problems(bad)]
+['robots[0].goal: cell (9, 2) is outside the 5x5 grid']
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field, replace
+from collections import deque
+
+from mrmp.core.cell import Cell
+from mrmp.core.errors import Problem
+from mrmp.core.grid import Grid
+from mrmp.core.heading import Heading
+
+RESOLUTIONS = ("divert", "wait")
+"""How a lower-priority robot resolves a conflict: divert (prioritized technique,
+"change of route") or wait (velocity tuning), thesis section 2.1."""
+
+
+@dataclass(frozen=True)
+class RobotSpec:
+    """One robot of a scenario: its name, start, goal and initial heading.
+
+    The thesis's robots always start facing NORTH (section 3.2, assumption 1).
+    """
+
+    id: str
+    start: Cell
+    goal: Cell
+    heading: Heading = Heading.NORTH
+
+
+@dataclass(frozen=True)
+class Timing:
+    """How long the robot's body takes: one cell (``cell_time``), one right turn (``turn_time``), in seconds."""
+
+    cell_time: float = 1.0
+    turn_time: float = 0.5
+
+
+@dataclass(frozen=True)
+class NetworkFaults:
+    """Faults of the simulated network, applied independently to every message on every link.
+
+    ``loss``, ``duplicate`` and ``reorder`` are probabilities; a message's delay
+    is drawn uniformly from ``delay_min .. delay_max`` ticks (0 means delivered
+    within the tick it was sent).
+    """
+
+    loss: float = 0.0
+    delay_min: int = 0
+    delay_max: int = 0
+    duplicate: float = 0.0
+    reorder: float = 0.0
+
+    @property
+    def is_perfect(self) -> bool:
+        """Whether the network delivers every message once, at once, in order."""
+        return self == NetworkFaults()
+
+
+@dataclass(frozen=True)
+class PolicyOptions:
+    """Which decision rule robots run and its settings.
+
+    ``resolve`` chooses the thesis's two collision-avoidance techniques
+    (section 2.1); ``heading_aware`` makes planners charge turns.
+    """
+
+    name: str = "thesis"
+    resolve: str = "divert"
+    heading_aware: bool = False
+
+
+@dataclass(frozen=True)
+class Scenario:
+    """Everything a run needs to start: world, robots and settings."""
+
+    grid: Grid
+    robots: tuple[RobotSpec, ...]
+    timing: Timing = field(default_factory=Timing)
+    network: NetworkFaults = field(default_factory=NetworkFaults)
+    policy: PolicyOptions = field(default_factory=PolicyOptions)
+    seed: int = 0
+    max_ticks: int | None = None
+    name: str = ""
+    description: str = ""
+
+    def with_changes(self, **changes: object) -> Scenario:
+        """A copy with some fields replaced (a frozen dataclass ``replace``)."""
+        return replace(self, **changes)  # type: ignore[arg-type]
+
+    def robot(self, robot_id: str) -> RobotSpec:
+        """The robot named ``robot_id``.
+
+        Raises
+        ------
+        KeyError
+            If no robot has that name.
+        """
+        for robot in self.robots:
+            if robot.id == robot_id:
+                return robot
+        raise KeyError(robot_id)
+
+
+def _component_labels(grid: Grid) -> dict[Cell, int]:
+    """Label each free cell with its 4-connected component."""
+    labels: dict[Cell, int] = {}
+    for origin in grid.free_cells():
+        if origin in labels:
+            continue
+        label = len(labels)
+        labels[origin] = label
+        queue = deque([origin])
+        while queue:
+            cell = queue.popleft()
+            for neighbour in grid.neighbours(cell):
+                if neighbour not in labels:
+                    labels[neighbour] = label
+                    queue.append(neighbour)
+    return labels
+
+
+def scenario_problems(scenario: Scenario) -> list[Problem]:
+    """Every problem with the meaning of ``scenario``, each named by its field path.
+
+    Checks: robots present, unique ids, starts and goals on the grid and free,
+    no two robots sharing a start or a goal, each goal reachable from its start,
+    timing and fault values in range.
+    """
+    problems: list[Problem] = []
+    grid = scenario.grid
+    size = f"{grid.x_size}x{grid.y_size}"
+    if not scenario.robots:
+        problems.append(Problem("robots", "a scenario needs at least one robot"))
+    seen_ids: dict[str, int] = {}
+    seen_starts: dict[Cell, int] = {}
+    seen_goals: dict[Cell, int] = {}
+    labels: dict[Cell, int] | None = None
+    for index, robot in enumerate(scenario.robots):
+        where = f"robots[{index}]"
+        if robot.id in seen_ids:
+            problems.append(Problem(f"{where}.id", f"id {robot.id!r} is already used by robots[{seen_ids[robot.id]}]"))
+        else:
+            seen_ids[robot.id] = index
+        endpoints_ok = True
+        for kind, cell, seen in (("start", robot.start, seen_starts), ("goal", robot.goal, seen_goals)):
+            if not grid.in_bounds(cell):
+                problems.append(Problem(f"{where}.{kind}", f"cell {cell} is outside the {size} grid"))
+                endpoints_ok = False
+            elif grid.is_blocked(cell):
+                problems.append(Problem(f"{where}.{kind}", f"cell {cell} is an obstacle"))
+                endpoints_ok = False
+            elif cell in seen:
+                problems.append(Problem(f"{where}.{kind}", f"cell {cell} is also the {kind} of robots[{seen[cell]}]"))
+            else:
+                seen[cell] = index
+        if endpoints_ok:
+            if labels is None:
+                labels = _component_labels(grid)
+            if labels[robot.start] != labels[robot.goal]:
+                problems.append(Problem(f"{where}.goal", f"cell {robot.goal} cannot be reached from start {robot.start}"))
+    timing = scenario.timing
+    if not timing.cell_time > 0:
+        problems.append(Problem("timing.cell_time", f"must be positive, got {timing.cell_time}"))
+    if not timing.turn_time >= 0:
+        problems.append(Problem("timing.turn_time", f"must not be negative, got {timing.turn_time}"))
+    network = scenario.network
+    for name in ("loss", "duplicate", "reorder"):
+        value = getattr(network, name)
+        if not 0.0 <= value <= 1.0:
+            problems.append(Problem(f"network.{name}", f"must be a probability in [0, 1], got {value}"))
+    if network.delay_min < 0 or network.delay_max < network.delay_min:
+        problems.append(
+            Problem("network.delay", f"must be a range 0 <= min <= max ticks, got {network.delay_min}..{network.delay_max}")
+        )
+    if scenario.policy.resolve not in RESOLUTIONS:
+        problems.append(Problem("policy.resolve", f"must be one of {', '.join(RESOLUTIONS)}, got {scenario.policy.resolve!r}"))
+    if scenario.max_ticks is not None and scenario.max_ticks <= 0:
+        problems.append(Problem("max_ticks", f"must be positive, got {scenario.max_ticks}"))
+    return problems

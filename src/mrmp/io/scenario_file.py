@@ -1,0 +1,791 @@
+"""The YAML scenario format, read strictly: every problem is reported with its file and line.
+
+A scenario file looks like this (only ``map`` and ``robots`` are required)::
+
+    name: thesis-swap                 # default: the file's stem
+    description: two robots swap ends of a column
+    map:                              # exactly one of: rows / file / width + height
+      rows: [".....", ".....", "..@..", ".....", "....."]   # first row is the NORTHMOST
+      # file: ../maps/random-32-32-20.map   (relative to this file's folder)
+      # width: 5     (number of y values, east-west)
+      # height: 5    (number of x values, north-south)
+    robots:                           # or, at top level: scen: file.scen + agents: N
+      - id: A
+        start: [0, 2]                 # [x, y]: x grows NORTH, y grows EAST
+        goal: [4, 2]
+        heading: NORTH                # optional: a name or 1-4
+    timing: {cell_time: 1.0, turn_time: 0.5}
+    network: {loss: 0.0, delay: 0, duplicate: 0.0, reorder: 0.0}   # delay: N, "A..B" or [A, B]
+    policy: {name: thesis, resolve: divert, heading_aware: false}
+    seed: 0
+    max_ticks: 100
+
+With ``scen:`` and ``agents:`` the robots are the first N agents of a MovingAI
+``.scen`` file (named ``"0"``, ``"1"``, ...); ``map:`` may then be left out, and
+the map named in the ``.scen`` file is read from the ``.scen`` file's folder.
+
+The file is read with PyYAML's node API (:func:`yaml.compose`) so that every
+value keeps its line. All problems are collected -- unknown keys, wrong types,
+missing keys, conflicting map forms, malformed map files, and the meaning
+checks of :func:`mrmp.core.scenario.scenario_problems` -- and raised together
+as one :class:`~mrmp.core.errors.InputError`, each as ``file:line`` and
+``field.path: reason``.
+
+Examples
+--------
+>>> text = '''
+... map: {rows: ["...", "...", "..."]}
+... robots:
+...   - {id: A, start: [0, 0], goal: [2, 2]}
+... '''
+>>> scenario = scenario_from_text(text, "demo.yaml")
+>>> scenario.name, scenario.grid.x_size, scenario.robots[0].goal
+('demo', 3, (2, 2))
+>>> scenario_from_text(text.replace("goal", "gaol"), "demo.yaml")
+Traceback (most recent call last):
+...
+mrmp.core.errors.InputError: demo.yaml:4: robots[0]: unknown key 'gaol' (did you mean 'goal'?)
+demo.yaml:4: robots[0]: missing required key 'goal'
+"""
+
+from __future__ import annotations
+
+import difflib
+import json
+import math
+import re
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any
+
+import yaml
+from yaml.constructor import SafeConstructor
+from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
+
+from mrmp.core.cell import Cell
+from mrmp.core.errors import InputError, Problem
+from mrmp.core.grid import COST_SYMBOLS, Grid
+from mrmp.core.heading import Heading
+from mrmp.core.scenario import NetworkFaults, PolicyOptions, RobotSpec, Scenario, Timing, scenario_problems
+from mrmp.io._files import PathLike, atomic_write_text, read_text
+from mrmp.io.movingai import (
+    MAP_SYMBOLS,
+    ScenEntry,
+    parse_scen,
+    read_map,
+    scen_map_problems,
+    select_agents,
+)
+
+TOP_KEYS = ("name", "description", "map", "robots", "scen", "agents", "timing", "network", "policy", "seed", "max_ticks")
+"""Keys allowed at the top level of a scenario file."""
+MAP_KEYS = ("rows", "file", "width", "height")
+"""Keys allowed under ``map``."""
+ROBOT_KEYS = ("id", "start", "goal", "heading")
+"""Keys allowed in each item of ``robots``."""
+TIMING_KEYS = ("cell_time", "turn_time")
+"""Keys allowed under ``timing``."""
+NETWORK_KEYS = ("loss", "delay", "duplicate", "reorder")
+"""Keys allowed under ``network``."""
+POLICY_KEYS = ("name", "resolve", "heading_aware")
+"""Keys allowed under ``policy``."""
+
+_BAD: Any = object()
+"""Returned by a value reader when the value was wrong (a problem has been recorded)."""
+_FLOAT_TEXT = re.compile(r"^[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
+_DELAY_RANGE = re.compile(r"^\s*(-?\d+)\s*\.\.\s*(-?\d+)\s*$")
+_ROBOT_INDEX = re.compile(r"robots\[(\d+)\]")
+
+
+def _line(node: Node) -> int:
+    """The 1-based line where ``node`` starts."""
+    return node.start_mark.line + 1
+
+
+def _describe(node: Node, value: Any = None) -> str:
+    """A short description of what a node holds, for "expected X, got Y" messages."""
+    if isinstance(node, MappingNode):
+        return "a mapping"
+    if isinstance(node, SequenceNode):
+        return "a list"
+    if value is None:
+        return "nothing (null)"
+    if isinstance(value, bool):
+        return f"a boolean {node.value!r}"
+    if isinstance(value, (int, float)):
+        return f"a number {node.value}"
+    return f"a string {str(value)!r}" if isinstance(value, str) else f"{node.value!r}"
+
+
+@dataclass
+class _Entry:
+    """A key of a mapping with its value node and line."""
+
+    key_line: int
+    value: Node
+
+
+@dataclass
+class _Reader:
+    """Walks the YAML nodes of one scenario file, collecting problems and field lines."""
+
+    source: str
+    base_dir: Path
+    known_policies: tuple[str, ...] | None
+    problems: list[Problem] = field(default_factory=list)
+    lines: dict[str, int] = field(default_factory=dict)
+    robot_sources: dict[int, str] = field(default_factory=dict)
+    robot_trouble: bool = False
+    constructor: SafeConstructor = field(default_factory=SafeConstructor)
+
+    # -- recording ---------------------------------------------------------------------
+
+    def report(self, line: int, path: str, reason: str) -> None:
+        """Record a problem at ``line`` about the field ``path``."""
+        text = f"{path}: {reason}" if path else reason
+        self.problems.append(Problem(f"{self.source}:{line}", text))
+        if path.startswith("robots") or path in ("scen", "agents"):
+            self.robot_trouble = True
+
+    def where(self, path: str) -> str:
+        """``file:line`` of the field ``path`` (or of its closest recorded parent)."""
+        match = _ROBOT_INDEX.match(path)
+        if match and int(match.group(1)) in self.robot_sources:
+            return self.robot_sources[int(match.group(1))]
+        candidate = path
+        while candidate:
+            if candidate in self.lines:
+                return f"{self.source}:{self.lines[candidate]}"
+            candidate = re.sub(r"(\.[^.\[\]]+|\[\d+\])$", "", candidate)
+        return f"{self.source}:{self.lines.get('', 1)}"
+
+    # -- structure ---------------------------------------------------------------------
+
+    def mapping(self, node: Node, path: str, allowed: Sequence[str], required: Sequence[str] = ()) -> dict[str, _Entry] | None:
+        """Check that ``node`` is a mapping of known, unique keys; return its entries or None."""
+        if not isinstance(node, MappingNode):
+            self.report(_line(node), path, f"expected a mapping of {', '.join(allowed)}, got {_describe(node, self.scalar(node))}")
+            return None
+        entries: dict[str, _Entry] = {}
+        for key_node, value_node in node.value:
+            key_line = _line(key_node)
+            if not isinstance(key_node, ScalarNode):
+                self.report(key_line, path, "keys must be plain names")
+                continue
+            key = str(key_node.value)
+            if key not in allowed:
+                close = difflib.get_close_matches(key, allowed, n=1)
+                hint = f"did you mean {close[0]!r}?" if close else f"allowed: {', '.join(allowed)}"
+                self.report(key_line, path, f"unknown key {key!r} ({hint})")
+                continue
+            if key in entries:
+                self.report(key_line, path, f"key {key!r} is given twice (first at line {entries[key].key_line})")
+                continue
+            entries[key] = _Entry(key_line, value_node)
+            self.lines[f"{path}.{key}" if path else key] = key_line
+        for key in required:
+            if key not in entries:
+                self.report(_line(node), path, f"missing required key {key!r}")
+        return entries
+
+    def scalar(self, node: Node) -> Any:
+        """The Python value of a scalar node (None for non-scalars or unreadable scalars)."""
+        if not isinstance(node, ScalarNode):
+            return None
+        try:
+            return self.constructor.construct_object(node, deep=True)
+        except yaml.YAMLError:
+            return node.value
+
+    # -- typed values ------------------------------------------------------------------
+
+    def integer(self, node: Node, path: str) -> Any:
+        """An int (not a bool), or ``_BAD``."""
+        value = self.scalar(node)
+        if isinstance(node, ScalarNode) and isinstance(value, int) and not isinstance(value, bool):
+            return value
+        self.report(_line(node), path, f"expected an integer, got {_describe(node, value)}")
+        return _BAD
+
+    def number(self, node: Node, path: str) -> Any:
+        """A float from an int or float (or a plain ``1e-3``), or ``_BAD``."""
+        value = self.scalar(node)
+        if isinstance(node, ScalarNode):
+            if isinstance(value, (int, float)) and not isinstance(value, bool):
+                return float(value)
+            if isinstance(value, str) and node.style is None and _FLOAT_TEXT.match(value):
+                return float(value)
+        self.report(_line(node), path, f"expected a number, got {_describe(node, value)}")
+        return _BAD
+
+    def boolean(self, node: Node, path: str) -> Any:
+        """A bool, or ``_BAD``."""
+        value = self.scalar(node)
+        if isinstance(node, ScalarNode) and isinstance(value, bool):
+            return value
+        self.report(_line(node), path, f"expected true or false, got {_describe(node, value)}")
+        return _BAD
+
+    def text(self, node: Node, path: str) -> Any:
+        """A string, or ``_BAD``."""
+        value = self.scalar(node)
+        if isinstance(node, ScalarNode) and isinstance(value, str):
+            return value
+        self.report(_line(node), path, f"expected a string, got {_describe(node, value)}")
+        return _BAD
+
+    def label(self, node: Node, path: str) -> Any:
+        """A name: a string, or an integer turned into its text as written; else ``_BAD``."""
+        value = self.scalar(node)
+        if isinstance(node, ScalarNode) and isinstance(value, (str, int)) and not isinstance(value, bool):
+            return str(node.value)
+        self.report(_line(node), path, f"expected a string or an integer, got {_describe(node, value)} (quote it)")
+        return _BAD
+
+    def cell(self, node: Node, path: str) -> Any:
+        """A cell from a list of two integers ``[x, y]``, or ``_BAD``."""
+        if isinstance(node, SequenceNode) and len(node.value) == 2:
+            values = [self.scalar(item) for item in node.value]
+            if all(isinstance(v, int) and not isinstance(v, bool) for v in values):
+                return (values[0], values[1])
+        got = f"a list of {len(node.value)} items" if isinstance(node, SequenceNode) else _describe(node, self.scalar(node))
+        if isinstance(node, SequenceNode) and len(node.value) == 2:
+            got = "[" + ", ".join(str(item.value) if isinstance(item, ScalarNode) else "..." for item in node.value) + "]"
+        self.report(_line(node), path, f"expected a list of two integers [x, y], got {got}")
+        return _BAD
+
+    def heading(self, node: Node, path: str) -> Any:
+        """A :class:`Heading` from a name or 1-4, or ``_BAD``."""
+        value = self.scalar(node)
+        if isinstance(node, ScalarNode) and isinstance(value, (str, int)) and not isinstance(value, bool):
+            try:
+                return Heading.parse(value)
+            except ValueError:
+                pass
+        self.report(_line(node), path, f"unknown heading {_describe(node, value)}: use NORTH, EAST, SOUTH, WEST or 1-4")
+        return _BAD
+
+    def delay(self, node: Node, path: str) -> Any:
+        """A delay range ``(min, max)`` from ``N``, ``"A..B"`` or ``[A, B]``, or ``_BAD``."""
+        value = self.scalar(node)
+        if isinstance(node, ScalarNode):
+            if isinstance(value, int) and not isinstance(value, bool):
+                return (value, value)
+            if isinstance(value, str):
+                match = _DELAY_RANGE.match(value)
+                if match:
+                    return (int(match.group(1)), int(match.group(2)))
+        if isinstance(node, SequenceNode) and len(node.value) == 2:
+            values = [self.scalar(item) for item in node.value]
+            if all(isinstance(v, int) and not isinstance(v, bool) for v in values):
+                return (values[0], values[1])
+        self.report(_line(node), path, f"expected ticks as N, \"A..B\" or [A, B], got {_describe(node, value)}")
+        return _BAD
+
+    def optional(self, entries: dict[str, _Entry] | None, key: str, path: str, read: Callable[[Node, str], Any]) -> Any:
+        """Read ``entries[key]`` with ``read``; None when absent or null, ``_BAD`` when wrong."""
+        if entries is None or key not in entries:
+            return None
+        node = entries[key].value
+        if isinstance(node, ScalarNode) and node.tag.endswith(":null"):
+            return None
+        return read(node, path)
+
+    # -- sections ----------------------------------------------------------------------
+
+    def read_map_section(self, node: Node, name: str) -> Grid | None:
+        """The grid of the ``map`` section, or None if it is wrong (problems recorded)."""
+        entries = self.mapping(node, "map", MAP_KEYS)
+        if entries is None:
+            return None
+        forms = [form for form, keys in (("rows", ("rows",)), ("file", ("file",)), ("width and height", ("width", "height"))) if any(k in entries for k in keys)]
+        if len(forms) != 1:
+            reason = "needs rows, file, or width and height" if not forms else f"give exactly one of rows, file, or width and height; got {' and '.join(forms)}"
+            self.report(_line(node), "map", reason)
+            return None
+        if "rows" in entries:
+            return self.read_rows(entries["rows"].value, name)
+        if "file" in entries:
+            return self.read_map_file(entries["file"].value)
+        missing = [key for key in ("width", "height") if key not in entries]
+        if missing:
+            self.report(_line(node), "map", f"missing required key {missing[0]!r} (width and height go together)")
+            return None
+        width = self.integer(entries["width"].value, "map.width")
+        height = self.integer(entries["height"].value, "map.height")
+        for key, value in (("width", width), ("height", height)):
+            if value is not _BAD and value <= 0:
+                self.report(entries[key].key_line, f"map.{key}", f"must be a positive integer, got {value}")
+                return None
+        if width is _BAD or height is _BAD:
+            return None
+        return Grid(height, width, name=name)
+
+    def read_rows(self, node: Node, name: str) -> Grid | None:
+        """A grid from ``map.rows`` (first row northmost), or None."""
+        if not isinstance(node, SequenceNode) or not node.value:
+            got = "an empty list" if isinstance(node, SequenceNode) else _describe(node, self.scalar(node))
+            self.report(_line(node), "map.rows", f"expected a non-empty list of rows of symbols, got {got}")
+            return None
+        rows: list[str] = []
+        ok = True
+        for index, item in enumerate(node.value):
+            path = f"map.rows[{index}]"
+            self.lines[path] = _line(item)
+            if not isinstance(item, ScalarNode):
+                self.report(_line(item), path, f"expected a row of symbols, got {_describe(item)}")
+                ok = False
+                continue
+            row = str(item.value)
+            rows.append(row)
+            if len(row) != len(rows[0]):
+                self.report(_line(item), path, f"has {len(row)} symbols, expected {len(rows[0])} like map.rows[0]")
+                ok = False
+            unknown = [(column, symbol) for column, symbol in enumerate(row) if symbol not in MAP_SYMBOLS]
+            if unknown:
+                column, symbol = unknown[0]
+                self.report(_line(item), path, f"column {column}: unknown symbol {symbol!r} (use . for free, @ for blocked, 1-9 for a cost)")
+                ok = False
+        return Grid.from_rows(rows, name=name) if ok else None
+
+    def read_map_file(self, node: Node) -> Grid | None:
+        """A grid from ``map.file`` (relative to the scenario's folder), or None."""
+        relative = self.text(node, "map.file")
+        if relative is _BAD:
+            return None
+        path = self.base_dir / relative
+        if not path.is_file():
+            self.report(_line(node), "map.file", f"map file not found: {path}")
+            return None
+        try:
+            return read_map(path)
+        except InputError as error:
+            self.problems.extend(error.problems)
+            return None
+
+    def read_robots(self, node: Node) -> list[tuple[int, RobotSpec]]:
+        """The robots that are well formed, each with its index in the file."""
+        if not isinstance(node, SequenceNode):
+            self.report(_line(node), "robots", f"expected a list of robots, got {_describe(node, self.scalar(node))}")
+            return []
+        robots: list[tuple[int, RobotSpec]] = []
+        for index, item in enumerate(node.value):
+            path = f"robots[{index}]"
+            self.lines[path] = _line(item)
+            entries = self.mapping(item, path, ROBOT_KEYS, required=("id", "start", "goal"))
+            if entries is None:
+                continue
+            values = {
+                "id": self.optional(entries, "id", f"{path}.id", self.label),
+                "start": self.optional(entries, "start", f"{path}.start", self.cell),
+                "goal": self.optional(entries, "goal", f"{path}.goal", self.cell),
+                "heading": self.optional(entries, "heading", f"{path}.heading", self.heading),
+            }
+            for key in ("id", "start", "goal"):
+                if key in entries and values[key] is None:
+                    self.report(entries[key].key_line, f"{path}.{key}", "missing value")
+            if any(values[key] is None or values[key] is _BAD for key in ("id", "start", "goal")) or values["heading"] is _BAD:
+                self.robot_trouble = True
+                continue
+            heading = values["heading"] if values["heading"] is not None else Heading.NORTH
+            robots.append((index, RobotSpec(values["id"], values["start"], values["goal"], heading)))
+        return robots
+
+    def read_scen_robots(self, entries: dict[str, _Entry], grid: Grid | None) -> tuple[Grid | None, list[tuple[int, RobotSpec]]]:
+        """The robots (and, without a ``map`` section, the grid) of ``scen`` + ``agents``."""
+        relative = self.optional(entries, "scen", "scen", self.text)
+        agents = self.optional(entries, "agents", "agents", self.integer)
+        if "agents" not in entries:
+            self.report(entries["scen"].key_line, "scen", "needs agents: N next to it")
+        elif agents is not _BAD and agents is not None and agents < 1:
+            self.report(entries["agents"].key_line, "agents", f"must be at least 1, got {agents}")
+            agents = _BAD
+        if relative is None or relative is _BAD or agents is None or agents is _BAD:
+            return grid, []
+        path = self.base_dir / relative
+        if not path.is_file():
+            self.report(entries["scen"].key_line, "scen", f"scenario file not found: {path}")
+            return grid, []
+        try:
+            text = read_text(path)
+            scen_entries = parse_scen(text, str(path))
+            if grid is None and "map" not in self.lines:
+                grid = self.grid_next_to(path, scen_entries, entries["scen"].key_line)
+            if grid is None:
+                return None, []
+            problems = scen_map_problems(scen_entries, grid, str(path))
+            if problems:
+                raise InputError(problems)
+            chosen = select_agents(scen_entries, agents, str(path), max(len(text.splitlines()), 1))
+        except InputError as error:
+            self.problems.extend(error.problems)
+            self.robot_trouble = True
+            return grid, []
+        for index, entry in enumerate(chosen):
+            self.robot_sources[index] = f"{path}:{entry.line}"
+        return grid, [(index, entry.robot(str(index))) for index, entry in enumerate(chosen)]
+
+    def grid_next_to(self, scen_path: Path, entries: Sequence[ScenEntry], line: int) -> Grid | None:
+        """The map a ``.scen`` file names, read from the ``.scen`` file's folder."""
+        if not entries:
+            self.report(line, "scen", f"{scen_path} lists no agents")
+            return None
+        map_path = scen_path.parent / entries[0].map_name
+        if not map_path.is_file():
+            self.report(line, "scen", f"map file {entries[0].map_name!r} named by {scen_path} not found (looked for {map_path})")
+            return None
+        return read_map(map_path)
+
+    def read_settings(self, top: dict[str, _Entry]) -> tuple[Timing, NetworkFaults, PolicyOptions]:
+        """The ``timing``, ``network`` and ``policy`` sections (defaults where absent or wrong)."""
+        timing_entries = self.section(top, "timing", TIMING_KEYS)
+        timing_values = {key: self.optional(timing_entries, key, f"timing.{key}", self.number) for key in TIMING_KEYS}
+        timing = Timing(**_given(timing_values))
+        network_entries = self.section(top, "network", NETWORK_KEYS)
+        network_values = {key: self.optional(network_entries, key, f"network.{key}", self.number) for key in ("loss", "duplicate", "reorder")}
+        delay = self.optional(network_entries, "delay", "network.delay", self.delay)
+        if delay is not None and delay is not _BAD:
+            network_values["delay_min"], network_values["delay_max"] = delay
+        network = NetworkFaults(**_given(network_values))
+        policy_entries = self.section(top, "policy", POLICY_KEYS)
+        policy_values = {
+            "name": self.optional(policy_entries, "name", "policy.name", self.text),
+            "resolve": self.optional(policy_entries, "resolve", "policy.resolve", self.text),
+            "heading_aware": self.optional(policy_entries, "heading_aware", "policy.heading_aware", self.boolean),
+        }
+        policy = PolicyOptions(**_given(policy_values))
+        if self.known_policies is not None and policy_values["name"] not in (None, _BAD) and policy.name not in self.known_policies:
+            known = ", ".join(self.known_policies)
+            self.report(self.lines["policy.name"], "policy.name", f"unknown policy {policy.name!r}; known policies: {known}")
+        return timing, network, policy
+
+    def section(self, top: dict[str, _Entry], key: str, allowed: Sequence[str]) -> dict[str, _Entry] | None:
+        """The entries of an optional sub-mapping (None when absent, null or wrong)."""
+        if key not in top:
+            return None
+        node = top[key].value
+        if isinstance(node, ScalarNode) and node.tag.endswith(":null"):
+            return None
+        return self.mapping(node, key, allowed)
+
+    # -- whole file --------------------------------------------------------------------
+
+    def read(self, root: Node) -> Scenario | None:
+        """Build the scenario from the root node; None if anything was wrong."""
+        self.lines[""] = _line(root)
+        top = self.mapping(root, "", TOP_KEYS)
+        if top is None:
+            return None
+        name = self.optional(top, "name", "name", self.label)
+        name = Path(self.source).stem if name is None or name is _BAD else name
+        description = self.optional(top, "description", "description", self.text)
+        has_scen = "scen" in top
+        if has_scen and "robots" in top:
+            self.report(top["scen"].key_line, "scen", "give either robots or scen + agents, not both")
+        if not has_scen and "agents" in top:
+            self.report(top["agents"].key_line, "agents", "only allowed together with scen")
+        for key in ("map", "robots"):
+            if key not in top and not has_scen:
+                self.report(_line(root), "", f"missing required key {key!r}")
+        grid = self.read_map_section(top["map"].value, name) if "map" in top else None
+        robots: list[tuple[int, RobotSpec]] = []
+        if has_scen:
+            grid, robots = self.read_scen_robots(top, grid)
+        elif "robots" in top:
+            robots = self.read_robots(top["robots"].value)
+        timing, network, policy = self.read_settings(top)
+        seed = self.optional(top, "seed", "seed", self.integer)
+        max_ticks = self.optional(top, "max_ticks", "max_ticks", self.integer)
+        scenario = Scenario(
+            grid=grid if grid is not None else Grid(1, 1),
+            robots=tuple(robot for _, robot in robots),
+            timing=timing,
+            network=network,
+            policy=policy,
+            seed=0 if seed is None or seed is _BAD else seed,
+            max_ticks=None if max_ticks is _BAD else max_ticks,
+            name=name,
+            description="" if description is None or description is _BAD else description,
+        )
+        self.check_meaning(scenario, grid is not None, [index for index, _ in robots])
+        return None if self.problems else scenario
+
+    def check_meaning(self, scenario: Scenario, have_grid: bool, indices: list[int]) -> None:
+        """Add :func:`scenario_problems`, placed at the lines of their fields."""
+
+        def original(text: str) -> str:
+            return _ROBOT_INDEX.sub(lambda m: f"robots[{indices[int(m.group(1))]}]", text)
+
+        for problem in scenario_problems(scenario):
+            if problem.where.startswith("robots") and (not have_grid or (problem.where == "robots" and self.robot_trouble)):
+                continue
+            path = original(problem.where)
+            self.problems.append(Problem(self.where(path), f"{path}: {original(problem.reason)}"))
+
+
+def _given(values: dict[str, Any]) -> dict[str, Any]:
+    """The values that were given and well formed."""
+    return {key: value for key, value in values.items() if value is not None and value is not _BAD}
+
+
+def _yaml_error_problem(error: yaml.YAMLError, text: str, source: str) -> Problem:
+    """One problem, with file and line, for a YAML syntax error."""
+    if isinstance(error, yaml.MarkedYAMLError):
+        mark = error.problem_mark or error.context_mark
+        line = mark.line + 1 if mark is not None else 1
+        reason = error.problem or error.context or "malformed YAML"
+        if error.context and error.problem:
+            started = error.context_mark
+            at = f" started at line {started.line + 1}" if started is not None and started.line + 1 != line else ""
+            reason = f"{error.problem} ({error.context}{at})"
+        return Problem(f"{source}:{line}", f"invalid YAML: {reason}")
+    position = getattr(error, "position", None)
+    line = text.count("\n", 0, position) + 1 if isinstance(position, int) else 1
+    reason = getattr(error, "reason", None) or str(error).splitlines()[0]
+    return Problem(f"{source}:{line}", f"invalid YAML: {reason}")
+
+
+def _problem_order(problem: Problem, source: str) -> tuple[bool, str, int]:
+    """Sort key: problems of ``source`` first, then other files, each by line."""
+    file, _, line = problem.where.rpartition(":")
+    if not line.isdigit():
+        file, line = problem.where, "0"
+    return (file != source, file, int(line))
+
+
+def scenario_from_text(
+    text: str,
+    source_name: str = "<scenario>",
+    known_policies: Sequence[str] | None = None,
+    base_dir: PathLike | None = None,
+) -> Scenario:
+    """Read a scenario from YAML text, strictly.
+
+    Parameters
+    ----------
+    text:
+        The YAML document.
+    source_name:
+        The file name used in problems and as the default scenario name (its stem).
+    known_policies:
+        When given, ``policy.name`` must be one of these.
+    base_dir:
+        The folder relative ``map.file`` and ``scen`` paths start from; by
+        default the folder of ``source_name``.
+
+    Returns
+    -------
+    Scenario
+        The scenario, which also passes :func:`scenario_problems`.
+
+    Raises
+    ------
+    InputError
+        Listing every problem as ``source_name:line`` and ``field.path: reason``.
+
+    Examples
+    --------
+    >>> text = "map: {width: 5, height: 5}\\nrobots:\\n  - {id: A, start: [0, 2], goal: [9, 2]}\\n"
+    >>> scenario_from_text(text, "swap.yaml")
+    Traceback (most recent call last):
+    ...
+    mrmp.core.errors.InputError: swap.yaml:3: robots[0].goal: cell (9, 2) is outside the 5x5 grid
+    """
+    folder = Path(source_name).parent if base_dir is None else Path(base_dir)
+    try:
+        root = yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.YAMLError as error:
+        raise InputError(_yaml_error_problem(error, text, source_name)) from None
+    if root is None:
+        raise InputError(Problem(f"{source_name}:1", "the file is empty: expected a mapping with map and robots"))
+    if not isinstance(root, MappingNode):
+        kind = "a list" if isinstance(root, SequenceNode) else f"a single value {root.value!r}"
+        raise InputError(Problem(f"{source_name}:{_line(root)}", f"the top level must be a mapping (name, map, robots, ...), got {kind}"))
+    policies = tuple(known_policies) if known_policies is not None else None
+    reader = _Reader(source_name, folder, policies)
+    scenario = reader.read(root)
+    if scenario is None:
+        raise InputError(sorted(reader.problems, key=lambda problem: _problem_order(problem, source_name)))
+    return scenario
+
+
+def load_scenario(path: PathLike, known_policies: Sequence[str] | None = None) -> Scenario:
+    """Read a YAML scenario file, strictly (see :func:`scenario_from_text`).
+
+    Parameters
+    ----------
+    path:
+        The ``.yaml`` file; ``map.file`` and ``scen`` are relative to its folder.
+    known_policies:
+        When given, ``policy.name`` must be one of these.
+
+    Returns
+    -------
+    Scenario
+        The checked scenario; its name defaults to the file's stem.
+
+    Raises
+    ------
+    InputError
+        If the file cannot be read or anything in it is wrong (every problem
+        listed as ``file:line: field.path: reason``).
+    """
+    return scenario_from_text(read_text(path), str(path), known_policies, Path(path).parent)
+
+
+def load_movingai_scenario(map_path: PathLike, scen_path: PathLike, agents: int) -> Scenario:
+    """The first ``agents`` agents of a MovingAI ``.scen`` file on its ``.map``, as a scenario.
+
+    Robots are named ``"0"``, ``"1"``, ... and face NORTH; the scenario is named
+    after the ``.scen`` file and uses default timing, network and policy.
+
+    Parameters
+    ----------
+    map_path:
+        The ``.map`` file.
+    scen_path:
+        The ``.scen`` file.
+    agents:
+        How many agents to take from the top of the ``.scen`` file.
+
+    Returns
+    -------
+    Scenario
+        The checked scenario.
+
+    Raises
+    ------
+    InputError
+        If a file is missing or malformed, the sizes differ, the file lists fewer
+        agents than asked, or a robot's cells are wrong on the map (named by the
+        ``.scen`` line of that agent).
+    """
+    grid = read_map(map_path)
+    source = str(scen_path)
+    text = read_text(scen_path)
+    entries = parse_scen(text, source)
+    mismatch = scen_map_problems(entries, grid, source)
+    if mismatch:
+        raise InputError(mismatch)
+    chosen = select_agents(entries, agents, source, max(len(text.splitlines()), 1))
+    scenario = Scenario(
+        grid=grid,
+        robots=tuple(entry.robot(str(index)) for index, entry in enumerate(chosen)),
+        name=Path(scen_path).stem,
+        description=f"first {agents} agents of {Path(scen_path).name} on {Path(map_path).name}",
+    )
+    problems = []
+    for problem in scenario_problems(scenario):
+        match = _ROBOT_INDEX.match(problem.where)
+        where = f"{source}:{chosen[int(match.group(1))].line}" if match else source
+        problems.append(Problem(where, f"{problem.where}: {problem.reason}"))
+    if problems:
+        raise InputError(problems)
+    return scenario
+
+
+# -- writing ---------------------------------------------------------------------------
+
+
+def _yaml_float(value: float) -> str:
+    """A float as text that PyYAML's YAML 1.1 resolver reads back as the same float.
+
+    >>> _yaml_float(0.5), _yaml_float(1e-05), _yaml_float(float("inf"))
+    ('0.5', '1.0e-05', '.inf')
+    """
+    if math.isnan(value):
+        return ".nan"
+    if math.isinf(value):
+        return ".inf" if value > 0 else "-.inf"
+    text = repr(float(value))
+    if "e" in text:
+        mantissa, exponent = text.split("e")
+        if "." not in mantissa:
+            mantissa += ".0"
+        if exponent[0] not in "+-":
+            exponent = "+" + exponent
+        text = f"{mantissa}e{exponent}"
+    return text
+
+
+def _quote(text: str) -> str:
+    """A YAML double-quoted string (JSON's quoting is valid YAML)."""
+    return json.dumps(text, ensure_ascii=False)
+
+
+def _cell_text(cell: Cell) -> str:
+    """``[x, y]``."""
+    return f"[{cell[0]}, {cell[1]}]"
+
+
+def scenario_to_yaml(scenario: Scenario, map_file: str | None = None) -> str:
+    """The YAML text of ``scenario``, readable by :func:`scenario_from_text`.
+
+    Parameters
+    ----------
+    scenario:
+        The scenario to write.
+    map_file:
+        When given, the map is written as ``map: {file: map_file}`` instead of
+        inline rows (the caller keeps that file next to the YAML).
+
+    Returns
+    -------
+    str
+        The YAML document. With inline rows, loading it gives back an equal scenario.
+
+    Raises
+    ------
+    ValueError
+        If a cell cost cannot be drawn as a map symbol (only whole costs 1-9 can).
+
+    Examples
+    --------
+    >>> from mrmp.core.grid import Grid
+    >>> scenario = Scenario(Grid.from_rows(["..", ".@"]), (RobotSpec("A", (0, 0), (1, 0)),), name="tiny")
+    >>> scenario_from_text(scenario_to_yaml(scenario), "x.yaml") == scenario
+    True
+    """
+    grid = scenario.grid
+    lines = [f"name: {_quote(scenario.name)}"]
+    if scenario.description:
+        lines.append(f"description: {_quote(scenario.description)}")
+    if map_file is not None:
+        lines += ["map:", f"  file: {_quote(map_file)}"]
+    else:
+        for cell, cost in grid.costs().items():
+            if cost not in COST_SYMBOLS.values():
+                raise ValueError(f"cell {cell} costs {cost}: only whole costs 1-9 can be written as map symbols")
+        lines += ["map:", "  rows:"] + [f"    - {_quote(row)}" for row in grid.to_rows()]
+    lines.append("robots:")
+    for robot in scenario.robots:
+        lines.append(
+            f"  - {{id: {_quote(robot.id)}, start: {_cell_text(robot.start)}, goal: {_cell_text(robot.goal)}, heading: {robot.heading.name}}}"
+        )
+    timing, network, policy = scenario.timing, scenario.network, scenario.policy
+    lines.append(f"timing: {{cell_time: {_yaml_float(timing.cell_time)}, turn_time: {_yaml_float(timing.turn_time)}}}")
+    delay = str(network.delay_min) if network.delay_min == network.delay_max else _quote(f"{network.delay_min}..{network.delay_max}")
+    lines.append(
+        f"network: {{loss: {_yaml_float(network.loss)}, delay: {delay}, "
+        f"duplicate: {_yaml_float(network.duplicate)}, reorder: {_yaml_float(network.reorder)}}}"
+    )
+    heading_aware = "true" if policy.heading_aware else "false"
+    lines.append(f"policy: {{name: {_quote(policy.name)}, resolve: {_quote(policy.resolve)}, heading_aware: {heading_aware}}}")
+    lines.append(f"seed: {scenario.seed}")
+    if scenario.max_ticks is not None:
+        lines.append(f"max_ticks: {scenario.max_ticks}")
+    return "\n".join(lines) + "\n"
+
+
+def save_scenario(scenario: Scenario, path: PathLike, map_file: str | None = None) -> None:
+    """Write ``scenario`` as a YAML file (atomically); see :func:`scenario_to_yaml`.
+
+    Raises
+    ------
+    ValueError
+        If a cell cost cannot be drawn as a map symbol.
+    InputError
+        If the file cannot be written.
+    """
+    atomic_write_text(path, scenario_to_yaml(scenario, map_file))

@@ -1,0 +1,101 @@
+"""Reactive A*: each robot follows its own A* path and yields by the thesis's priority rule.
+
+This is the thesis's future work 1 and 2 (chapter 5): A* with costs for more
+complex environments, and more robots. Each robot plans an A* path (Hart,
+Nilsson & Raphael 1968) around static obstacles, optionally over headings so
+that turns cost time. It announces the next cell of its path, uses the thesis's
+Obstacle Found test and priority (higher x, then higher y), and, when it is the
+lower-priority robot, either waits (``resolve="wait"``) or replans around the
+higher-priority robots in its way, treating their Present and Next cells as
+blocked for this step (``resolve="divert"``). The new plan is kept.
+
+One departure from the thesis's rule, because A* plans around obstacles: a peer
+that has arrived and stays (its Present equals its Next) is a static obstacle
+for as long as it stays there. A conflict with it is resolved by replanning
+around it whatever the priorities (the thesis's higher-priority robot would
+drive into it; waiting for it would never end).
+
+Like the thesis's rule it has no progress guarantee: it can deadlock in narrow
+corridors and livelock in crowds, and the referee reports it.
+"""
+
+from __future__ import annotations
+
+from mrmp.core.cell import Cell
+from mrmp.core.errors import NoPathError
+from mrmp.core.scenario import Timing
+from mrmp.policies.base import Decision, Situation
+from mrmp.policies.priority import claimed_cells, conflicting_peers, outranks_all
+from mrmp.search.planners import astar
+
+
+class AstarPolicy:
+    """Follow an A* path; on a conflict with a higher-priority robot, replan or wait.
+
+    Parameters
+    ----------
+    resolve:
+        ``"divert"`` (replan around the higher-priority robots) or ``"wait"``.
+    heading_aware:
+        Plan over (cell, heading) so that right turns cost ``timing.turn_time``.
+    timing:
+        The robot's timing, used when ``heading_aware``.
+    """
+
+    name = "astar"
+
+    def __init__(self, resolve: str = "divert", heading_aware: bool = False, timing: Timing | None = None) -> None:
+        self.resolve = resolve
+        self.heading_aware = heading_aware
+        self.timing = timing or Timing()
+        self._path: list[Cell] = []
+        self.replans = 0
+
+    def _plan(self, situation: Situation, blocked: frozenset[Cell] = frozenset()) -> list[Cell] | None:
+        heading = situation.heading if self.heading_aware else None
+        try:
+            result = astar(situation.grid, situation.present, situation.goal, blocked=blocked, heading=heading, timing=self.timing)
+        except NoPathError:
+            return None
+        return list(result.path)
+
+    def intend(self, situation: Situation) -> Cell:
+        """The next cell of the current plan, planning afresh when off it."""
+        present = situation.present
+        if present == situation.goal:
+            return present
+        if len(self._path) < 2 or self._path[0] != present:
+            self._path = self._plan(situation) or [present]
+        return self._path[1] if len(self._path) > 1 else present
+
+    def decide(self, situation: Situation, intended: Cell) -> Decision:
+        """Apply the thesis's detection and priority; replan around higher-priority robots."""
+        present = situation.present
+        if intended == present:
+            return Decision(present, "arrived" if present == situation.goal else "wait")
+        conflicts = conflicting_peers(intended, situation.peers)
+        if not conflicts:
+            self._advance(intended)
+            return Decision(intended, "clear")
+        conflict_ids = tuple(peer.index for peer in conflicts)
+        parked = [peer for peer in situation.peers.values() if peer.arrived and peer.present == peer.next]
+        blocked_by_parked = any(peer.arrived and peer.present == peer.next for peer in conflicts)
+        if not blocked_by_parked:
+            if outranks_all(present, situation.index, conflicts):
+                self._advance(intended)
+                return Decision(intended, "priority", conflict_ids)
+            if self.resolve == "wait":
+                return Decision(present, "wait", conflict_ids)
+        avoid = frozenset(cell for peer in [*conflicts, *parked] for cell in (peer.present, peer.next))
+        self.replans += 1
+        path = self._plan(situation, blocked=avoid)
+        if path is None or len(path) < 2 or path[1] in claimed_cells(situation.peers):
+            return Decision(present, "blocked", conflict_ids)
+        step = path[1]
+        self._path = path
+        self._advance(step)
+        return Decision(step, "divert", conflict_ids)
+
+    def _advance(self, entered: Cell) -> None:
+        if len(self._path) > 1 and self._path[1] == entered:
+            self._path.pop(0)

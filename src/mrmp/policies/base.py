@@ -1,0 +1,81 @@
+"""What every decision rule sees and returns.
+
+A policy is a pure per-robot object. Twice per step the robot asks it:
+
+1. :meth:`Policy.intend`: which cell do I want next (the thesis's "Next"), from
+   my own state only; the robot announces it to its peers;
+2. :meth:`Policy.decide`: having heard my peers' Present and Next, which cell do
+   I really enter (or stay on), and why.
+
+Policies never see the world's ground truth, only a :class:`Situation` built
+from the robot's own state and its :class:`~mrmp.robot.belief.Belief`.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Protocol
+
+from mrmp.core.cell import Cell
+from mrmp.core.grid import Grid
+from mrmp.core.heading import Heading
+
+
+@dataclass(frozen=True, slots=True)
+class PeerState:
+    """What a robot last heard from one peer, and when (in the driver's time)."""
+
+    index: int
+    present: Cell
+    next: Cell
+    heading: Heading
+    arrived: bool
+    seq: int
+    heard_at: float
+
+
+@dataclass(frozen=True, slots=True)
+class Situation:
+    """A robot's own state and its knowledge of its peers at one decision."""
+
+    index: int
+    present: Cell
+    heading: Heading
+    goal: Cell
+    grid: Grid
+    peers: Mapping[int, PeerState]
+
+
+@dataclass(frozen=True, slots=True)
+class Decision:
+    """The cell a robot will occupy after this step, and the rule that chose it.
+
+    ``reason`` is one of ``"arrived"``, ``"clear"``, ``"priority"`` (conflict,
+    but this robot outranks every conflicting peer and continues), ``"divert"``,
+    ``"wait"`` or ``"blocked"`` (wanted to divert but the diversion cell was
+    taken, so it stays).
+    """
+
+    next: Cell
+    reason: str
+    conflicts: tuple[int, ...] = ()
+
+    @property
+    def moves(self) -> bool:
+        """Whether the decision is a move (not a wait)."""
+        return self.reason not in ("arrived", "wait", "blocked")
+
+
+class Policy(Protocol):
+    """A per-robot decision rule."""
+
+    name: str
+
+    def intend(self, situation: Situation) -> Cell:
+        """The cell this robot would like to enter next (its announced Next)."""
+        ...
+
+    def decide(self, situation: Situation, intended: Cell) -> Decision:
+        """The cell this robot enters (or keeps) after hearing its peers."""
+        ...

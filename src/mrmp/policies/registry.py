@@ -1,0 +1,48 @@
+"""The one table of decision rules, by name.
+
+Examples
+--------
+>>> sorted(POLICIES)
+['astar', 'thesis']
+>>> make_policy(PolicyOptions(name="thesis", resolve="wait")).resolve
+'wait'
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+from mrmp.core.errors import InputError, Problem
+from mrmp.core.scenario import PolicyOptions, Timing
+from mrmp.policies.astar import AstarPolicy
+from mrmp.policies.base import Policy
+from mrmp.policies.thesis import ThesisPolicy
+
+PolicyFactory = Callable[[PolicyOptions, Timing], Policy]
+
+POLICIES: dict[str, PolicyFactory] = {
+    "thesis": lambda options, timing: ThesisPolicy(resolve=options.resolve),
+    "astar": lambda options, timing: AstarPolicy(
+        resolve=options.resolve, heading_aware=options.heading_aware, timing=timing
+    ),
+}
+"""Every policy name a scenario or ``--policy`` may use, with its factory."""
+
+POLICY_NAMES: tuple[str, ...] = tuple(POLICIES)
+
+
+def make_policy(options: PolicyOptions, timing: Timing | None = None) -> Policy:
+    """A fresh policy object for one robot.
+
+    Raises
+    ------
+    InputError
+        If ``options.name`` is not a known policy.
+    """
+    try:
+        factory = POLICIES[options.name]
+    except KeyError:
+        raise InputError(
+            Problem("policy.name", f"unknown policy {options.name!r}; known: {', '.join(POLICY_NAMES)}")
+        ) from None
+    return factory(options, timing or Timing())

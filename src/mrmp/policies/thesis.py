@@ -1,0 +1,110 @@
+"""The thesis's decentralized rule: update coordinates, detect, prioritize, change route.
+
+Source: H. K. Buttar, *Multi-Robot Motion Planning with Communication*, M.S.
+thesis, University of Cincinnati, chapter 3:
+
+* section 3.1 item 4 and 3.2 assumption 2, the *update coordinate method*:
+  move x toward the destination until equal, then y;
+* section 3.6, *Obstacle Avoidance*: Obstacle Found when Next equals the
+  other's Present or the other's Next (:mod:`mrmp.policies.priority`);
+* section 3.6, *Diversion*: the robot with the lower x (then lower y) changes
+  its route, the other continues;
+* section 3.6, *Change of Route*: the lower-priority robot sidesteps (below);
+* section 2.1, *velocity tuning*, the other technique the thesis names: with
+  ``resolve="wait"`` the lower-priority robot stops instead of diverting.
+
+Choices where the pseudo-code is silent or ambiguous are listed in
+``docs/thesis.md`` and tested; in short: "Update Y" on line 5 steps toward the
+destination (it is the update-coordinate step), "Update" where the coordinate
+already equals the destination means +1 (as "NORTH = x update"); a diversion
+cell that is off the grid, a static obstacle, or another robot's Present or Next
+is not entered (the robot waits); a static obstacle on Next is an obstacle
+that never yields; and the rule is memoryless: every step starts again from
+the update-coordinate method at the current cell.
+
+Examples
+--------
+>>> change_of_route(present=(1, 2), goal=(4, 2), x_max=4, y_max=4)   # y at destination, not Ymax: y + 1
+(1, 3)
+>>> change_of_route(present=(1, 0), goal=(4, 4), x_max=4, y_max=4)   # y not at destination: step toward it
+(1, 1)
+>>> change_of_route(present=(4, 3), goal=(4, 0), x_max=4, y_max=4)   # x at destination and at Xmax: x - 1
+(3, 3)
+"""
+
+from __future__ import annotations
+
+from mrmp.core.cell import Cell, step_toward
+from mrmp.policies.base import Decision, Situation
+from mrmp.policies.priority import claimed_cells, conflicting_peers, outranks_all
+
+
+def update_coordinate_step(present: Cell, goal: Cell) -> Cell:
+    """The next cell of the update coordinate method: x first, then y.
+
+    >>> update_coordinate_step((0, 0), (4, 4)), update_coordinate_step((4, 0), (4, 4))
+    ((1, 0), (4, 1))
+    """
+    if present[0] != goal[0]:
+        return (step_toward(present[0], goal[0]), present[1])
+    return (present[0], step_toward(present[1], goal[1]))
+
+
+def change_of_route(present: Cell, goal: Cell, x_max: int, y_max: int) -> Cell:
+    """The thesis's "Change of Route" pseudo-code (section 3.6), line by line.
+
+    Lines 3-15: while x is not at its destination, the robot sidesteps in y:
+    toward the destination y if it differs (line 5), else +1 (line 9) unless y is
+    already Ymax, then -1 (line 12). Lines 16-23: once x is at its destination,
+    it sidesteps in x: +1 unless x is Xmax, then -1.
+
+    The result may lie off the grid on a one-cell-wide grid; callers check it.
+    """
+    x, y = present
+    goal_x, goal_y = goal
+    if x != goal_x:
+        if y != goal_y:
+            return (x, step_toward(y, goal_y))
+        return (x, y + 1) if y != y_max else (x, y - 1)
+    return (x + 1, y) if x != x_max else (x - 1, y)
+
+
+class ThesisPolicy:
+    """The thesis's rule for one robot (module docstring has the sources and choices).
+
+    Parameters
+    ----------
+    resolve:
+        ``"divert"`` (the thesis's Change of Route) or ``"wait"`` (velocity tuning).
+    """
+
+    name = "thesis"
+
+    def __init__(self, resolve: str = "divert") -> None:
+        self.resolve = resolve
+
+    def intend(self, situation: Situation) -> Cell:
+        """Next of the update coordinate method (or Present once arrived)."""
+        if situation.present == situation.goal:
+            return situation.present
+        return update_coordinate_step(situation.present, situation.goal)
+
+    def decide(self, situation: Situation, intended: Cell) -> Decision:
+        """Apply Obstacle Avoidance, Diversion and Change of Route to the intended Next."""
+        present = situation.present
+        if intended == present:
+            return Decision(present, "arrived" if present == situation.goal else "wait")
+        conflicts = conflicting_peers(intended, situation.peers)
+        wall = not situation.grid.is_free(intended)
+        if not conflicts and not wall:
+            return Decision(intended, "clear")
+        conflict_ids = tuple(peer.index for peer in conflicts)
+        if not wall and outranks_all(present, situation.index, conflicts):
+            return Decision(intended, "priority", conflict_ids)
+        if self.resolve == "wait":
+            return Decision(present, "wait", conflict_ids)
+        grid = situation.grid
+        diversion = change_of_route(present, situation.goal, grid.x_max, grid.y_max)
+        if not grid.is_free(diversion) or diversion in claimed_cells(situation.peers):
+            return Decision(present, "blocked", conflict_ids)
+        return Decision(diversion, "divert", conflict_ids)

@@ -1,0 +1,524 @@
+"""Geometry, colours and motion shared by the GIF and SVG renderers.
+
+Everything here is pure: no file is written and Pillow is not imported, so the
+two renderers draw exactly the same picture from the same numbers.
+
+Drawing convention: NORTH is up and EAST is to the right. The cell ``(x, y)``
+(x grows NORTH, y grows EAST) is drawn at column ``y`` and at row
+``x_size - 1 - x`` counted from the top.
+
+Motion: a robot's :func:`track` lists keyframes ``(t, x, y, angle)`` where
+``t`` is in ticks, ``(x, y)`` is a (fractional) cell and ``angle`` is the
+heading in degrees clockwise from north. Robots only turn right (see
+:func:`mrmp.core.heading.right_turns`), so angles only grow; when a robot both
+turns and moves during a tick it turns in the first half and moves in the
+second.
+
+Examples
+--------
+>>> from mrmp.core import Grid, Heading, RobotResult
+>>> layout = make_layout(Grid(5, 5))
+>>> layout.cell
+72
+>>> layout.centre((4, 0)) == (layout.left + 36.0, layout.top + 36.0)   # NW corner cell
+True
+>>> robot = RobotResult("A", (0, 2), (1, 3), path=[(0, 2), (0, 3), (1, 3)],
+...                     headings=[Heading.NORTH, Heading.EAST, Heading.NORTH])
+>>> [tuple(frame) for frame in track(robot, 2)]
+[(0.0, 0.0, 2.0, 0.0), (0.5, 0.0, 2.0, 90.0), (1.0, 0.0, 3.0, 90.0), (1.5, 0.0, 3.0, 360.0), (2.0, 1.0, 3.0, 360.0)]
+>>> pose_at(track(robot, 2), 0.75)
+(0.0, 2.5, 90.0)
+"""
+
+from __future__ import annotations
+
+import colorsys
+import math
+from bisect import bisect_right
+from collections.abc import Sequence
+from dataclasses import dataclass
+from typing import NamedTuple
+
+from mrmp.core.cell import Cell
+from mrmp.core.grid import Grid
+from mrmp.core.heading import Heading, right_turns
+from mrmp.core.result import RobotResult, RunResult
+
+RGB = tuple[int, int, int]
+"""A colour as 0-255 red, green, blue."""
+
+# -- theme ---------------------------------------------------------------------------
+
+BACKGROUND: RGB = (250, 249, 245)
+"""Page and free-cell colour (warm white)."""
+GRID_LINE: RGB = (222, 220, 212)
+"""Thin lines between cells."""
+OBSTACLE: RGB = (52, 58, 72)
+"""Blocked cells (dark slate)."""
+OBSTACLE_EDGE: RGB = (38, 42, 53)
+"""Outline of blocked cells."""
+HEADER: RGB = (36, 41, 54)
+"""Caption band above the grid."""
+HEADER_TEXT: RGB = (236, 238, 244)
+"""Caption text."""
+HEADER_DIM: RGB = (150, 158, 178)
+"""Secondary caption text (policy, progress track)."""
+SUCCESS: RGB = (102, 204, 128)
+"""Caption colour of a successful run."""
+COLLISION: RGB = (228, 26, 48)
+"""Collision flash."""
+COST_HIGH: RGB = (240, 180, 90)
+"""Tint of the most expensive cells (amber)."""
+COST_LOW: RGB = (150, 214, 180)
+"""Tint of cells cheaper than 1 (mint)."""
+COST_TEXT: RGB = (170, 120, 50)
+"""Cost figures written in big cells."""
+FONT_FAMILY = "DejaVu Sans, Verdana, Helvetica, Arial, sans-serif"
+"""CSS font family for SVG text (the GIF uses DejaVu Sans too when installed)."""
+
+PALETTE: tuple[RGB, ...] = (
+    (78, 121, 167),  # blue
+    (242, 142, 43),  # orange
+    (89, 161, 79),  # green
+    (176, 122, 161),  # purple
+    (237, 201, 72),  # yellow
+    (118, 183, 178),  # teal
+    (255, 157, 167),  # pink
+    (156, 117, 95),  # brown
+    (225, 87, 89),  # red
+    (73, 152, 148),  # sea green
+)
+"""A qualitative palette (Tableau 10, reordered, grey dropped): the first robots' colours."""
+
+# -- robot body, in cell units, pointing NORTH (up, towards -y on screen) ---------------------
+
+ROBOT_RADIUS = 0.31
+"""Radius of a robot's disc, as a fraction of a cell."""
+HEADING_MARKER: tuple[tuple[float, float], ...] = ((0.0, -0.49), (-0.17, -0.2), (0.17, -0.2))
+"""Triangle showing a robot's heading, in cell units around the robot's centre, for NORTH."""
+GOAL_INSET = 0.13
+"""Gap between a goal square and its cell's edge, as a fraction of a cell."""
+GOAL_WIDTH = 0.075
+"""Stroke of a goal square, as a fraction of a cell."""
+TURN_SHARE = 0.5
+"""Fraction of a tick spent turning when a robot turns and moves in the same tick."""
+
+
+# -- layout --------------------------------------------------------------------------
+
+
+@dataclass(frozen=True)
+class Layout:
+    """Where a grid goes in a picture: cell size, margins and the caption band.
+
+    Use :func:`make_layout` rather than building one by hand. Pixel coordinates
+    have their origin at the top-left corner of the picture, y growing down.
+    """
+
+    x_size: int
+    y_size: int
+    cell: int
+    left: int
+    top: int
+    width: int
+    height: int
+    header: int
+    robots: int = 0
+
+    @property
+    def grid_width(self) -> int:
+        """Width of the drawn grid in pixels."""
+        return self.y_size * self.cell
+
+    @property
+    def grid_height(self) -> int:
+        """Height of the drawn grid in pixels."""
+        return self.x_size * self.cell
+
+    def point(self, x: float, y: float) -> tuple[float, float]:
+        """Pixel position of the centre of a (possibly fractional) cell ``(x, y)``.
+
+        >>> make_layout(Grid(3, 4)).point(2, 0) == make_layout(Grid(3, 4)).centre((2, 0))
+        True
+        """
+        return (self.left + (y + 0.5) * self.cell, self.top + (self.x_size - 0.5 - x) * self.cell)
+
+    def centre(self, cell: Cell) -> tuple[float, float]:
+        """Pixel centre of ``cell``: column ``y``, row ``x_size - 1 - x`` from the top.
+
+        >>> layout = make_layout(Grid(5, 5))
+        >>> left, top = layout.left, layout.top
+        >>> layout.centre((0, 0)) == (left + 36.0, top + 4.5 * 72)   # SW corner: bottom left
+        True
+        """
+        return self.point(cell[0], cell[1])
+
+    def cell_box(self, cell: Cell) -> tuple[int, int, int, int]:
+        """Pixel box ``(left, top, right, bottom)`` of ``cell``, right and bottom exclusive.
+
+        >>> layout = make_layout(Grid(2, 2))
+        >>> box = layout.cell_box((1, 0))   # north-west cell
+        >>> (box[0] - layout.left, box[1] - layout.top, box[2] - box[0])
+        (0, 0, 72)
+        """
+        left = self.left + cell[1] * self.cell
+        top = self.top + (self.x_size - 1 - cell[0]) * self.cell
+        return (left, top, left + self.cell, top + self.cell)
+
+    def scaled(self, factor: int) -> Layout:
+        """The same layout with every pixel length multiplied by ``factor`` (for supersampling).
+
+        >>> make_layout(Grid(2, 2)).scaled(2).cell
+        144
+        """
+        return Layout(
+            self.x_size,
+            self.y_size,
+            self.cell * factor,
+            self.left * factor,
+            self.top * factor,
+            self.width * factor,
+            self.height * factor,
+            self.header * factor,
+            self.robots,
+        )
+
+    @property
+    def show_labels(self) -> bool:
+        """Whether robots are big enough, and few enough, to carry their id."""
+        return self.cell >= 26 and self.robots <= 80
+
+    @property
+    def trail_width(self) -> float:
+        """Stroke width of trails in pixels (thin for crowded runs)."""
+        share = 0.14 if self.robots <= 20 else 0.1 if self.robots <= 80 else 0.08
+        return max(1.0, self.cell * share)
+
+    @property
+    def trail_ticks(self) -> int | None:
+        """How many ticks of trail to keep (``None``: the whole path)."""
+        if self.robots <= 20:
+            return None
+        return 12 if self.robots <= 80 else 5
+
+    @property
+    def font_size(self) -> int:
+        """Caption font size in pixels."""
+        return max(11, min(16, self.width // 28))
+
+
+def make_layout(
+    grid: Grid,
+    robots: int = 0,
+    *,
+    max_side: int = 720,
+    max_cell: int = 72,
+    min_cell: int = 2,
+    min_width: int = 300,
+) -> Layout:
+    """Choose the cell size and margins for drawing ``grid``.
+
+    The cell size is the largest that keeps the longer side of the grid within
+    ``max_side`` pixels, between ``min_cell`` and ``max_cell``. A narrow grid is
+    centred in a picture at least ``min_width`` wide so the caption fits.
+
+    Parameters
+    ----------
+    grid:
+        The grid to draw.
+    robots:
+        Number of robots, which decides labels and trail styles.
+    max_side, max_cell, min_cell, min_width:
+        Size limits in pixels.
+
+    Examples
+    --------
+    >>> make_layout(Grid(32, 32)).cell, make_layout(Grid(64, 64)).cell
+    (22, 11)
+    >>> layout = make_layout(Grid(1, 2))
+    >>> layout.width >= 300 and layout.left > layout.cell // 2
+    True
+    """
+    cell = max(min_cell, min(max_cell, max_side // max(grid.x_size, grid.y_size)))
+    margin = max(6, min(18, cell // 3))
+    header = 40
+    grid_width = grid.y_size * cell
+    width = max(grid_width + 2 * margin, min_width)
+    left = (width - grid_width) // 2
+    top = header + margin
+    height = top + grid.x_size * cell + margin
+    return Layout(grid.x_size, grid.y_size, cell, left, top, width, height, header, robots)
+
+
+# -- colours --------------------------------------------------------------------------
+
+
+def robot_colours(count: int) -> list[RGB]:
+    """Distinct colours for ``count`` robots.
+
+    The first ten come from :data:`PALETTE`; after that the palette repeats,
+    each round with its own lightness and a slight hue shift (low-discrepancy
+    sequences, so rounds differ as much as they can). No two robots get the
+    same colour, however many there are.
+
+    >>> colours = robot_colours(1000)
+    >>> colours[:2] == [PALETTE[0], PALETTE[1]], len(set(colours))
+    (True, 1000)
+    """
+    colours: list[RGB] = []
+    seen: set[RGB] = set()
+    for index in range(count):
+        round_, slot = divmod(index, len(PALETTE))
+        colour = PALETTE[slot]
+        if round_:
+            hue, lightness, saturation = colorsys.rgb_to_hls(*(channel / 255 for channel in colour))
+            lightness = min(0.8, max(0.3, lightness + ((round_ * 0.618034 + 0.5) % 1.0 - 0.5) * 0.5))
+            hue = (hue + ((round_ * 0.414214) % 1.0 - 0.5) * 0.09) % 1.0
+            saturation *= 0.8 if round_ % 3 == 2 else 1.0
+            red, green, blue = colorsys.hls_to_rgb(hue, lightness, saturation)
+            colour = (round(red * 255), round(green * 255), round(blue * 255))
+        while colour in seen:  # nudge a clash by one step of blue, then green
+            red, green, blue = colour
+            colour = (red, green, blue + 1) if blue < 255 else (red, (green + 1) % 256, 0)
+        seen.add(colour)
+        colours.append(colour)
+    return colours
+
+
+def mix(colour: RGB, other: RGB, share: float) -> RGB:
+    """``share`` of ``colour`` over ``1 - share`` of ``other``.
+
+    >>> mix((255, 0, 0), (0, 0, 255), 0.5)
+    (128, 0, 128)
+    """
+    share = min(1.0, max(0.0, share))
+    return tuple(round(a * share + b * (1 - share)) for a, b in zip(colour, other))  # type: ignore[return-value]
+
+
+def darker(colour: RGB, amount: float = 0.35) -> RGB:
+    """``colour`` darkened towards black by ``amount``.
+
+    >>> darker((200, 100, 0), 0.5)
+    (100, 50, 0)
+    """
+    return mix((0, 0, 0), colour, amount)
+
+
+def text_colour_on(colour: RGB) -> RGB:
+    """Black or white, whichever reads better on ``colour``.
+
+    >>> text_colour_on((250, 250, 250)), text_colour_on((20, 20, 60))
+    ((28, 28, 34), (255, 255, 255))
+    """
+    red, green, blue = colour
+    luminance = (0.299 * red + 0.587 * green + 0.114 * blue) / 255
+    return (28, 28, 34) if luminance > 0.62 else (255, 255, 255)
+
+
+def hex_colour(colour: RGB) -> str:
+    """CSS hex form of a colour.
+
+    >>> hex_colour((78, 121, 167))
+    '#4e79a7'
+    """
+    return "#{:02x}{:02x}{:02x}".format(*colour)
+
+
+def cost_tint(cost: float, costs: Sequence[float]) -> RGB:
+    """Fill of a cell whose entry cost is ``cost``, given every cost on the grid.
+
+    Costlier cells are more amber, the costliest at full tint; cells cheaper
+    than 1 are mint.
+
+    >>> cost_tint(1.0, [1.0, 5.0]) == BACKGROUND
+    True
+    >>> cost_tint(5.0, [2.0, 5.0]) == mix(COST_HIGH, BACKGROUND, 0.85)
+    True
+    """
+    if cost == 1.0:
+        return BACKGROUND
+    if cost < 1.0:
+        return mix(COST_LOW, BACKGROUND, 0.3 + 0.5 * (1.0 - cost))
+    highest = max([1.0, *costs])
+    share = 0.3 + 0.55 * (cost - 1.0) / (highest - 1.0) if highest > 1.0 else 0.6
+    return mix(COST_HIGH, BACKGROUND, share)
+
+
+# -- motion --------------------------------------------------------------------------
+
+
+class Keyframe(NamedTuple):
+    """A robot's pose at time ``t`` (ticks): fractional cell ``(x, y)`` and heading ``angle``."""
+
+    t: float
+    x: float
+    y: float
+    angle: float
+
+
+def heading_angle(heading: Heading | int) -> float:
+    """Degrees clockwise from north (screen up) for ``heading``.
+
+    >>> [heading_angle(h) for h in Heading]
+    [0.0, 90.0, 180.0, 270.0]
+    """
+    return 90.0 * (int(heading) - 1)
+
+
+def run_ticks(result: RunResult) -> int:
+    """The last tick of a run: one less than the longest path (0 for an empty run).
+
+    >>> from mrmp.core import RobotResult, RunResult
+    >>> run = RunResult("s", "p", 0, [RobotResult("A", (0, 0), (0, 1), path=[(0, 0), (0, 1)])], [], "done", 1, 1, 0.0)
+    >>> run_ticks(run)
+    1
+    """
+    return max((len(robot.path) - 1 for robot in result.robots), default=0) if result.robots else 0
+
+
+def cell_at(robot: RobotResult, tick: int) -> Cell:
+    """Where ``robot`` is at ``tick``; past the end of its path it stays put.
+
+    >>> cell_at(RobotResult("A", (0, 0), (0, 1), path=[(0, 0), (0, 1)]), 7)
+    (0, 1)
+    """
+    if not robot.path:
+        return robot.start
+    return robot.path[min(max(tick, 0), len(robot.path) - 1)]
+
+
+def _heading_at(robot: RobotResult, tick: int) -> Heading:
+    if not robot.headings:
+        if robot.path and 0 < tick < len(robot.path) and robot.path[tick] != robot.path[tick - 1]:
+            try:
+                return Heading.between(robot.path[tick - 1], robot.path[tick])
+            except ValueError:
+                pass
+        return Heading.NORTH if tick <= 0 else _heading_at(robot, tick - 1)
+    return Heading(robot.headings[min(max(tick, 0), len(robot.headings) - 1)])
+
+
+def track(robot: RobotResult, ticks: int) -> list[Keyframe]:
+    """Keyframes of ``robot``'s motion over ticks ``0 .. ticks``.
+
+    Between two ticks a robot that changes heading first turns right (as many
+    quarter turns as :func:`~mrmp.core.heading.right_turns` says) and then
+    moves; one that only turns takes the whole tick to turn. Keyframes where
+    nothing changes pace are dropped, so the list is short for robots that wait.
+    The first keyframe is at ``t = 0`` and the last at ``t = ticks``.
+
+    >>> still = RobotResult("A", (1, 1), (1, 1), path=[(1, 1)] * 5)
+    >>> track(still, 4)
+    [Keyframe(t=0.0, x=1.0, y=1.0, angle=0.0), Keyframe(t=4.0, x=1.0, y=1.0, angle=0.0)]
+    """
+    heading = _heading_at(robot, 0)
+    angle = heading_angle(heading)
+    here = cell_at(robot, 0)
+    frames = [Keyframe(0.0, float(here[0]), float(here[1]), angle)]
+    for tick in range(ticks):
+        there = cell_at(robot, tick + 1)
+        next_heading = _heading_at(robot, tick + 1)
+        turns = right_turns(heading, next_heading)
+        if turns:
+            angle += 90.0 * turns
+            turn_end = tick + (TURN_SHARE if there != here else 1.0)
+            frames.append(Keyframe(float(turn_end), float(here[0]), float(here[1]), angle))
+        frames.append(Keyframe(float(tick + 1), float(there[0]), float(there[1]), angle))
+        here, heading = there, next_heading
+    return simplify(frames)
+
+
+def simplify(frames: Sequence[Keyframe], fields: Sequence[str] = ("x", "y", "angle")) -> list[Keyframe]:
+    """Drop keyframes that lie on the straight line between their neighbours.
+
+    Only ``fields`` are compared, so a renderer animating just the position can
+    pass ``("x", "y")`` to get the position's own, shorter, keyframes.
+
+    >>> frames = [Keyframe(0, 0, 0, 0), Keyframe(1, 1, 0, 0), Keyframe(2, 2, 0, 0), Keyframe(3, 2, 0, 90)]
+    >>> [frame.t for frame in simplify(frames)]
+    [0, 2, 3]
+    >>> [frame.t for frame in simplify(frames, ("x", "y"))]
+    [0, 2, 3]
+    """
+    if len(frames) <= 2:
+        return list(frames)
+    kept = [frames[0]]
+    for index in range(1, len(frames) - 1):
+        before, here, after = kept[-1], frames[index], frames[index + 1]
+        span = after.t - before.t
+        share = (here.t - before.t) / span if span else 0.0
+        on_line = all(
+            abs(getattr(before, name) + (getattr(after, name) - getattr(before, name)) * share - getattr(here, name))
+            < 1e-9
+            for name in fields
+        )
+        if not on_line:
+            kept.append(here)
+    kept.append(frames[-1])
+    return kept
+
+
+def _time_of(frame: Keyframe) -> float:
+    return frame.t
+
+
+def pose_at(frames: Sequence[Keyframe], t: float) -> tuple[float, float, float]:
+    """Interpolated ``(x, y, angle)`` of a track at time ``t`` (clamped to the track).
+
+    >>> frames = [Keyframe(0, 0, 0, 0), Keyframe(2, 2, 0, 90)]
+    >>> pose_at(frames, 1.0), pose_at(frames, 5.0)
+    ((1.0, 0.0, 45.0), (2, 0, 90))
+    """
+    if t <= frames[0].t:
+        first = frames[0]
+        return (first.x, first.y, first.angle)
+    if t >= frames[-1].t:
+        last = frames[-1]
+        return (last.x, last.y, last.angle)
+    index = bisect_right(frames, t, key=_time_of)
+    before, after = frames[index - 1], frames[index]
+    share = (t - before.t) / (after.t - before.t)
+    return (
+        before.x + (after.x - before.x) * share,
+        before.y + (after.y - before.y) * share,
+        before.angle + (after.angle - before.angle) * share,
+    )
+
+
+def marker_points(
+    centre: tuple[float, float], angle: float, size: float, shape: Sequence[tuple[float, float]] = HEADING_MARKER
+) -> list[tuple[float, float]]:
+    """``shape`` (cell units, pointing north) turned ``angle`` degrees clockwise, scaled by ``size`` pixels.
+
+    >>> [(round(x), round(y)) for x, y in marker_points((0, 0), 90.0, 100, [(0.0, -0.5)])]
+    [(50, 0)]
+    """
+    radians = math.radians(angle)
+    cos, sin = math.cos(radians), math.sin(radians)
+    cx, cy = centre
+    return [(cx + size * (px * cos - py * sin), cy + size * (px * sin + py * cos)) for px, py in shape]
+
+
+def run_caption(result: RunResult) -> str:
+    """Title shown above the grid: scenario and policy.
+
+    >>> run_caption(RunResult("swap", "thesis", 0, [], [], "done", 0, 0, 0.0))
+    'swap · thesis'
+    """
+    parts = [part for part in (result.scenario, result.policy) if part]
+    return " · ".join(parts) if parts else "mrmp run"
+
+
+def run_verdict(result: RunResult) -> tuple[str, bool]:
+    """Short end-of-run verdict for the caption and whether it is good news.
+
+    >>> run_verdict(RunResult("s", "p", 0, [], [], "done", 0, 0, 0.0))
+    ('all arrived', True)
+    """
+    if result.collisions:
+        count = len(result.collisions)
+        return (f"{count} collision{'s' if count != 1 else ''}", False)
+    missing = len(result.not_arrived)
+    if missing:
+        return (f"{missing} not arrived", False)
+    return ("all arrived", True)
