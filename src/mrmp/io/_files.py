@@ -61,7 +61,9 @@ def read_text(path: PathLike) -> str:
     except UnicodeDecodeError as error:
         line = data.count(b"\n", 0, error.start) + 1
         raise InputError(
-            Problem(f"{where}:{line}", f"not a UTF-8 text file (byte 0x{data[error.start]:02x} at offset {error.start})")
+            Problem(
+                f"{where}:{line}", f"not a UTF-8 text file (byte 0x{data[error.start]:02x} at offset {error.start})"
+            )
         ) from None
 
 
@@ -94,14 +96,12 @@ def atomic_write_text(path: PathLike, text: str) -> None:
     target = Path(path)
     try:
         target.parent.mkdir(parents=True, exist_ok=True)
-        handle = tempfile.NamedTemporaryFile(
-            "w", encoding="utf-8", newline="\n", dir=target.parent, prefix=f".{target.name}.", suffix=".tmp", delete=False
-        )
+        descriptor, name = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
     except OSError as error:
         raise InputError(Problem(str(path), f"cannot write the file: {error.strerror or error}")) from None
-    temporary = Path(handle.name)
+    temporary = Path(name)
     try:
-        with handle:
+        with os.fdopen(descriptor, "w", encoding="utf-8", newline="\n") as handle:
             handle.write(text)
             handle.flush()
             os.fsync(handle.fileno())

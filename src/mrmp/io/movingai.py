@@ -23,10 +23,10 @@ Examples
 >>> entry = parse_scen(scen, "tiny.scen")[0]
 >>> entry.robot("0")
 RobotSpec(id='0', start=(0, 0), goal=(1, 1), heading=<Heading.NORTH: 1>)
->>> parse_map("type octile\\nheight 1\\nwidth 2\\nmap\\n.X\\n", "bad.map")
+>>> parse_map("type octile\\nheight 1\\nwidth 2\\nmap\\n.X\\n", "bad.map")  # doctest: +ELLIPSIS
 Traceback (most recent call last):
 ...
-mrmp.core.errors.InputError: bad.map:5: map row 0, column 1: unknown symbol 'X' (expected one of . G S @ O T W or a cost digit 1-9)
+mrmp.core.errors.InputError: bad.map:5: map row 0, column 1: unknown symbol 'X' (expected one of ...)
 """
 
 from __future__ import annotations
@@ -38,7 +38,14 @@ from pathlib import Path
 
 from mrmp.core.cell import Cell
 from mrmp.core.errors import InputError, Problem
-from mrmp.core.grid import BLOCKED_SYMBOLS, COST_SYMBOLS, FREE_SYMBOLS, Grid, cell_from_movingai, movingai_from_cell
+from mrmp.core.grid import (
+    BLOCKED_SYMBOLS,
+    COST_SYMBOLS,
+    FREE_SYMBOLS,
+    Grid,
+    cell_from_movingai,
+    movingai_from_cell,
+)
 from mrmp.core.scenario import RobotSpec
 from mrmp.io._files import PathLike, atomic_write_text, read_text
 
@@ -160,7 +167,9 @@ def _parse_map_header(lines: Sequence[str], source: str) -> tuple[int, int, int]
         tokens = lines[index].split()
         where = f"{source}:{index + 1}"
         if len(tokens) != 2 or tokens[0] not in ("height", "width"):
-            raise InputError(Problem(where, f"bad header: expected 'height N', 'width N' or 'map', got {lines[index]!r}"))
+            raise InputError(
+                Problem(where, f"bad header: expected 'height N', 'width N' or 'map', got {lines[index]!r}")
+            )
         if tokens[0] in sizes:
             raise InputError(Problem(where, f"bad header: {tokens[0]} given twice"))
         value = _positive_int(tokens[1])
@@ -227,10 +236,17 @@ def parse_map(text: str, source: str = "<map>", name: str | None = None) -> Grid
     problems: list[Problem] = []
     if len(body) < height:
         last_line = map_index + 1 + len(body)
-        problems.append(Problem(f"{source}:{last_line}", f"expected {height} map rows after 'map' (the header's height), found {len(body)}"))
+        problems.append(
+            Problem(
+                f"{source}:{last_line}",
+                f"expected {height} map rows after 'map' (the header's height), found {len(body)}",
+            )
+        )
     elif len(body) > height:
         extra_line = map_index + 2 + height
-        problems.append(Problem(f"{source}:{extra_line}", f"extra line after the {height} map rows declared by 'height {height}'"))
+        problems.append(
+            Problem(f"{source}:{extra_line}", f"extra line after the {height} map rows declared by 'height {height}'")
+        )
     for row_index, row in enumerate(body[:height]):
         problem = _row_problem(row, row_index, width, f"{source}:{map_index + 2 + row_index}")
         if problem is not None:
@@ -262,9 +278,12 @@ def read_map(path: PathLike) -> Grid:
 
     Examples
     --------
-    >>> grid = read_map("maps/random-32-32-20.map")  # doctest: +SKIP
-    >>> grid.x_size, grid.y_size                      # doctest: +SKIP
-    (32, 32)
+    >>> import pathlib, tempfile
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "column.map"
+    >>> _ = path.write_text("type octile\\nheight 2\\nwidth 1\\nmap\\n@\\n.\\n")
+    >>> grid = read_map(path)
+    >>> grid.name, grid.blocked_cells()
+    ('column', [(1, 0)])
     """
     return parse_map(read_text(path), str(path))
 
@@ -325,14 +344,18 @@ def _parse_scen_line(line: str, number: int, source: str) -> tuple[ScenEntry | N
         fields = line.split()
     if len(fields) != len(SCEN_FIELDS):
         expected = ", ".join(SCEN_FIELDS)
-        return None, [Problem(where, f"expected {len(SCEN_FIELDS)} tab-separated fields ({expected}), found {len(fields)}")]
+        return None, [
+            Problem(where, f"expected {len(SCEN_FIELDS)} tab-separated fields ({expected}), found {len(fields)}")
+        ]
     problems: list[Problem] = []
     numbers: dict[int, int] = {}
     for index in _INTEGER_FIELDS:
         try:
             numbers[index] = int(fields[index])
         except ValueError:
-            problems.append(Problem(where, f"field {index + 1} ({SCEN_FIELDS[index]}) must be an integer, got {fields[index]!r}"))
+            problems.append(
+                Problem(where, f"field {index + 1} ({SCEN_FIELDS[index]}) must be an integer, got {fields[index]!r}")
+            )
     try:
         optimal = float(fields[8])
     except ValueError:
@@ -346,11 +369,15 @@ def _parse_scen_line(line: str, number: int, source: str) -> tuple[ScenEntry | N
     for kind, column, row in (("start", numbers[4], numbers[5]), ("goal", numbers[6], numbers[7])):
         if not (0 <= column < width and 0 <= row < height):
             problems.append(
-                Problem(where, f"{kind} (column {column}, row {row}) is outside the {width}x{height} map (width x height)")
+                Problem(
+                    where, f"{kind} (column {column}, row {row}) is outside the {width}x{height} map (width x height)"
+                )
             )
     if problems:
         return None, problems
-    entry = ScenEntry(number, numbers[0], fields[1], width, height, (numbers[4], numbers[5]), (numbers[6], numbers[7]), optimal)
+    entry = ScenEntry(
+        number, numbers[0], fields[1], width, height, (numbers[4], numbers[5]), (numbers[6], numbers[7]), optimal
+    )
     return entry, []
 
 
@@ -445,25 +472,26 @@ def scen_map_problems(entries: Sequence[ScenEntry], grid: Grid, source: str) -> 
     first = wrong[0]
     label = f"map {grid.name!r}" if grid.name else "the map"
     more = f" (and {len(wrong) - 1} more lines)" if len(wrong) > 1 else ""
-    reason = f"map size {first.width}x{first.height} (width x height) does not match {label}, which is {grid.y_size}x{grid.x_size}{more}"
+    declared = f"{first.width}x{first.height}"
+    reason = f"map size {declared} (width x height) does not match {label}, which is {grid.y_size}x{grid.x_size}{more}"
     return [Problem(f"{source}:{first.line}", reason)]
 
 
-def select_agents(entries: Sequence[ScenEntry], agents: int | None, source: str, last_line: int) -> list[ScenEntry]:
+def select_agents(entries: Sequence[ScenEntry], agents: int | None, source: str) -> list[ScenEntry]:
     """The first ``agents`` entries (all of them when ``agents`` is None).
 
     Raises
     ------
     InputError
         If ``agents`` is below 1 or the file lists fewer agents than asked
-        (the problem names the file's last line).
+        (the problem names the last agent line).
 
     Examples
     --------
     >>> entry = ScenEntry(2, 0, "m.map", 4, 3, (0, 0), (1, 1), 2.0)
-    >>> len(select_agents([entry], 1, "m.scen", 2))
+    >>> len(select_agents([entry], 1, "m.scen"))
     1
-    >>> select_agents([entry], 3, "m.scen", 2)
+    >>> select_agents([entry], 3, "m.scen")
     Traceback (most recent call last):
     ...
     mrmp.core.errors.InputError: m.scen:2: asked for 3 agents but the file lists only 1
@@ -473,7 +501,9 @@ def select_agents(entries: Sequence[ScenEntry], agents: int | None, source: str,
     if agents < 1:
         raise InputError(Problem(source, f"the number of agents must be at least 1, got {agents}"))
     if len(entries) < agents:
-        raise InputError(Problem(f"{source}:{last_line}", f"asked for {agents} agents but the file lists only {len(entries)}"))
+        last_line = entries[-1].line if entries else 1
+        reason = f"asked for {agents} agents but the file lists only {len(entries)}"
+        raise InputError(Problem(f"{source}:{last_line}", reason))
     return list(entries[:agents])
 
 
@@ -500,12 +530,11 @@ def read_scen(path: PathLike, agents: int | None = None, grid: Grid | None = Non
         If the file cannot be read, is malformed, lists fewer agents than
         asked, or declares a map size different from ``grid``'s.
     """
-    text = read_text(path)
     source = str(path)
-    entries = parse_scen(text, source)
+    entries = parse_scen(read_text(path), source)
     if grid is not None:
         _raise_if_any(scen_map_problems(entries, grid, source), source)
-    chosen = select_agents(entries, agents, source, max(len(text.splitlines()), 1))
+    chosen = select_agents(entries, agents, source)
     return [entry.robot(str(index)) for index, entry in enumerate(chosen)]
 
 

@@ -67,7 +67,14 @@ from mrmp.core.cell import Cell
 from mrmp.core.errors import InputError, Problem
 from mrmp.core.grid import COST_SYMBOLS, Grid
 from mrmp.core.heading import Heading
-from mrmp.core.scenario import NetworkFaults, PolicyOptions, RobotSpec, Scenario, Timing, scenario_problems
+from mrmp.core.scenario import (
+    NetworkFaults,
+    PolicyOptions,
+    RobotSpec,
+    Scenario,
+    Timing,
+    scenario_problems,
+)
 from mrmp.io._files import PathLike, atomic_write_text, read_text
 from mrmp.io.movingai import (
     MAP_SYMBOLS,
@@ -78,7 +85,19 @@ from mrmp.io.movingai import (
     select_agents,
 )
 
-TOP_KEYS = ("name", "description", "map", "robots", "scen", "agents", "timing", "network", "policy", "seed", "max_ticks")
+TOP_KEYS = (
+    "name",
+    "description",
+    "map",
+    "robots",
+    "scen",
+    "agents",
+    "timing",
+    "network",
+    "policy",
+    "seed",
+    "max_ticks",
+)
 """Keys allowed at the top level of a scenario file."""
 MAP_KEYS = ("rows", "file", "width", "height")
 """Keys allowed under ``map``."""
@@ -96,11 +115,12 @@ _BAD: Any = object()
 _FLOAT_TEXT = re.compile(r"^[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?$")
 _DELAY_RANGE = re.compile(r"^\s*(-?\d+)\s*\.\.\s*(-?\d+)\s*$")
 _ROBOT_INDEX = re.compile(r"robots\[(\d+)\]")
+_PARENT_SUFFIX = re.compile(r"(\.[^.\[\]]+|\[\d+\])$")
 
 
 def _line(node: Node) -> int:
     """The 1-based line where ``node`` starts."""
-    return node.start_mark.line + 1
+    return int(node.start_mark.line) + 1
 
 
 def _describe(node: Node, value: Any = None) -> str:
@@ -157,15 +177,22 @@ class _Reader:
         while candidate:
             if candidate in self.lines:
                 return f"{self.source}:{self.lines[candidate]}"
-            candidate = re.sub(r"(\.[^.\[\]]+|\[\d+\])$", "", candidate)
+            parent = _PARENT_SUFFIX.sub("", candidate)
+            candidate = parent if parent != candidate else ""
         return f"{self.source}:{self.lines.get('', 1)}"
 
     # -- structure ---------------------------------------------------------------------
 
-    def mapping(self, node: Node, path: str, allowed: Sequence[str], required: Sequence[str] = ()) -> dict[str, _Entry] | None:
+    def mapping(
+        self, node: Node, path: str, allowed: Sequence[str], required: Sequence[str] = ()
+    ) -> dict[str, _Entry] | None:
         """Check that ``node`` is a mapping of known, unique keys; return its entries or None."""
         if not isinstance(node, MappingNode):
-            self.report(_line(node), path, f"expected a mapping of {', '.join(allowed)}, got {_describe(node, self.scalar(node))}")
+            self.report(
+                _line(node),
+                path,
+                f"expected a mapping of {', '.join(allowed)}, got {_describe(node, self.scalar(node))}",
+            )
             return None
         entries: dict[str, _Entry] = {}
         for key_node, value_node in node.value:
@@ -249,9 +276,15 @@ class _Reader:
             values = [self.scalar(item) for item in node.value]
             if all(isinstance(v, int) and not isinstance(v, bool) for v in values):
                 return (values[0], values[1])
-        got = f"a list of {len(node.value)} items" if isinstance(node, SequenceNode) else _describe(node, self.scalar(node))
+        got = (
+            f"a list of {len(node.value)} items"
+            if isinstance(node, SequenceNode)
+            else _describe(node, self.scalar(node))
+        )
         if isinstance(node, SequenceNode) and len(node.value) == 2:
-            got = "[" + ", ".join(str(item.value) if isinstance(item, ScalarNode) else "..." for item in node.value) + "]"
+            got = (
+                "[" + ", ".join(str(item.value) if isinstance(item, ScalarNode) else "..." for item in node.value) + "]"
+            )
         self.report(_line(node), path, f"expected a list of two integers [x, y], got {got}")
         return _BAD
 
@@ -280,7 +313,7 @@ class _Reader:
             values = [self.scalar(item) for item in node.value]
             if all(isinstance(v, int) and not isinstance(v, bool) for v in values):
                 return (values[0], values[1])
-        self.report(_line(node), path, f"expected ticks as N, \"A..B\" or [A, B], got {_describe(node, value)}")
+        self.report(_line(node), path, f'expected ticks as N, "A..B" or [A, B], got {_describe(node, value)}')
         return _BAD
 
     def optional(self, entries: dict[str, _Entry] | None, key: str, path: str, read: Callable[[Node, str], Any]) -> Any:
@@ -299,9 +332,17 @@ class _Reader:
         entries = self.mapping(node, "map", MAP_KEYS)
         if entries is None:
             return None
-        forms = [form for form, keys in (("rows", ("rows",)), ("file", ("file",)), ("width and height", ("width", "height"))) if any(k in entries for k in keys)]
+        forms = [
+            form
+            for form, keys in (("rows", ("rows",)), ("file", ("file",)), ("width and height", ("width", "height")))
+            if any(k in entries for k in keys)
+        ]
         if len(forms) != 1:
-            reason = "needs rows, file, or width and height" if not forms else f"give exactly one of rows, file, or width and height; got {' and '.join(forms)}"
+            reason = (
+                "needs rows, file, or width and height"
+                if not forms
+                else f"give exactly one of rows, file, or width and height; got {' and '.join(forms)}"
+            )
             self.report(_line(node), "map", reason)
             return None
         if "rows" in entries:
@@ -345,7 +386,11 @@ class _Reader:
             unknown = [(column, symbol) for column, symbol in enumerate(row) if symbol not in MAP_SYMBOLS]
             if unknown:
                 column, symbol = unknown[0]
-                self.report(_line(item), path, f"column {column}: unknown symbol {symbol!r} (use . for free, @ for blocked, 1-9 for a cost)")
+                self.report(
+                    _line(item),
+                    path,
+                    f"column {column}: unknown symbol {symbol!r} (use . for free, @ for blocked, 1-9 for a cost)",
+                )
                 ok = False
         return Grid.from_rows(rows, name=name) if ok else None
 
@@ -385,14 +430,19 @@ class _Reader:
             for key in ("id", "start", "goal"):
                 if key in entries and values[key] is None:
                     self.report(entries[key].key_line, f"{path}.{key}", "missing value")
-            if any(values[key] is None or values[key] is _BAD for key in ("id", "start", "goal")) or values["heading"] is _BAD:
+            if (
+                any(values[key] is None or values[key] is _BAD for key in ("id", "start", "goal"))
+                or values["heading"] is _BAD
+            ):
                 self.robot_trouble = True
                 continue
             heading = values["heading"] if values["heading"] is not None else Heading.NORTH
             robots.append((index, RobotSpec(values["id"], values["start"], values["goal"], heading)))
         return robots
 
-    def read_scen_robots(self, entries: dict[str, _Entry], grid: Grid | None) -> tuple[Grid | None, list[tuple[int, RobotSpec]]]:
+    def read_scen_robots(
+        self, entries: dict[str, _Entry], grid: Grid | None
+    ) -> tuple[Grid | None, list[tuple[int, RobotSpec]]]:
         """The robots (and, without a ``map`` section, the grid) of ``scen`` + ``agents``."""
         relative = self.optional(entries, "scen", "scen", self.text)
         agents = self.optional(entries, "agents", "agents", self.integer)
@@ -408,8 +458,7 @@ class _Reader:
             self.report(entries["scen"].key_line, "scen", f"scenario file not found: {path}")
             return grid, []
         try:
-            text = read_text(path)
-            scen_entries = parse_scen(text, str(path))
+            scen_entries = parse_scen(read_text(path), str(path))
             if grid is None and "map" not in self.lines:
                 grid = self.grid_next_to(path, scen_entries, entries["scen"].key_line)
             if grid is None:
@@ -417,7 +466,7 @@ class _Reader:
             problems = scen_map_problems(scen_entries, grid, str(path))
             if problems:
                 raise InputError(problems)
-            chosen = select_agents(scen_entries, agents, str(path), max(len(text.splitlines()), 1))
+            chosen = select_agents(scen_entries, agents, str(path))
         except InputError as error:
             self.problems.extend(error.problems)
             self.robot_trouble = True
@@ -433,7 +482,9 @@ class _Reader:
             return None
         map_path = scen_path.parent / entries[0].map_name
         if not map_path.is_file():
-            self.report(line, "scen", f"map file {entries[0].map_name!r} named by {scen_path} not found (looked for {map_path})")
+            self.report(
+                line, "scen", f"map file {entries[0].map_name!r} named by {scen_path} not found (looked for {map_path})"
+            )
             return None
         return read_map(map_path)
 
@@ -443,7 +494,10 @@ class _Reader:
         timing_values = {key: self.optional(timing_entries, key, f"timing.{key}", self.number) for key in TIMING_KEYS}
         timing = Timing(**_given(timing_values))
         network_entries = self.section(top, "network", NETWORK_KEYS)
-        network_values = {key: self.optional(network_entries, key, f"network.{key}", self.number) for key in ("loss", "duplicate", "reorder")}
+        network_values = {
+            key: self.optional(network_entries, key, f"network.{key}", self.number)
+            for key in ("loss", "duplicate", "reorder")
+        }
         delay = self.optional(network_entries, "delay", "network.delay", self.delay)
         if delay is not None and delay is not _BAD:
             network_values["delay_min"], network_values["delay_max"] = delay
@@ -455,9 +509,15 @@ class _Reader:
             "heading_aware": self.optional(policy_entries, "heading_aware", "policy.heading_aware", self.boolean),
         }
         policy = PolicyOptions(**_given(policy_values))
-        if self.known_policies is not None and policy_values["name"] not in (None, _BAD) and policy.name not in self.known_policies:
+        if (
+            self.known_policies is not None
+            and policy_values["name"] not in (None, _BAD)
+            and policy.name not in self.known_policies
+        ):
             known = ", ".join(self.known_policies)
-            self.report(self.lines["policy.name"], "policy.name", f"unknown policy {policy.name!r}; known policies: {known}")
+            self.report(
+                self.lines["policy.name"], "policy.name", f"unknown policy {policy.name!r}; known policies: {known}"
+            )
         return timing, network, policy
 
     def section(self, top: dict[str, _Entry], key: str, allowed: Sequence[str]) -> dict[str, _Entry] | None:
@@ -488,6 +548,7 @@ class _Reader:
         for key in ("map", "robots"):
             if key not in top and not has_scen:
                 self.report(_line(root), "", f"missing required key {key!r}")
+                self.robot_trouble = self.robot_trouble or key == "robots"
         grid = self.read_map_section(top["map"].value, name) if "map" in top else None
         robots: list[tuple[int, RobotSpec]] = []
         if has_scen:
@@ -518,7 +579,9 @@ class _Reader:
             return _ROBOT_INDEX.sub(lambda m: f"robots[{indices[int(m.group(1))]}]", text)
 
         for problem in scenario_problems(scenario):
-            if problem.where.startswith("robots") and (not have_grid or (problem.where == "robots" and self.robot_trouble)):
+            if problem.where.startswith("robots") and (
+                not have_grid or (problem.where == "robots" and self.robot_trouble)
+            ):
                 continue
             path = original(problem.where)
             self.problems.append(Problem(self.where(path), f"{path}: {original(problem.reason)}"))
@@ -601,7 +664,11 @@ def scenario_from_text(
         raise InputError(Problem(f"{source_name}:1", "the file is empty: expected a mapping with map and robots"))
     if not isinstance(root, MappingNode):
         kind = "a list" if isinstance(root, SequenceNode) else f"a single value {root.value!r}"
-        raise InputError(Problem(f"{source_name}:{_line(root)}", f"the top level must be a mapping (name, map, robots, ...), got {kind}"))
+        raise InputError(
+            Problem(
+                f"{source_name}:{_line(root)}", f"the top level must be a mapping (name, map, robots, ...), got {kind}"
+            )
+        )
     policies = tuple(known_policies) if known_policies is not None else None
     reader = _Reader(source_name, folder, policies)
     scenario = reader.read(root)
@@ -663,12 +730,11 @@ def load_movingai_scenario(map_path: PathLike, scen_path: PathLike, agents: int)
     """
     grid = read_map(map_path)
     source = str(scen_path)
-    text = read_text(scen_path)
-    entries = parse_scen(text, source)
+    entries = parse_scen(read_text(scen_path), source)
     mismatch = scen_map_problems(entries, grid, source)
     if mismatch:
         raise InputError(mismatch)
-    chosen = select_agents(entries, agents, source, max(len(text.splitlines()), 1))
+    chosen = select_agents(entries, agents, source)
     scenario = Scenario(
         grid=grid,
         robots=tuple(entry.robot(str(index)) for index, entry in enumerate(chosen)),
@@ -760,18 +826,23 @@ def scenario_to_yaml(scenario: Scenario, map_file: str | None = None) -> str:
         lines += ["map:", "  rows:"] + [f"    - {_quote(row)}" for row in grid.to_rows()]
     lines.append("robots:")
     for robot in scenario.robots:
-        lines.append(
-            f"  - {{id: {_quote(robot.id)}, start: {_cell_text(robot.start)}, goal: {_cell_text(robot.goal)}, heading: {robot.heading.name}}}"
-        )
+        start, goal = _cell_text(robot.start), _cell_text(robot.goal)
+        lines.append(f"  - {{id: {_quote(robot.id)}, start: {start}, goal: {goal}, heading: {robot.heading.name}}}")
     timing, network, policy = scenario.timing, scenario.network, scenario.policy
     lines.append(f"timing: {{cell_time: {_yaml_float(timing.cell_time)}, turn_time: {_yaml_float(timing.turn_time)}}}")
-    delay = str(network.delay_min) if network.delay_min == network.delay_max else _quote(f"{network.delay_min}..{network.delay_max}")
+    delay = (
+        str(network.delay_min)
+        if network.delay_min == network.delay_max
+        else _quote(f"{network.delay_min}..{network.delay_max}")
+    )
     lines.append(
         f"network: {{loss: {_yaml_float(network.loss)}, delay: {delay}, "
         f"duplicate: {_yaml_float(network.duplicate)}, reorder: {_yaml_float(network.reorder)}}}"
     )
     heading_aware = "true" if policy.heading_aware else "false"
-    lines.append(f"policy: {{name: {_quote(policy.name)}, resolve: {_quote(policy.resolve)}, heading_aware: {heading_aware}}}")
+    lines.append(
+        f"policy: {{name: {_quote(policy.name)}, resolve: {_quote(policy.resolve)}, heading_aware: {heading_aware}}}"
+    )
     lines.append(f"seed: {scenario.seed}")
     if scenario.max_ticks is not None:
         lines.append(f"max_ticks: {scenario.max_ticks}")

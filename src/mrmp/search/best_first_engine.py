@@ -32,11 +32,14 @@ optimal paths, Hart et al. 1968, theorems 1-3):
   where ``needed`` holds NORTH/SOUTH if the goal's x is above/below and
   EAST/WEST if its y is east/west: every path must move in (so face) each
   needed direction, and :func:`~mrmp.core.heading.minimum_right_turns` is the
-  fewest right turns that face them all in any order. A move in direction
-  ``d`` from heading ``h`` costs ``right_turns(h, d)`` turns and leaves a
-  needed set contained in the old one plus the opposite of ``d``; since the
-  right-turn count is a cyclic distance (it obeys the triangle inequality),
-  the bound drops by at most ``right_turns(h, d)``, so the sum stays consistent.
+  fewest right turns that face them all in any order. For consistency: a
+  move in direction ``d`` from heading ``h`` costs ``right_turns(h, d)``
+  turns, and every direction needed before the move is ``d`` or still needed
+  after it. Facing ``d`` first and then the new needed set in its best order
+  faces the old set too, and the right-turn count is a cyclic distance (it
+  obeys the triangle inequality, so facing a subset never takes more turns);
+  hence the bound before the move is at most ``right_turns(h, d)`` plus the
+  bound after it.
 
 Ties between equal priorities go to the larger ``g`` (the node nearer the
 goal for A*), then to the earlier insertion, so results are reproducible.
@@ -58,7 +61,7 @@ import itertools
 from collections.abc import Callable, Collection, Hashable, Iterable
 from collections.abc import Set as AbstractSet
 from dataclasses import dataclass
-from typing import Generic, TypeVar
+from typing import Protocol, TypeVar
 
 from mrmp.core.cell import Cell
 from mrmp.core.errors import NoPathError
@@ -158,22 +161,25 @@ _DIRECTION_OF: dict[Cell, int] = {heading.delta: int(heading) for heading in HEA
 State = TypeVar("State", bound=Hashable)
 
 
-class _Model(Generic[State]):
+class _Model(Protocol[State]):
     """A state space over a grid: start state, successors with step costs, heuristic."""
 
     start: State
 
     def cell(self, state: State) -> Cell:
-        raise NotImplementedError
+        """The grid cell of ``state``."""
+        ...
 
     def successors(self, state: State) -> Iterable[tuple[State, float]]:
-        raise NotImplementedError
+        """The states one move from ``state``, with the move's cost."""
+        ...
 
     def estimate(self, state: State) -> float:
-        raise NotImplementedError
+        """A consistent lower bound on the cost from ``state`` to the goal."""
+        ...
 
 
-class _CellModel(_Model[Cell]):
+class _CellModel:
     """States are cells; entering ``c`` costs ``cell_time * cost(c)``."""
 
     def __init__(self, grid: GridMap, start: Cell, goal: Cell, blocked: AbstractSet[Cell], cell_time: float) -> None:
@@ -195,7 +201,7 @@ class _CellModel(_Model[Cell]):
         return self.unit * (abs(state[0] - self.goal[0]) + abs(state[1] - self.goal[1]))
 
 
-class _HeadingModel(_Model[tuple[Cell, int]]):
+class _HeadingModel:
     """States are ``(cell, heading number)``; a move charges right turns, then the entered cell."""
 
     def __init__(

@@ -13,9 +13,9 @@ last frame is held for ``hold_s`` seconds.
 
 Large runs stay small and quick: past about 20 robots trails get shorter and
 thinner, labels go away in small cells, and the number of frames is capped by
-a pixel budget (frames are then sampled evenly over the run), so a run of
-hundreds of robots on a 64x64 grid still makes a GIF of a few megabytes in a few
-seconds.
+budgets of pixels and bytes (fewer frames per tick, then frames sampled evenly
+over the run), so a run of hundreds of robots on a 64x64 grid still makes a GIF
+of a few megabytes in a few seconds.
 
 Examples
 --------
@@ -66,11 +66,13 @@ from mrmp.viz.layout import (
     cell_at,
     cost_tint,
     darker,
+    label_size,
     make_layout,
     marker_points,
     mix,
     pose_at,
     robot_colours,
+    robot_label,
     run_caption,
     run_ticks,
     run_verdict,
@@ -144,7 +146,7 @@ def write_gif(
     if max_frames is None:
         max_frames = _frame_cap(layout)
     times = frame_times(ticks, frames_per_tick, max_frames)
-    painter = _Painter(grid, result, layout, ticks)
+    painter = _Painter(grid, result, layout, ticks, step=times[1] - times[0] if len(times) > 1 else 1.0)
     samples = sorted({0, len(times) // 3, (2 * len(times)) // 3, len(times) - 1})
     palette = _shared_palette([painter.frame(times[index]) for index in samples], painter.colours)
     frames = [painter.frame(t).quantize(palette=palette, dither=Image.Dither.NONE) for t in times]
@@ -198,7 +200,7 @@ def frame_times(ticks: int, frames_per_tick: int, max_frames: int) -> list[float
     return [ticks * index / (count - 1) for index in range(count)]
 
 
-@lru_cache(maxsize=32)
+@lru_cache(maxsize=64)
 def _font(size: int, bold: bool = False) -> ImageFont.FreeTypeFont | ImageFont.ImageFont:
     name = "DejaVuSans-Bold.ttf" if bold else "DejaVuSans.ttf"
     try:
@@ -227,8 +229,9 @@ def _frame_cap(layout: Layout) -> int:
 class _Painter:
     """Draws the frames of one run: a static background once, then moving parts."""
 
-    def __init__(self, grid: Grid, result: RunResult, layout: Layout, ticks: int) -> None:
+    def __init__(self, grid: Grid, result: RunResult, layout: Layout, ticks: int, step: float = 1.0) -> None:
         self.grid = grid
+        self.flash = max(0.75, 0.55 * step)  # ticks either side of a collision it is flashed: at least one frame
         self.result = result
         self.layout = layout
         self.ticks = ticks
@@ -325,7 +328,7 @@ class _Painter:
     def _collisions(self, t: float) -> list[tuple[tuple[float, float, float, float], float]]:
         """Boxes of collision cells to mark at ``t`` with a flash strength (0: faint reminder)."""
         big = self.big
-        window = 0.75
+        window = self.flash
         marks: list[tuple[tuple[float, float, float, float], float]] = []
         for collision in self.result.collisions:
             distance = t - collision.tick
@@ -378,7 +381,6 @@ class _Painter:
         radius = big.cell * ROBOT_RADIUS
         outline = max(1, round(big.cell * 0.045))
         labels = self.layout.show_labels
-        font = _font(max(6, round(big.cell * 0.24)), bold=True) if labels else None
         nose_outside = self.layout.cell >= 18
         for index, robot in enumerate(self.result.robots):
             colour, edge = self.colours[index], self.edges[index]
@@ -391,10 +393,14 @@ class _Painter:
             else:
                 draw.ellipse(disc, fill=colour)
                 draw.polygon(marker_points(centre, angle, big.cell, _SMALL_MARKER), fill=edge)
-            if font is not None:
-                text = robot.id if len(robot.id) <= 4 else robot.id[:3] + "…"
-                if draw.textlength(text, font=font) <= 2 * radius * 0.92:
-                    draw.text(centre, text, fill=text_colour_on(colour), font=font, anchor="mm")
+            if labels:
+                text = robot_label(robot.id)
+                size = round(label_size(text, big.cell))
+                font = _font(size, bold=True)
+                while size > 6 * self.ss and draw.textlength(text, font=font) > 2 * radius * 0.9:
+                    size -= 1
+                    font = _font(size, bold=True)
+                draw.text(centre, text, fill=text_colour_on(colour), font=font, anchor="mm")
 
     def _caption(self, draw: ImageDraw.ImageDraw, t: float) -> None:
         big, ss = self.big, self.ss
@@ -408,9 +414,9 @@ class _Painter:
         if finished:
             right += f"  ·  {self.verdict}"
         right_colour = (SUCCESS if self.good else _BAD_NEWS) if finished else HEADER_TEXT
-        right_width = draw.textlength(right, font=tick_font)
         draw.text((big.width - pad, middle), right, fill=right_colour, font=tick_font, anchor="rm")
-        room = big.width - 3 * pad - right_width
+        longest = f"tick {self.ticks} / {self.ticks}  ·  {self.verdict}"  # the same title on every frame
+        room = big.width - 3 * pad - draw.textlength(longest, font=tick_font)
         title = _fit(draw, self.title, title_font, room)
         if title:
             draw.text((pad, middle), title, fill=HEADER_TEXT, font=title_font, anchor="lm")

@@ -499,6 +499,42 @@ def marker_points(
     return [(cx + size * (px * cos - py * sin), cy + size * (px * sin + py * cos)) for px, py in shape]
 
 
+def robot_label(robot_id: str) -> str:
+    """The text written on a robot: its id, cut to four characters.
+
+    >>> robot_label("B"), robot_label("r123"), robot_label("robot-7")
+    ('B', 'r123', 'rob…')
+    """
+    return robot_id if len(robot_id) <= 4 else robot_id[:3] + "…"
+
+
+def label_size(label: str, cell: float) -> float:
+    """Font size (pixels) that fits ``label`` inside a robot's disc in a cell of ``cell`` pixels.
+
+    >>> label_size("A", 72), round(label_size("r123", 72), 1)
+    (17.28, 15.5)
+    """
+    fits = 1.8 * ROBOT_RADIUS * cell / (0.65 * max(1, len(label)))
+    return min(0.24 * cell, fits)
+
+
+def shorten(text: str, room: float, font_size: float, bold: bool = False) -> str:
+    """``text`` cut with an ellipsis to about ``room`` pixels, estimating DejaVu Sans widths.
+
+    For SVG, whose text is measured by the browser; the GIF measures exactly.
+
+    >>> shorten("swap · thesis", 400, 14)
+    'swap · thesis'
+    >>> shorten("a very long scenario name indeed", 100, 14)
+    'a very long…'
+    """
+    width = (0.62 if bold else 0.55) * font_size
+    most = int(room // width)
+    if len(text) <= most:
+        return text
+    return text[: max(0, most - 1)].rstrip() + "…" if most > 1 else ""
+
+
 def run_caption(result: RunResult) -> str:
     """Title shown above the grid: scenario and policy.
 

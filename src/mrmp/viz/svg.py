@@ -63,12 +63,15 @@ from mrmp.viz.layout import (
     cost_tint,
     darker,
     hex_colour,
+    label_size,
     make_layout,
     mix,
     robot_colours,
+    robot_label,
     run_caption,
     run_ticks,
     run_verdict,
+    shorten,
     simplify,
     text_colour_on,
     track,
@@ -430,7 +433,6 @@ class _SvgRun:
         nose_outside = layout.cell >= 18
         shape = HEADING_MARKER if nose_outside else _SMALL_MARKER
         nose = " ".join(f"{_n(x * layout.cell)},{_n(y * layout.cell)}" for x, y in shape)
-        font_size = max(6.0, layout.cell * 0.24)
         for index, robot in enumerate(self.result.robots):
             colour = self.colours[index]
             edge = darker(colour, 0.4)
@@ -472,12 +474,12 @@ class _SvgRun:
                     {
                         "text-anchor": "middle",
                         "dy": "0.35em",
-                        "font-size": _n(font_size),
+                        "font-size": _n(max(6.0, label_size(robot_label(robot.id), layout.cell))),
                         "font-weight": "bold",
                         "fill": hex_colour(text_colour_on(colour)),
                     },
                 )
-                label.text = robot.id if len(robot.id) <= 4 else robot.id[:3] + "…"
+                label.text = robot_label(robot.id)
 
     def _caption(self, group: ET.Element) -> None:
         layout = self.layout
@@ -499,8 +501,10 @@ class _SvgRun:
                 "fill": hex_colour(HEADER_TEXT),
             },
         )
-        title.text = run_caption(self.result)
         verdict, good = run_verdict(self.result)
+        longest = f"tick {self.ticks} / {self.ticks}  ·  {verdict}"  # the widest tick counter
+        room = layout.width - 3 * pad - 0.55 * size * len(longest)
+        title.text = shorten(run_caption(self.result), room, size, bold=True)
         ticks = ET.SubElement(group, "g", {"id": "ticks", "font-size": str(size), "text-anchor": "end"})
         for tick in range(self.ticks + 1):
             final = tick == self.ticks

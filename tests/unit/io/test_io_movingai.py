@@ -241,7 +241,7 @@ def test_scen_round_trip(maps_dir: Path, tmp_path: Path) -> None:
     write_scen(tmp_path / "mine.scen", "random-32-32-20.map", grid, robots)
     assert read_scen(tmp_path / "mine.scen", grid=grid) == robots
     entries = read_scen_entries(tmp_path / "mine.scen")
-    for entry, robot in zip(entries, robots):
+    for entry, robot in zip(entries, robots, strict=True):
         assert entry.map_name == "random-32-32-20.map"
         assert entry.optimal_length == shortest_path_length(grid, robot.start, robot.goal)
         assert entry.optimal_length >= manhattan(robot.start, robot.goal)

@@ -7,7 +7,16 @@ from pathlib import Path
 
 import pytest
 
-from mrmp.core import Grid, Heading, InputError, NetworkFaults, PolicyOptions, RobotSpec, Scenario, Timing
+from mrmp.core import (
+    Grid,
+    Heading,
+    InputError,
+    NetworkFaults,
+    PolicyOptions,
+    RobotSpec,
+    Scenario,
+    Timing,
+)
 from mrmp.io.scenario_file import (
     load_movingai_scenario,
     load_scenario,
@@ -88,7 +97,10 @@ def test_defaults_and_name_from_file_stem() -> None:
 
 
 def test_first_row_is_the_northmost() -> None:
-    scenario = scenario_from_text(MINIMAL.replace('"...", "...", "..."', '"..@", "...", "@.."'), "n.yaml")
+    text = MINIMAL.replace('"...", "...", "..."', '"..@", "...", "@.."').replace(
+        "[0, 0], goal: [2, 2]", "[0, 2], goal: [2, 0]"
+    )
+    scenario = scenario_from_text(text, "n.yaml")
     assert scenario.grid.is_blocked((2, 2))  # first row, last column: north-east corner
     assert scenario.grid.is_blocked((0, 0))  # last row, first column: south-west corner
 
@@ -100,7 +112,9 @@ def test_width_and_height_map() -> None:
     assert grid.blocked_cells() == []
 
 
-@pytest.mark.parametrize(("delay", "expected"), [("2", (2, 2)), ('"1..4"', (1, 4)), ("[0, 3]", (0, 3)), ("1 .. 2", (1, 2))])
+@pytest.mark.parametrize(
+    ("delay", "expected"), [("2", (2, 2)), ('"1..4"', (1, 4)), ("[0, 3]", (0, 3)), ("1 .. 2", (1, 2))]
+)
 def test_delay_forms(delay: str, expected: tuple[int, int]) -> None:
     scenario = scenario_from_text(MINIMAL + f"network: {{delay: {delay}}}\n", "d.yaml")
     assert (scenario.network.delay_min, scenario.network.delay_max) == expected
@@ -202,7 +216,7 @@ def test_writing_with_a_map_file(maps_dir: Path, tmp_path: Path) -> None:
     scenario = load_movingai_scenario(maps_dir / "room-32-32-4.map", maps_dir / "room-32-32-4-random-1.scen", 5)
     shutil.copy(maps_dir / "room-32-32-4.map", tmp_path)
     save_scenario(scenario, tmp_path / "room.yaml", map_file="room-32-32-4.map")
-    assert "file: \"room-32-32-4.map\"" in (tmp_path / "room.yaml").read_text()
+    assert 'file: "room-32-32-4.map"' in (tmp_path / "room.yaml").read_text()
     assert load_scenario(tmp_path / "room.yaml") == scenario
 
 
@@ -282,7 +296,10 @@ def test_missing_robot_goal() -> None:
 
 def test_rows_and_file_together() -> None:
     text = 'map:\n  rows: ["..."]\n  file: x.map\nrobots: [{id: A, start: [0, 0], goal: [0, 1]}]\n'
-    assert only_problem(text) == ("s.yaml:2", "map: give exactly one of rows, file, or width and height; got rows and file")
+    assert only_problem(text) == (
+        "s.yaml:2",
+        "map: give exactly one of rows, file, or width and height; got rows and file",
+    )
 
 
 def test_width_without_height() -> None:
@@ -430,7 +447,10 @@ def test_duplicate_ids() -> None:
 
 
 def test_non_positive_max_ticks() -> None:
-    assert only_problem(SWAP.replace("max_ticks: 100", "max_ticks: 0")) == ("s.yaml:18", "max_ticks: must be positive, got 0")
+    assert only_problem(SWAP.replace("max_ticks: 100", "max_ticks: 0")) == (
+        "s.yaml:18",
+        "max_ticks: must be positive, got 0",
+    )
 
 
 def test_unknown_policy_lists_the_known_ones() -> None:

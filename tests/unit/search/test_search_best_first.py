@@ -294,3 +294,23 @@ def test_planners_mapping() -> None:
         result = planner(grid, (0, 0), (5, 5), blocked=frozenset({(3, 3)}), heading=Heading.NORTH, timing=Timing())
         assert_valid_path(grid, result.path, (0, 0), (5, 5), blocked={(3, 3)})
         assert result.headings is not None
+
+
+def test_heading_aware_search_rejects_non_adjacent_moves() -> None:
+    class Teleport:
+        """A GridMap whose (0, 0) leads straight to (2, 2)."""
+
+        min_cost = 1.0
+
+        def is_free(self, cell: tuple[int, int]) -> bool:
+            return 0 <= cell[0] < 3 and 0 <= cell[1] < 3
+
+        def neighbours(self, cell: tuple[int, int]) -> list[tuple[int, int]]:
+            return [(2, 2)] if cell == (0, 0) else []
+
+        def cost(self, cell: tuple[int, int]) -> float:
+            return 1.0
+
+    assert astar(Teleport(), (0, 0), (2, 2)).path == ((0, 0), (2, 2))
+    with pytest.raises(ValueError, match="not adjacent"):
+        astar(Teleport(), (0, 0), (2, 2), heading=Heading.NORTH)

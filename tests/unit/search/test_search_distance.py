@@ -194,3 +194,61 @@ def test_one_way_grid_map_uses_reverse_moves() -> None:
     assert one_way_goal.distance((0, 0)) == 2.0
     assert one_way_goal.distance((0, 1)) == math.inf
     assert one_way_goal.path((3, 0)) == ((3, 0), (2, 0))
+
+
+@pytest.mark.parametrize("costs", [False, True])
+def test_wavefront_that_ends_wide(costs: bool) -> None:
+    # A diamond around the goal: the last wavefront is the whole rim (80 cells),
+    # so the search ends while expanding wavefronts with numpy.
+    radius = 20
+    centre = (radius, radius)
+    blocked = [
+        (x, y)
+        for x in range(2 * radius + 1)
+        for y in range(2 * radius + 1)
+        if abs(x - radius) + abs(y - radius) > radius
+    ]
+    grid = Grid(2 * radius + 1, 2 * radius + 1, blocked, {(radius, 0): 3.0} if costs else None)
+    table = distance_table(grid, centre, cache=False)
+    assert_matches(table, grid, dijkstra_to_goal(grid, centre))
+    assert table.distance((0, radius)) == radius
+
+
+def test_unhashable_grid_maps_are_not_cached() -> None:
+    class Unhashable:
+        __hash__ = None  # type: ignore[assignment]
+        x_size = 3
+        y_size = 3
+        min_cost = 1.0
+
+        def __init__(self) -> None:
+            self.grid = Grid(3, 3, blocked=[(1, 1)])
+
+        def is_free(self, cell: tuple[int, int]) -> bool:
+            return self.grid.is_free(cell)
+
+        def neighbours(self, cell: tuple[int, int]) -> list[tuple[int, int]]:
+            return self.grid.neighbours(cell)
+
+        def cost(self, cell: tuple[int, int]) -> float:
+            return 1.0
+
+    grid = Unhashable()
+    first = distance_table(grid, (0, 0), cache=True)
+    assert first.distance((2, 2)) == 4.0
+    assert distance_table(grid, (0, 0), cache=True) is not first
+
+
+def test_table_cache_is_bounded(monkeypatch: pytest.MonkeyPatch) -> None:
+    from mrmp.search import distance as distance_module
+
+    monkeypatch.setattr(distance_module, "_TABLE_CACHE_CELLS", 4 * 30)
+    monkeypatch.setattr(distance_module, "_GRIDS", type(distance_module._GRIDS)())
+    grid = Grid(5, 6, blocked=[(4, 5)], name="bounded-cache")
+    first = distance_table(grid, (0, 0))
+    for goal in [(0, y) for y in range(1, 6)]:
+        distance_table(grid, goal)
+    again = distance_table(grid, (0, 0))
+    assert again is not first
+    np.testing.assert_array_equal(again.array, first.array)
+    assert repr(again) == "<DistanceTable to (0, 0) on 5x6>"

@@ -26,7 +26,9 @@ def swap() -> tuple[Grid, RunResult]:
         path=[(0, 2), (1, 2), (1, 3), (2, 3), (3, 3), (4, 3), (4, 2)],
         headings=[N, N, E, N, N, N, W],
     )
-    b = RobotResult("B", (4, 2), (0, 2), path=[(4, 2), (3, 2), (2, 2), (1, 2), (0, 2), (0, 2), (0, 2)], headings=[N] + [S] * 6)
+    b = RobotResult(
+        "B", (4, 2), (0, 2), path=[(4, 2), (3, 2), (2, 2), (1, 2), (0, 2), (0, 2), (0, 2)], headings=[N] + [S] * 6
+    )
     return Grid(5, 5, name="swap"), make_run([a, b], name="swap")
 
 
@@ -35,7 +37,7 @@ def walled() -> tuple[Grid, RunResult]:
     """A 4x6 grid with obstacles, a costly cell and a vertex collision at tick 2."""
     grid = Grid.from_rows(["..@...", "..@.5.", "......", "......"], name="walled")
     a = RobotResult("A", (0, 0), (0, 3), path=[(0, 0), (0, 1), (0, 2), (0, 3)], headings=[E, E, E, E])
-    b = RobotResult("B", (2, 2), (0, 2), path=[(2, 2), (1, 2), (0, 2), (0, 2)], headings=[S, S, S, S])
+    b = RobotResult("B", (1, 3), (0, 2), path=[(1, 3), (1, 2), (0, 2), (0, 2)], headings=[W, W, S, S])
     collision = Collision("vertex", 2, ("A", "B"), ((0, 2),))
     return grid, make_run([a, b], [collision], name="walled")
 

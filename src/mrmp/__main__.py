@@ -1,0 +1,5 @@
+"""``python -m mrmp`` runs the ``mrmp`` command."""
+
+from mrmp.cli import main
+
+main()

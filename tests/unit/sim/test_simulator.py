@@ -1,0 +1,85 @@
+"""The lockstep simulator: determinism, stale knowledge under delay, stopping rules, partial results."""
+
+import pytest
+
+from mrmp.core import Grid, NetworkFaults, PolicyOptions, RobotSpec, Scenario
+from mrmp.sim.simulator import RECURRENCE_LIMIT, LockstepSimulator, simulate
+
+SWAP = Scenario(Grid(5, 5), (RobotSpec("A", (0, 2), (4, 2)), RobotSpec("B", (4, 2), (0, 2))), name="swap")
+
+
+def trajectories(result):
+    return [robot.path for robot in result.robots]
+
+
+def test_same_seed_same_run_under_faults():
+    faulty = SWAP.with_changes(network=NetworkFaults(loss=0.3, delay_min=0, delay_max=2, duplicate=0.2), seed=5)
+    first, second = simulate(faulty), simulate(faulty)
+    assert trajectories(first) == trajectories(second)
+    assert first.network == second.network
+
+
+def test_delayed_messages_leave_robots_with_stale_knowledge_and_they_collide():
+    """With a one-tick delay the robots decide on last tick's Next: the thesis's rule misses the conflict."""
+    delayed = SWAP.with_changes(network=NetworkFaults(delay_min=1, delay_max=1))
+    result = simulate(delayed)
+    assert not result.success
+    assert result.collisions, "the referee must report what stale knowledge caused"
+
+
+def test_total_loss_hides_each_robot_from_the_other():
+    result = simulate(SWAP.with_changes(network=NetworkFaults(loss=1.0)))
+    assert result.network["lost"] == result.network["sent"] > 0
+    assert {c.kind for c in result.collisions} & {"vertex", "swap"}
+
+
+def test_deadlock_is_detected_and_named():
+    """A parked robot closes the only corridor: A cannot plan past it and waits for ever."""
+    corridor = Scenario(
+        Grid.from_rows(["....."]),
+        (RobotSpec("A", (0, 0), (0, 4)), RobotSpec("B", (0, 2), (0, 2))),
+        policy=PolicyOptions(name="astar"),
+    )
+    simulator = LockstepSimulator(corridor, record_decisions=True)
+    result = simulator.run()
+    assert result.stop_reason == "deadlock" and not result.collisions
+    assert result.robots[0].path[-1] == (0, 1) and result.not_arrived == ["A"]
+    assert result.ticks == 1 + RECURRENCE_LIMIT - 1  # one move, then the same configuration recurs
+    assert simulator.decisions[-1][0].reason == "blocked"
+
+
+def test_tick_limit_names_robots_that_did_not_arrive():
+    result = simulate(SWAP.with_changes(max_ticks=3))
+    assert result.stop_reason == "tick limit" and result.ticks == 3
+    assert result.not_arrived == ["A", "B"] and not result.success
+
+
+def test_interrupt_returns_what_was_computed(monkeypatch):
+    simulator = LockstepSimulator(SWAP)
+    original = simulator.step
+    calls = []
+
+    def interrupted_step():
+        calls.append(1)
+        if len(calls) == 3:
+            raise KeyboardInterrupt
+        original()
+
+    monkeypatch.setattr(simulator, "step", interrupted_step)
+    result = simulator.run()
+    assert result.stop_reason == "interrupted"
+    assert [len(path) for path in trajectories(result)] == [3, 3]
+
+
+def test_messages_are_counted_per_datagram():
+    result = simulate(SWAP)
+    assert result.messages == 2 * result.ticks  # each robot, each tick, one datagram to its one peer
+    assert result.network["sent"] == result.messages
+    assert all(robot.bytes_sent == 28 * robot.messages_sent for robot in result.robots)
+
+
+@pytest.mark.parametrize("policy", ["thesis", "astar"])
+def test_single_robot_walks_a_shortest_path(policy):
+    scenario = Scenario(Grid(6, 7), (RobotSpec("A", (0, 0), (5, 6)),), policy=PolicyOptions(name=policy))
+    result = simulate(scenario)
+    assert result.success and result.makespan == result.lower_bound == 11
