@@ -122,10 +122,14 @@ class _FlatGrid:
 
 
 def _dedupe(cells: IndexArray, owner: IndexArray, ranks: IndexArray) -> IndexArray:
-    """The distinct values of ``cells`` (first occurrences, in order), via ``owner`` scratch."""
+    """One copy of each value of ``cells``, via the ``owner`` scratch array (no sort).
+
+    Each position writes its rank into ``owner[cell]``; exactly one write per
+    cell survives (NumPy does not say which), and only that position matches.
+    """
     order = ranks[: cells.size]
-    owner[cells] = order  # the last writer of each index wins ...
-    unique: IndexArray = cells[owner[cells] == order]  # ... and keeps exactly one copy
+    owner[cells] = order
+    unique: IndexArray = cells[owner[cells] == order]
     return unique
 
 
