@@ -8,7 +8,7 @@ from mrmp.core.errors import InputError, MrmpError, Problem
 from mrmp.core.grid import Grid
 from mrmp.core.heading import Heading, right_turns
 from mrmp.core.result import Collision, RobotResult, RunResult
-from mrmp.core.scenario import NetworkFaults, PolicyOptions, RobotSpec, Scenario, Timing
+from mrmp.core.scenario import LinkFaults, NetworkFaults, PolicyOptions, RobotSpec, Scenario, Timing
 
 __all__ = [
     "Cell",
@@ -16,6 +16,7 @@ __all__ = [
     "Grid",
     "Heading",
     "InputError",
+    "LinkFaults",
     "MrmpError",
     "NetworkFaults",
     "PolicyOptions",

@@ -76,6 +76,15 @@ class NetworkFaults:
 
 
 @dataclass(frozen=True)
+class LinkFaults:
+    """Faults of one directed link, from robot ``sender`` to robot ``recipient`` (by id)."""
+
+    sender: str
+    recipient: str
+    faults: NetworkFaults
+
+
+@dataclass(frozen=True)
 class PolicyOptions:
     """Which decision rule robots run and its settings.
 
@@ -96,6 +105,7 @@ class Scenario:
     robots: tuple[RobotSpec, ...]
     timing: Timing = field(default_factory=Timing)
     network: NetworkFaults = field(default_factory=NetworkFaults)
+    links: tuple[LinkFaults, ...] = ()
     policy: PolicyOptions = field(default_factory=PolicyOptions)
     seed: int = 0
     max_ticks: int | None = None
@@ -138,12 +148,25 @@ def _component_labels(grid: Grid) -> dict[Cell, int]:
     return labels
 
 
+def _fault_problems(faults: NetworkFaults, where: str) -> list[Problem]:
+    problems = []
+    for name in ("loss", "duplicate", "reorder"):
+        value = getattr(faults, name)
+        if not 0.0 <= value <= 1.0:
+            problems.append(Problem(f"{where}.{name}", f"must be a probability in [0, 1], got {value}"))
+    if faults.delay_min < 0 or faults.delay_max < faults.delay_min:
+        problems.append(
+            Problem(f"{where}.delay", f"must be a range 0 <= min <= max ticks, got {faults.delay_min}..{faults.delay_max}")
+        )
+    return problems
+
+
 def scenario_problems(scenario: Scenario) -> list[Problem]:
     """Every problem with the meaning of ``scenario``, each named by its field path.
 
     Checks: robots present, unique ids, starts and goals on the grid and free,
     no two robots sharing a start or a goal, each goal reachable from its start,
-    timing and fault values in range.
+    timing and fault values in range, links between existing robots.
     """
     problems: list[Problem] = []
     grid = scenario.grid
@@ -182,15 +205,15 @@ def scenario_problems(scenario: Scenario) -> list[Problem]:
         problems.append(Problem("timing.cell_time", f"must be positive, got {timing.cell_time}"))
     if not timing.turn_time >= 0:
         problems.append(Problem("timing.turn_time", f"must not be negative, got {timing.turn_time}"))
-    network = scenario.network
-    for name in ("loss", "duplicate", "reorder"):
-        value = getattr(network, name)
-        if not 0.0 <= value <= 1.0:
-            problems.append(Problem(f"network.{name}", f"must be a probability in [0, 1], got {value}"))
-    if network.delay_min < 0 or network.delay_max < network.delay_min:
-        problems.append(
-            Problem("network.delay", f"must be a range 0 <= min <= max ticks, got {network.delay_min}..{network.delay_max}")
-        )
+    problems.extend(_fault_problems(scenario.network, "network"))
+    for index, link in enumerate(scenario.links):
+        where = f"network.links[{index}]"
+        for end, robot_id in (("from", link.sender), ("to", link.recipient)):
+            if robot_id not in seen_ids:
+                problems.append(Problem(f"{where}.{end}", f"no robot has the id {robot_id!r}"))
+        if link.sender == link.recipient:
+            problems.append(Problem(f"{where}.to", "a link joins two different robots"))
+        problems.extend(_fault_problems(link.faults, where))
     if scenario.policy.resolve not in RESOLUTIONS:
         problems.append(Problem("policy.resolve", f"must be one of {', '.join(RESOLUTIONS)}, got {scenario.policy.resolve!r}"))
     if scenario.max_ticks is not None and scenario.max_ticks <= 0:

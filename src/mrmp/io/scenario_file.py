@@ -15,7 +15,13 @@ A scenario file looks like this (only ``map`` and ``robots`` are required)::
         goal: [4, 2]
         heading: NORTH                # optional: a name or 1-4
     timing: {cell_time: 1.0, turn_time: 0.5}
-    network: {loss: 0.0, delay: 0, duplicate: 0.0, reorder: 0.0}   # delay: N, "A..B" or [A, B]
+    network:                          # delay: N, "A..B" or [A, B] ticks
+      loss: 0.0
+      delay: 0
+      duplicate: 0.0
+      reorder: 0.0
+      links:                          # optional: faults of particular directed links
+        - {from: A, to: B, loss: 0.5} # unset settings are the network's
     policy: {name: thesis, resolve: divert, heading_aware: false}
     seed: 0
     max_ticks: 100
@@ -55,7 +61,7 @@ import json
 import math
 import re
 from collections.abc import Callable, Sequence
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 from typing import Any
 
@@ -68,6 +74,7 @@ from mrmp.core.errors import InputError, Problem
 from mrmp.core.grid import COST_SYMBOLS, Grid
 from mrmp.core.heading import Heading
 from mrmp.core.scenario import (
+    LinkFaults,
     NetworkFaults,
     PolicyOptions,
     RobotSpec,
@@ -105,8 +112,12 @@ ROBOT_KEYS = ("id", "start", "goal", "heading")
 """Keys allowed in each item of ``robots``."""
 TIMING_KEYS = ("cell_time", "turn_time")
 """Keys allowed under ``timing``."""
-NETWORK_KEYS = ("loss", "delay", "duplicate", "reorder")
+FAULT_KEYS = ("loss", "delay", "duplicate", "reorder")
+"""Fault settings, allowed under ``network`` and in each of its ``links``."""
+NETWORK_KEYS = (*FAULT_KEYS, "links")
 """Keys allowed under ``network``."""
+LINK_KEYS = ("from", "to", *FAULT_KEYS)
+"""Keys allowed in each entry of ``network.links``; unset faults are the network's."""
 POLICY_KEYS = ("name", "resolve", "heading_aware")
 """Keys allowed under ``policy``."""
 
@@ -488,20 +499,14 @@ class _Reader:
             return None
         return read_map(map_path)
 
-    def read_settings(self, top: dict[str, _Entry]) -> tuple[Timing, NetworkFaults, PolicyOptions]:
+    def read_settings(self, top: dict[str, _Entry]) -> tuple[Timing, NetworkFaults, tuple[LinkFaults, ...], PolicyOptions]:
         """The ``timing``, ``network`` and ``policy`` sections (defaults where absent or wrong)."""
         timing_entries = self.section(top, "timing", TIMING_KEYS)
         timing_values = {key: self.optional(timing_entries, key, f"timing.{key}", self.number) for key in TIMING_KEYS}
         timing = Timing(**_given(timing_values))
         network_entries = self.section(top, "network", NETWORK_KEYS)
-        network_values = {
-            key: self.optional(network_entries, key, f"network.{key}", self.number)
-            for key in ("loss", "duplicate", "reorder")
-        }
-        delay = self.optional(network_entries, "delay", "network.delay", self.delay)
-        if delay is not None and delay is not _BAD:
-            network_values["delay_min"], network_values["delay_max"] = delay
-        network = NetworkFaults(**_given(network_values))
+        network = self.faults(network_entries, "network", NetworkFaults())
+        links = self.links(network_entries, network)
         policy_entries = self.section(top, "policy", POLICY_KEYS)
         policy_values = {
             "name": self.optional(policy_entries, "name", "policy.name", self.text),
@@ -518,7 +523,36 @@ class _Reader:
             self.report(
                 self.lines["policy.name"], "policy.name", f"unknown policy {policy.name!r}; known policies: {known}"
             )
-        return timing, network, policy
+        return timing, network, links, policy
+
+    def faults(self, entries: dict[str, _Entry] | None, path: str, defaults: NetworkFaults) -> NetworkFaults:
+        """Fault settings under ``path``; the ones not given keep their value in ``defaults``."""
+        values = {key: self.optional(entries, key, f"{path}.{key}", self.number) for key in ("loss", "duplicate", "reorder")}
+        delay = self.optional(entries, "delay", f"{path}.delay", self.delay)
+        if delay is not None and delay is not _BAD:
+            values["delay_min"], values["delay_max"] = delay
+        return replace(defaults, **_given(values))
+
+    def links(self, network_entries: dict[str, _Entry] | None, network: NetworkFaults) -> tuple[LinkFaults, ...]:
+        """The ``network.links`` list: faults of particular directed links between robots."""
+        if network_entries is None or "links" not in network_entries:
+            return ()
+        node = network_entries["links"].value
+        if not isinstance(node, SequenceNode):
+            self.report(_line(node), "network.links", f"expected a list of links, got {_describe(node, self.scalar(node))}")
+            return ()
+        links = []
+        for index, item in enumerate(node.value):
+            path = f"network.links[{index}]"
+            self.lines[path] = _line(item)
+            entries = self.mapping(item, path, LINK_KEYS, required=("from", "to"))
+            if entries is None:
+                continue
+            ends = [self.optional(entries, key, f"{path}.{key}", self.label) for key in ("from", "to")]
+            faults = self.faults(entries, path, network)
+            if all(end is not None and end is not _BAD for end in ends):
+                links.append(LinkFaults(ends[0], ends[1], faults))
+        return tuple(links)
 
     def section(self, top: dict[str, _Entry], key: str, allowed: Sequence[str]) -> dict[str, _Entry] | None:
         """The entries of an optional sub-mapping (None when absent, null or wrong)."""
@@ -555,7 +589,7 @@ class _Reader:
             grid, robots = self.read_scen_robots(top, grid)
         elif "robots" in top:
             robots = self.read_robots(top["robots"].value)
-        timing, network, policy = self.read_settings(top)
+        timing, network, links, policy = self.read_settings(top)
         seed = self.optional(top, "seed", "seed", self.integer)
         max_ticks = self.optional(top, "max_ticks", "max_ticks", self.integer)
         scenario = Scenario(
@@ -563,6 +597,7 @@ class _Reader:
             robots=tuple(robot for _, robot in robots),
             timing=timing,
             network=network,
+            links=links,
             policy=policy,
             seed=0 if seed is None or seed is _BAD else seed,
             max_ticks=None if max_ticks is _BAD else max_ticks,
@@ -785,6 +820,17 @@ def _cell_text(cell: Cell) -> str:
     return f"[{cell[0]}, {cell[1]}]"
 
 
+def _faults_text(faults: NetworkFaults) -> str:
+    """Fault settings as YAML flow-mapping entries."""
+    delay = (
+        str(faults.delay_min) if faults.delay_min == faults.delay_max else _quote(f"{faults.delay_min}..{faults.delay_max}")
+    )
+    return (
+        f"loss: {_yaml_float(faults.loss)}, delay: {delay}, "
+        f"duplicate: {_yaml_float(faults.duplicate)}, reorder: {_yaml_float(faults.reorder)}"
+    )
+
+
 def scenario_to_yaml(scenario: Scenario, map_file: str | None = None) -> str:
     """The YAML text of ``scenario``, readable by :func:`scenario_from_text`.
 
@@ -830,15 +876,14 @@ def scenario_to_yaml(scenario: Scenario, map_file: str | None = None) -> str:
         lines.append(f"  - {{id: {_quote(robot.id)}, start: {start}, goal: {goal}, heading: {robot.heading.name}}}")
     timing, network, policy = scenario.timing, scenario.network, scenario.policy
     lines.append(f"timing: {{cell_time: {_yaml_float(timing.cell_time)}, turn_time: {_yaml_float(timing.turn_time)}}}")
-    delay = (
-        str(network.delay_min)
-        if network.delay_min == network.delay_max
-        else _quote(f"{network.delay_min}..{network.delay_max}")
-    )
-    lines.append(
-        f"network: {{loss: {_yaml_float(network.loss)}, delay: {delay}, "
-        f"duplicate: {_yaml_float(network.duplicate)}, reorder: {_yaml_float(network.reorder)}}}"
-    )
+    lines.append(f"network: {{{_faults_text(network)}}}")
+    if scenario.links:
+        lines[-1] = "network:"
+        lines += [f"  {setting}" for setting in _faults_text(network).split(", ")]
+        lines.append("  links:")
+        for link in scenario.links:
+            ends = f"from: {_quote(link.sender)}, to: {_quote(link.recipient)}"
+            lines.append(f"    - {{{ends}, {_faults_text(link.faults)}}}")
     heading_aware = "true" if policy.heading_aware else "false"
     lines.append(
         f"policy: {{name: {_quote(policy.name)}, resolve: {_quote(policy.resolve)}, heading_aware: {heading_aware}}}"

@@ -66,7 +66,9 @@ class LockstepSimulator:
             Robot(spec, index, grid, make_policy(scenario.policy, scenario.timing))
             for index, spec in enumerate(scenario.robots)
         ]
-        self.network = SimulatedNetwork(scenario.network, seed=scenario.seed)
+        index_of = {spec.id: index for index, spec in enumerate(scenario.robots)}
+        links = {(index_of[link.sender], index_of[link.recipient]): link.faults for link in scenario.links}
+        self.network = SimulatedNetwork(scenario.network, seed=scenario.seed, links=links)
         self.referee = Referee(grid, [spec.id for spec in scenario.robots])
         self.lengths = shortest_steps(scenario)
         self.max_ticks = scenario.max_ticks or default_max_ticks(scenario, self.lengths)

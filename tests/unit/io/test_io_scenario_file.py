@@ -491,7 +491,7 @@ seed: yes
     assert problems(text) == [
         ("s.yaml:4", "robots[0].goal: cell (5, 5) is outside the 2x3 grid"),
         ("s.yaml:5", "timing.cell_time: must be positive, got 0.0"),
-        ("s.yaml:6", "network: unknown key 'jitter' (allowed: loss, delay, duplicate, reorder)"),
+        ("s.yaml:6", "network: unknown key 'jitter' (allowed: loss, delay, duplicate, reorder, links)"),
         ("s.yaml:6", "network.loss: must be a probability in [0, 1], got 1.5"),
         ("s.yaml:7", "seed: expected an integer, got a boolean 'yes'"),
     ]
@@ -504,3 +504,29 @@ def test_error_message_is_one_line_per_problem() -> None:
         "x.yaml:4: unknown key 'sed' (did you mean 'seed'?)",
         "x.yaml:5: unknown key 'max_tick' (did you mean 'max_ticks'?)",
     ]
+
+
+LINKED = """\
+map: {width: 5, height: 5}
+robots:
+  - {id: A, start: [0, 2], goal: [4, 2]}
+  - {id: B, start: [4, 2], goal: [0, 2]}
+network:
+  delay: 1
+  links:
+    - {from: A, to: B, loss: 1.0}
+    - {from: B, to: Z, delay: "0..2"}
+    - {to: A}
+"""
+
+
+def test_links_inherit_network_faults_and_name_bad_robots() -> None:
+    found = problems(LINKED)
+    assert ("s.yaml:10", "network.links[2]: missing required key 'from'") in found
+    assert ("s.yaml:9", "network.links[1].to: no robot has the id 'Z'") in found
+    fixed = LINKED.replace("to: Z", "to: A").replace("    - {to: A}\n", "")
+    scenario = scenario_from_text(fixed, "s.yaml")
+    first, second = scenario.links
+    assert (first.sender, first.recipient, first.faults.loss, first.faults.delay_max) == ("A", "B", 1.0, 1)
+    assert (second.faults.delay_min, second.faults.delay_max, second.faults.loss) == (0, 2, 0.0)
+    assert scenario_from_text(scenario_to_yaml(scenario), "t.yaml").links == scenario.links

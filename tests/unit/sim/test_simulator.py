@@ -83,3 +83,14 @@ def test_single_robot_walks_a_shortest_path(policy):
     scenario = Scenario(Grid(6, 7), (RobotSpec("A", (0, 0), (5, 6)),), policy=PolicyOptions(name=policy))
     result = simulate(scenario)
     assert result.success and result.makespan == result.lower_bound == 11
+
+
+def test_per_link_faults_apply_to_one_direction_only():
+    from mrmp.core.scenario import LinkFaults
+
+    deaf_b = SWAP.with_changes(links=(LinkFaults("A", "B", NetworkFaults(loss=1.0)),))
+    simulator = LockstepSimulator(deaf_b)
+    result = simulator.run()
+    a, b = simulator.robots
+    assert 0 not in b.belief.peers and 1 in a.belief.peers
+    assert result.network["lost"] == result.robots[0].messages_sent
