@@ -81,7 +81,7 @@ def _apply_options(scenario: Scenario, **options: object) -> Scenario:
     if network_changes:
         network = NetworkFaults(**{**network.__dict__, **network_changes})
     changes: dict[str, object] = {"policy": policy, "network": network}
-    for key in ("seed", "max_ticks"):
+    for key in ("seed", "max_ticks", "safety"):
         if options.get(key) is not None:
             changes[key] = options[key]
     updated = scenario.with_changes(**changes)
@@ -141,6 +141,7 @@ def run(
     policy: Annotated[Optional[str], typer.Option(help=f"Decision rule: {', '.join(POLICY_NAMES)}.")] = None,
     resolve: Annotated[Optional[str], typer.Option(help=f"Conflict resolution: {', '.join(RESOLUTIONS)}.")] = None,
     heading_aware: Annotated[Optional[bool], typer.Option("--heading-aware/--no-heading-aware", help="Charge turns when planning.")] = None,
+    unsafe: Annotated[bool, typer.Option("--unsafe", help="Turn the safety layer off: the policy as written.")] = False,
     max_ticks: Annotated[Optional[int], typer.Option(help="Stop after this many ticks.")] = None,
     seed: Annotated[Optional[int], typer.Option(help="Seed of the simulated network.")] = None,
     loss: Annotated[Optional[float], typer.Option(help="Probability that a message is lost.")] = None,
@@ -165,6 +166,7 @@ def run(
             reorder=reorder,
             seed=seed,
             max_ticks=max_ticks,
+            safety=False if unsafe else None,
         )
         if animate is not None and animate.suffix.lower() not in (".gif", ".svg"):
             raise InputError(Problem("--animate", f"unsupported suffix {animate.suffix!r}; use .gif or .svg"))

@@ -17,6 +17,7 @@ from pathlib import Path
 import pytest
 
 from mrmp.core.heading import Heading
+from mrmp.core.scenario import PolicyOptions
 from mrmp.io import load_scenario
 from mrmp.sim.simulator import simulate
 
@@ -24,16 +25,21 @@ EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 N, E, S, W = Heading.NORTH, Heading.EAST, Heading.SOUTH, Heading.WEST
 
 
-def run(name):
-    return simulate(load_scenario(EXAMPLES / f"{name}.yaml"), record_decisions=True)
+def run(name, safety=True):
+    return simulate(load_scenario(EXAMPLES / f"{name}.yaml").with_changes(safety=safety), record_decisions=True)
+
+
+both = pytest.mark.parametrize("safety", [True, False], ids=["guarded", "as-written"])
 
 
 def paths(result):
     return {robot.id: robot.path for robot in result.robots}
 
 
-def test_head_on_swap():
-    result = run("thesis-swap")
+@both
+def test_head_on_swap(safety):
+    """Without faults the safety layer grants every move the thesis makes: same trajectories."""
+    result = run("thesis-swap", safety)
     assert paths(result) == {
         "A": [(0, 2), (1, 2), (1, 3), (2, 3), (3, 3), (4, 3), (4, 2)],
         "B": [(4, 2), (3, 2), (2, 2), (1, 2), (0, 2), (0, 2), (0, 2)],
@@ -58,16 +64,18 @@ def test_swap_first_conflict_a_diverts_off_the_row_b_keeps_it():
     assert all(r in ("clear", "arrived") for tick in reasons[2:] for r in tick)
 
 
-def test_single_robot_scenario_1():
-    result = run("thesis-single")
+@both
+def test_single_robot_scenario_1(safety):
+    result = run("thesis-single", safety)
     assert paths(result) == {"A": [(0, 0), (1, 0), (2, 0), (3, 0), (4, 0), (4, 1), (4, 2), (4, 3), (4, 4)]}
     assert result.robots[0].turns == 1  # NORTH to EAST: one right turn
     assert result.success and result.makespan == 8 == result.lower_bound
     assert result.messages == 0  # nobody to talk to
 
 
-def test_crossing_paths():
-    result = run("thesis-cross")
+@both
+def test_crossing_paths(safety):
+    result = run("thesis-cross", safety)
     assert paths(result) == {
         "A": [(0, 0), (1, 0), (1, 1), (2, 1), (3, 1), (4, 1), (4, 2), (4, 3), (4, 4)],
         "B": [(4, 0), (3, 0), (2, 0), (1, 0), (0, 0), (0, 1), (0, 2), (0, 3), (0, 4)],
@@ -75,12 +83,21 @@ def test_crossing_paths():
     assert result.success and (result.makespan, result.sum_of_costs) == (8, 16)
 
 
-def test_velocity_tuning_on_the_swap_deadlocks_and_is_reported():
+def test_velocity_tuning_as_written_collides_and_is_reported():
     """With resolve=wait the lower robot waits; B walks into it (the thesis's rule lets it), and the referee says so."""
     scenario = load_scenario(EXAMPLES / "thesis-swap.yaml")
-    result = simulate(scenario.with_changes(policy=scenario.policy.__class__(name="thesis", resolve="wait")))
+    waiting = scenario.with_changes(policy=PolicyOptions(name="thesis", resolve="wait"), safety=False)
+    result = simulate(waiting)
     assert not result.success
-    assert any(collision.kind in ("vertex", "swap") for collision in result.collisions)
+    assert [(c.kind, c.tick, c.robots) for c in result.collisions][0] == ("vertex", 3, ("A", "B"))
+
+
+def test_velocity_tuning_guarded_deadlocks_without_collision():
+    """The safety layer refuses B the cell A stands on: no collision, and the deadlock is named."""
+    scenario = load_scenario(EXAMPLES / "thesis-swap.yaml")
+    result = simulate(scenario.with_changes(policy=PolicyOptions(name="thesis", resolve="wait")))
+    assert result.collisions == [] and result.stop_reason == "deadlock"
+    assert result.robots[0].path[-1] == (1, 2) and result.robots[1].path[-1] == (2, 2)
 
 
 @pytest.mark.parametrize("name", ["thesis-swap", "thesis-single", "thesis-cross"])

@@ -99,7 +99,11 @@ class PolicyOptions:
 
 @dataclass(frozen=True)
 class Scenario:
-    """Everything a run needs to start: world, robots and settings."""
+    """Everything a run needs to start: world, robots and settings.
+
+    ``safety`` turns on the safety layer that guards every move
+    (:mod:`mrmp.protocol.safety`); ``False`` runs the policy as written.
+    """
 
     grid: Grid
     robots: tuple[RobotSpec, ...]
@@ -107,6 +111,7 @@ class Scenario:
     network: NetworkFaults = field(default_factory=NetworkFaults)
     links: tuple[LinkFaults, ...] = ()
     policy: PolicyOptions = field(default_factory=PolicyOptions)
+    safety: bool = True
     seed: int = 0
     max_ticks: int | None = None
     name: str = ""

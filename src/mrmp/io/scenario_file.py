@@ -23,6 +23,7 @@ A scenario file looks like this (only ``map`` and ``robots`` are required)::
       links:                          # optional: faults of particular directed links
         - {from: A, to: B, loss: 0.5} # unset settings are the network's
     policy: {name: thesis, resolve: divert, heading_aware: false}
+    safety: true                      # false: no safety layer, the policy as written
     seed: 0
     max_ticks: 100
 
@@ -104,6 +105,7 @@ TOP_KEYS = (
     "policy",
     "seed",
     "max_ticks",
+    "safety",
 )
 """Keys allowed at the top level of a scenario file."""
 MAP_KEYS = ("rows", "file", "width", "height")
@@ -590,6 +592,7 @@ class _Reader:
         elif "robots" in top:
             robots = self.read_robots(top["robots"].value)
         timing, network, links, policy = self.read_settings(top)
+        safety = self.optional(top, "safety", "safety", self.boolean)
         seed = self.optional(top, "seed", "seed", self.integer)
         max_ticks = self.optional(top, "max_ticks", "max_ticks", self.integer)
         scenario = Scenario(
@@ -599,6 +602,7 @@ class _Reader:
             network=network,
             links=links,
             policy=policy,
+            safety=True if safety is None or safety is _BAD else safety,
             seed=0 if seed is None or seed is _BAD else seed,
             max_ticks=None if max_ticks is _BAD else max_ticks,
             name=name,
@@ -888,6 +892,8 @@ def scenario_to_yaml(scenario: Scenario, map_file: str | None = None) -> str:
     lines.append(
         f"policy: {{name: {_quote(policy.name)}, resolve: {_quote(policy.resolve)}, heading_aware: {heading_aware}}}"
     )
+    if not scenario.safety:
+        lines.append("safety: false")
     lines.append(f"seed: {scenario.seed}")
     if scenario.max_ticks is not None:
         lines.append(f"max_ticks: {scenario.max_ticks}")

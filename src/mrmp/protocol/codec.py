@@ -9,10 +9,15 @@ Wire layout (network byte order)::
     6       4     sequence number (unsigned)
     10      ...   body, fixed layout per type
 
-:class:`~mrmp.protocol.messages.StateMessage` (type 1) has a 18-byte body:
-present x, present y, next x, next y (signed 32-bit each), heading (1..4) and
-flags (bit 0: arrived), 28 bytes in all. Every datagram is at most
-:data:`MAX_MESSAGE_BYTES`.
+Bodies (cells are two signed 32-bit integers)::
+
+    1 state  present, next, target, claim cell (4 cells), heading (1 byte, 1..4),
+             flags (1 byte: bit 0 arrived, bit 1 moving, bit 2 claiming), claim (u32)   48 bytes in all
+    2 claim  claim (u32), cell                                                          22 bytes in all
+    3 reply  claimant (u32), claim (u32), cell, granted (1 byte, 0 or 1)                 27 bytes in all
+
+Every datagram is at most :data:`MAX_MESSAGE_BYTES`. Authentication (a MAC
+over these bytes) is a separate layer, :mod:`mrmp.protocol.auth`.
 
 Decoding never trusts its input: anything that is not exactly a valid message
 raises :class:`DecodeError` with a ``reason`` (``"oversized"``,
@@ -24,9 +29,9 @@ Examples
 >>> from mrmp.protocol.messages import StateMessage
 >>> data = encode(StateMessage(sender=1, seq=3, present=(4, 2), next=(3, 2)))
 >>> len(data)
-28
+48
 >>> decode(data)
-StateMessage(sender=1, seq=3, present=(4, 2), next=(3, 2), heading=<Heading.NORTH: 1>, arrived=False)
+StateMessage(sender=1, seq=3, present=(4, 2), next=(3, 2), heading=<Heading.NORTH: 1>, arrived=False, target=None, claim=0, claim_cell=None)
 >>> decode(b"hello")
 Traceback (most recent call last):
 ...
@@ -39,9 +44,9 @@ import struct
 
 from mrmp.core.errors import MrmpError
 from mrmp.core.heading import Heading
-from mrmp.protocol.messages import Message, StateMessage
+from mrmp.protocol.messages import NO_CELL, ClaimMessage, Message, ReplyMessage, StateMessage
 
-PROTOCOL_VERSION = 1
+PROTOCOL_VERSION = 2
 """Version byte of every datagram; a receiver drops other versions."""
 MAX_MESSAGE_BYTES = 512
 """Upper bound on the size of any encoded message."""
@@ -50,9 +55,12 @@ DECODE_REASONS = ("oversized", "truncated", "version", "type", "malformed")
 """Why a datagram can be rejected by :func:`decode`."""
 
 _HEADER = struct.Struct("!BBII")
-_STATE_BODY = struct.Struct("!iiiiBB")
-_STATE_TYPE = 1
-_ARRIVED = 0x01
+_STATE_BODY = struct.Struct("!iiiiiiiiBBI")
+_CLAIM_BODY = struct.Struct("!Iii")
+_REPLY_BODY = struct.Struct("!IIiiB")
+_STATE, _CLAIM, _REPLY = 1, 2, 3
+_ARRIVED, _MOVING, _CLAIMING = 0x01, 0x02, 0x04
+_BODIES = {_STATE: _STATE_BODY, _CLAIM: _CLAIM_BODY, _REPLY: _REPLY_BODY}
 
 
 class DecodeError(MrmpError):
@@ -74,11 +82,26 @@ def encode(message: Message) -> bytes:
         If a field does not fit its wire size (for example a negative sender).
     """
     if isinstance(message, StateMessage):
-        flags = _ARRIVED if message.arrived else 0
-        return _HEADER.pack(PROTOCOL_VERSION, _STATE_TYPE, message.sender, message.seq) + _STATE_BODY.pack(
-            message.present[0], message.present[1], message.next[0], message.next[1], int(message.heading), flags
+        target = message.target if message.target is not None else NO_CELL
+        claim_cell = message.claim_cell if message.claim and message.claim_cell is not None else NO_CELL
+        flags = (
+            (_ARRIVED if message.arrived else 0)
+            | (_MOVING if message.target is not None else 0)
+            | (_CLAIMING if message.claim else 0)
         )
-    raise TypeError(f"cannot encode {type(message).__name__}")
+        body = _STATE_BODY.pack(
+            *message.present, *message.next, *target, *claim_cell, int(message.heading), flags, message.claim
+        )
+        type_code = _STATE
+    elif isinstance(message, ClaimMessage):
+        body = _CLAIM_BODY.pack(message.claim, *message.cell)
+        type_code = _CLAIM
+    elif isinstance(message, ReplyMessage):
+        body = _REPLY_BODY.pack(message.claimant, message.claim, *message.cell, 1 if message.granted else 0)
+        type_code = _REPLY
+    else:
+        raise TypeError(f"cannot encode {type(message).__name__}")
+    return _HEADER.pack(PROTOCOL_VERSION, type_code, message.sender, message.seq) + body
 
 
 def decode(data: bytes) -> Message:
@@ -98,15 +121,39 @@ def decode(data: bytes) -> Message:
     version, type_code, sender, seq = _HEADER.unpack_from(data)
     if version != PROTOCOL_VERSION:
         raise DecodeError("version", f"protocol version {version}, expected {PROTOCOL_VERSION}")
-    if type_code == _STATE_TYPE:
-        expected = _HEADER.size + _STATE_BODY.size
-        if size != expected:
-            reason = "truncated" if size < expected else "malformed"
-            raise DecodeError(reason, f"state message of {size} bytes, expected {expected}")
-        px, py, nx, ny, heading, flags = _STATE_BODY.unpack_from(data, _HEADER.size)
+    body = _BODIES.get(type_code)
+    if body is None:
+        raise DecodeError("type", f"unknown message type {type_code}")
+    expected = _HEADER.size + body.size
+    if size != expected:
+        raise DecodeError("truncated" if size < expected else "malformed", f"{size} bytes, expected {expected}")
+    fields = body.unpack_from(data, _HEADER.size)
+    if type_code == _STATE:
+        px, py, nx, ny, tx, ty, cx, cy, heading, flags, claim = fields
         if not 1 <= heading <= 4:
             raise DecodeError("malformed", f"heading {heading} is not 1..4")
-        if flags & ~_ARRIVED:
+        if flags & ~(_ARRIVED | _MOVING | _CLAIMING):
             raise DecodeError("malformed", f"unknown flags {flags:#04x}")
-        return StateMessage(sender, seq, (px, py), (nx, ny), Heading(heading), bool(flags & _ARRIVED))
-    raise DecodeError("type", f"unknown message type {type_code}")
+        moving, claiming = bool(flags & _MOVING), bool(flags & _CLAIMING)
+        if moving != ((tx, ty) != NO_CELL) or claiming != (claim != 0) or claiming != ((cx, cy) != NO_CELL):
+            raise DecodeError("malformed", "flags disagree with the target and claim fields")
+        return StateMessage(
+            sender,
+            seq,
+            (px, py),
+            (nx, ny),
+            Heading(heading),
+            bool(flags & _ARRIVED),
+            (tx, ty) if moving else None,
+            claim,
+            (cx, cy) if claiming else None,
+        )
+    if type_code == _CLAIM:
+        claim, cx, cy = fields
+        if claim == 0:
+            raise DecodeError("malformed", "claim number 0")
+        return ClaimMessage(sender, seq, claim, (cx, cy))
+    claimant, claim, cx, cy, granted = fields
+    if granted > 1 or claim == 0:
+        raise DecodeError("malformed", f"reply with granted={granted}, claim={claim}")
+    return ReplyMessage(sender, seq, claimant, claim, (cx, cy), bool(granted))

@@ -1,48 +1,60 @@
-"""The sans-IO robot: a pure object fed time and messages, returning actions and messages.
+"""The sans-IO robot: a pure object fed time and messages, returning motions and messages.
 
-A :class:`Robot` holds its own state (Present cell, heading, goal) and its
-:class:`~mrmp.robot.belief.Belief` of its peers, and delegates the choice of
-cells to its :class:`~mrmp.policies.base.Policy`. It never opens a socket,
-starts a thread, sleeps or reads a clock: its driver (the lockstep simulator,
-or a live process) hands it the time and the bytes it received, and carries out
-what it returns. So the robot benchmarked in the simulator is the robot
-deployed (the design of h11: the protocol is a state machine, the caller owns
-the I/O).
+A :class:`Robot` holds its own state (Present cell, heading, goal), its
+:class:`~mrmp.robot.belief.Belief` of its peers, its
+:class:`~mrmp.policies.base.Policy`, and its
+:class:`~mrmp.protocol.safety.SafetyLayer`. It never opens a socket, starts a
+thread, sleeps or reads a clock: its driver (the lockstep simulator, or a live
+process) hands it the time and the bytes it received, and carries out what it
+returns. So the robot benchmarked in the simulator is the robot deployed (the
+design of h11: the protocol is a state machine, the caller owns the I/O).
 
-One step, as in the thesis (section 3.5-3.6):
+One step, as in the thesis (sections 3.5-3.6), with the safety layer:
 
-1. :meth:`Robot.intend` computes Next and returns the messages announcing
-   Present and Next (the thesis's client thread sends on every update);
-2. the driver delivers what peers sent: :meth:`Robot.receive_datagram` (the
-   thesis's server thread);
-3. :meth:`Robot.decide` applies the policy to Next and the peers' Present and
-   Next, and returns the :class:`~mrmp.policies.base.Decision`;
-4. the body moves; the driver reports the cell and heading the robot's own
-   sensors give (the Khepera counts grid lines) with :meth:`Robot.observe`.
+1. :meth:`Robot.announce`: compute Next and return the state message that
+   announces Present and Next (the thesis's client thread);
+2. :meth:`Robot.receive_datagram` / :meth:`Robot.receive`, at any time: take
+   in what peers sent (the thesis's server thread) and return the answers to
+   their claims;
+3. :meth:`Robot.decide`: apply the policy to Next and the peers' Present and
+   Next; when guarded, return the claim for the chosen cell;
+4. :meth:`Robot.motion`: the cell the body may start entering now, if any
+   (guarded: only once a majority has registered it to this robot);
+5. :meth:`Robot.arrived`: the body stands on a new cell (the Khepera counts grid
+   lines); the robot then announces again;
+6. :meth:`Robot.expire`: timers (resend or abandon a claim).
+
+With ``guarded=False`` step 4 allows whatever step 3 decided, reproducing the
+thesis as written.
 
 Examples
 --------
 >>> from mrmp.core import Grid, RobotSpec
 >>> from mrmp.policies.thesis import ThesisPolicy
->>> robot = Robot(RobotSpec("A", (0, 2), (4, 2)), index=0, grid=Grid(5, 5), policy=ThesisPolicy())
->>> [outgoing.message.next for outgoing in robot.intend(now=1)]
+>>> robot = Robot(RobotSpec("A", (0, 2), (4, 2)), index=0, grid=Grid(5, 5), policy=ThesisPolicy(), starts=[(0, 2)])
+>>> [outgoing.message.next for outgoing in robot.announce(now=1)]
 [(1, 2)]
->>> robot.decide(now=1)
-Decision(next=(1, 2), reason='clear', conflicts=())
+>>> [type(outgoing.message).__name__ for outgoing in robot.decide(now=1)]
+['ClaimMessage']
+>>> robot.motion(now=1)   # a fleet of one is its own majority
+(1, 2)
 """
 
 from __future__ import annotations
 
 from collections import Counter
-from dataclasses import dataclass
+from collections.abc import Sequence
+from dataclasses import dataclass, replace
 
 from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
 from mrmp.core.heading import Heading
 from mrmp.core.scenario import RobotSpec
 from mrmp.policies.base import Decision, Policy, Situation
+from mrmp.policies.priority import outranks
 from mrmp.protocol.codec import DecodeError, decode
-from mrmp.protocol.messages import Message, StateMessage
+from mrmp.protocol.messages import ClaimMessage, Message, ReplyMessage, StateMessage
+from mrmp.protocol.safety import SafetyLayer
 from mrmp.robot.belief import Belief
 
 
@@ -67,63 +79,142 @@ class Robot:
         The map, known to every robot beforehand.
     policy:
         Its decision rule (a fresh object per robot).
+    starts:
+        Every robot's start cell, by index (the safety layer's initial registry).
+    guarded:
+        Whether the safety layer guards every move (``False`` reproduces the thesis as written).
+    claim_timeout, retry_interval:
+        Safety-layer timers, in the driver's time units.
     """
 
-    def __init__(self, spec: RobotSpec, index: int, grid: Grid, policy: Policy) -> None:
+    def __init__(
+        self,
+        spec: RobotSpec,
+        index: int,
+        grid: Grid,
+        policy: Policy,
+        starts: Sequence[Cell],
+        guarded: bool = True,
+        claim_timeout: float = 4.0,
+        retry_interval: float = 1.0,
+    ) -> None:
         self.id = spec.id
         self.index = index
         self.goal = spec.goal
         self.grid = grid
         self.policy = policy
+        self.guarded = guarded
         self.present: Cell = spec.start
         self.heading: Heading = spec.heading
         self.intended: Cell = spec.start
+        self.wanted: Cell | None = None
+        self.moving = False
         self.belief = Belief()
+        self.safety = SafetyLayer(index, starts, claim_timeout=claim_timeout, retry_interval=retry_interval)
         self.seq = 0
         self.dropped: Counter[str] = Counter()
         self.last_decision: Decision | None = None
 
     @property
     def arrived(self) -> bool:
-        """Whether the robot stands on its goal."""
-        return self.present == self.goal
+        """Whether the robot stands on its goal (and is not leaving it)."""
+        return self.present == self.goal and not self.moving
 
     def situation(self) -> Situation:
         """The robot's state and beliefs, as its policy sees them."""
         return Situation(self.index, self.present, self.heading, self.goal, self.grid, self.belief.peers)
 
-    def intend(self, now: float) -> list[Outgoing]:
-        """Compute the intended Next and return the messages that announce it."""
-        self.intended = self.policy.intend(self.situation())
-        return [Outgoing(self._state_message())]
-
-    def _state_message(self) -> StateMessage:
+    def _stamp(self, message: Message) -> Message:
         self.seq += 1
-        return StateMessage(self.index, self.seq, self.present, self.intended, self.heading, self.arrived)
+        return replace(message, seq=self.seq)
 
-    def receive(self, message: Message, now: float) -> None:
-        """Take in a decoded message from a peer (own messages are ignored)."""
+    def state_message(self) -> StateMessage:
+        """A fresh state message: Present, Next, heading, arrival and safety state."""
+        self.seq += 1
+        return StateMessage(
+            self.index, self.seq, self.present, self.intended, self.heading, self.arrived, **self.safety.state_fields()
+        )  # type: ignore[arg-type]
+
+    # -- the step -------------------------------------------------------------------
+
+    def announce(self, now: float) -> list[Outgoing]:
+        """Compute the intended Next (unless moving) and return the state message announcing it."""
+        if not self.moving:
+            self.intended = self.policy.intend(self.situation())
+        return [Outgoing(self.state_message())]
+
+    def decide(self, now: float) -> list[Outgoing]:
+        """Apply the policy; when guarded, return the claim for the chosen cell."""
+        if self.moving or (self.guarded and self.safety.pending is not None):
+            return []
+        decision = self.policy.decide(self.situation(), self.intended)
+        self.last_decision = decision
+        self.wanted = decision.next if decision.next != self.present else None
+        if self.wanted is None or not self.guarded:
+            return []
+        claim = self.safety.start_claim(self.wanted, now)
+        if claim is None:
+            self.wanted = None  # a peer owns the cell in this robot's registry: stay this step
+            return []
+        return [Outgoing(self._stamp(claim))]
+
+    def motion(self, now: float) -> Cell | None:
+        """The cell the body may start entering now, if any; the robot then counts as moving."""
+        wanted = self.wanted
+        if self.moving or wanted is None:
+            return None
+        if self.guarded and not self.safety.may_enter(wanted):
+            return None
+        self.safety.begin_move(wanted)
+        self.moving = True
+        self.wanted = None
+        return wanted
+
+    def arrived_at(self, cell: Cell, heading: Heading) -> None:
+        """The body reports the cell it now stands on and its heading (from its own sensors)."""
+        self.present = cell
+        self.heading = heading
+        self.moving = False
+        self.safety.end_move(cell)
+
+    def expire(self, now: float) -> list[Outgoing]:
+        """Run the safety layer's timers: resend a claim still short of a majority, or abandon it."""
+        if not self.guarded:
+            return []
+        resend = self.safety.expire(now)
+        if self.safety.pending is None and not self.moving:
+            self.wanted = None
+        return [Outgoing(self._stamp(resend))] if resend is not None else []
+
+    # -- messages in ----------------------------------------------------------------------
+
+    def receive(self, message: Message, now: float) -> list[Outgoing]:
+        """Take in a decoded message from a peer; return the answer to a claim, if any."""
         if message.sender == self.index:
             self.dropped["own"] += 1
-            return
-        self.belief.update(message, now)
+            return []
+        if isinstance(message, StateMessage):
+            self.belief.update(message, now)
+            self.safety.handle_state(message)
+            return []
+        if isinstance(message, ClaimMessage):
+            peer = self.belief.peers.get(message.sender)
+            claimant_present = peer.present if peer is not None else message.cell
+            claimant_outranks = outranks(claimant_present, message.sender, self.present, self.index)
+            reply = self.safety.handle_claim(message, claimant_outranks)
+            if reply is None:
+                self.dropped["stale_claim"] += 1
+                return []
+            return [Outgoing(self._stamp(reply), (message.sender,))]
+        if isinstance(message, ReplyMessage):
+            self.safety.handle_reply(message, now)
+        return []
 
-    def receive_datagram(self, data: bytes, now: float) -> None:
+    def receive_datagram(self, data: bytes, now: float) -> list[Outgoing]:
         """Decode and take in a datagram; malformed data is dropped and counted by reason."""
         try:
             message = decode(data)
         except DecodeError as error:
             self.dropped[error.reason] += 1
-            return
-        self.receive(message, now)
-
-    def decide(self, now: float) -> Decision:
-        """Apply the policy to the intended Next and the peers' Present and Next."""
-        decision = self.policy.decide(self.situation(), self.intended)
-        self.last_decision = decision
-        return decision
-
-    def observe(self, present: Cell, heading: Heading) -> None:
-        """Update the robot's own cell and heading as its body's sensors report them."""
-        self.present = present
-        self.heading = heading
+            return []
+        return self.receive(message, now)

@@ -1,20 +1,22 @@
 """The lockstep simulator: every robot's brain, a simulated network, ideal bodies and the referee.
 
-Per tick, as in the thesis (section 3.5-3.6):
+Per tick, as in the thesis (sections 3.5-3.6), with the safety layer:
 
 1. every robot computes its intended Next and sends Present and Next to its peers;
 2. the network delivers what is due (at once with zero delay; later with delay,
-   so decisions rest on stale knowledge);
-3. every robot checks for obstacles and decides;
-4. the bodies carry out the moves (turning right first when the heading
-   changes) and each robot observes its new cell;
-5. the referee checks the new configuration.
+   so decisions rest on stale knowledge), and robots answer claims;
+3. every robot checks for obstacles and decides; a guarded robot claims the
+   cell it chose, and the claims and their answers are delivered;
+4. every robot whose move is allowed (guarded: a majority registered the cell
+   to it; unguarded: always) moves, turning right first when the heading
+   changes, and observes its new cell;
+5. the referee checks the new configuration, and the robots' timers run.
 
-The run ends when every robot stands on its goal, at the tick limit, or when
-the same configuration of every robot's cell and heading has recurred
-:data:`RECURRENCE_LIMIT` times ("deadlock" if nobody moved meanwhile, else
-"livelock"), or on Ctrl-C ("interrupted"), always returning what was computed.
-It is deterministic for a seed.
+Time for the safety layer's timers is counted in ticks. The run ends when every
+robot stands on its goal, at the tick limit, or when the same configuration of
+every robot's cell and heading has recurred too often ("deadlock" if nobody
+moved meanwhile, else "livelock"), or on Ctrl-C ("interrupted"), always
+returning what was computed. It is deterministic for a seed.
 
 Examples
 --------
@@ -38,13 +40,27 @@ from mrmp.policies.base import Decision
 from mrmp.policies.registry import make_policy
 from mrmp.protocol.codec import DecodeError, decode, encode
 from mrmp.protocol.messages import Message
-from mrmp.robot.robot import Robot
+from mrmp.robot.robot import Outgoing, Robot
 from mrmp.sim.metrics import default_max_ticks, shortest_steps
 from mrmp.sim.network import SimulatedNetwork
 from mrmp.sim.referee import Referee
 
 RECURRENCE_LIMIT = 10
-"""How often one configuration may recur before the run is declared stuck."""
+"""How often one configuration may recur before the run is declared stuck (plus
+twice the claim timeout, so that robots waiting for late answers are not)."""
+
+
+def safety_timers(delay_max: int) -> tuple[int, int]:
+    """Retry interval and claim timeout, in ticks, for a network delaying up to ``delay_max`` ticks.
+
+    A claim and its answer take up to ``2 * delay_max`` ticks; a claim is sent
+    again after one such round trip and abandoned after three.
+
+    >>> safety_timers(0), safety_timers(3)
+    ((1, 4), (7, 22))
+    """
+    retry = 2 * delay_max + 1
+    return retry, 3 * retry + 1
 
 
 class LockstepSimulator:
@@ -62,10 +78,23 @@ class LockstepSimulator:
     def __init__(self, scenario: Scenario, record_decisions: bool = False) -> None:
         self.scenario = scenario
         grid = scenario.grid
+        starts = [spec.start for spec in scenario.robots]
+        delay_max = max([scenario.network.delay_max, *(link.faults.delay_max for link in scenario.links)])
+        retry, timeout = safety_timers(delay_max)
         self.robots = [
-            Robot(spec, index, grid, make_policy(scenario.policy, scenario.timing))
+            Robot(
+                spec,
+                index,
+                grid,
+                make_policy(scenario.policy, scenario.timing),
+                starts,
+                guarded=scenario.safety,
+                claim_timeout=timeout,
+                retry_interval=retry,
+            )
             for index, spec in enumerate(scenario.robots)
         ]
+        self.recurrence_limit = RECURRENCE_LIMIT + 2 * timeout
         index_of = {spec.id: index for index, spec in enumerate(scenario.robots)}
         links = {(index_of[link.sender], index_of[link.recipient]): link.faults for link in scenario.links}
         self.network = SimulatedNetwork(scenario.network, seed=scenario.seed, links=links)
@@ -82,6 +111,7 @@ class LockstepSimulator:
         self._durations: list[list[float]] = [[] for _ in scenario.robots]
         self._recurrences: Counter[tuple[tuple[Cell, ...], tuple[Heading, ...]]] = Counter()
         self._still_since = 0
+        self._everyone = range(len(self.robots))
 
     def run(self) -> RunResult:
         """Run to the end and return the result (partial on Ctrl-C)."""
@@ -110,45 +140,24 @@ class LockstepSimulator:
         self.tick += 1
         tick = self.tick
         robots = self.robots
-        network = self.network
-        everyone = range(len(robots))
         for robot in robots:
-            outgoing = robot.intend(tick)
-            result = self._results[robot.index]
-            for item in outgoing:
-                payload = encode(item.message)
-                recipients = item.recipients if item.recipients is not None else everyone
-                for recipient in recipients:
-                    if recipient != robot.index:
-                        network.send(robot.index, recipient, payload, tick)
-                        result.messages_sent += 1
-                        result.bytes_sent += len(payload)
-        decoded: dict[bytes, Message | None] = {}
-        for _, recipient, payload in network.deliver(tick):
-            message = decoded.get(payload, False)
-            if message is False:
-                try:
-                    message = decode(payload)
-                except DecodeError:
-                    message = None
-                decoded[payload] = message
-            if message is None:
-                robots[recipient].receive_datagram(payload, tick)
-            else:
-                robots[recipient].receive(message, tick)
-        decisions = [robot.decide(tick) for robot in robots]
+            self._send(robot, robot.announce(tick))
+        self._drain()
+        for robot in robots:
+            self._send(robot, robot.decide(tick))
+        self._drain()
         if self.record_decisions:
-            self.decisions.append(decisions)
+            self.decisions.append([robot.last_decision for robot in robots])  # type: ignore[misc]
         before = [robot.present for robot in robots]
+        targets = [robot.motion(tick) for robot in robots]
         timing = self.scenario.timing
         grid = self.scenario.grid
         moved = False
-        for robot, decision in zip(robots, decisions):
+        for robot, target in zip(robots, targets):
             result = self._results[robot.index]
-            target = decision.next
             heading = robot.heading
             duration = timing.cell_time
-            if target != robot.present:
+            if target is not None and target != robot.present:
                 moved = True
                 try:
                     new_heading = Heading.between(robot.present, target)
@@ -156,21 +165,58 @@ class LockstepSimulator:
                     new_heading = heading
                 turns = right_turns(heading, new_heading)
                 result.turns += turns
-                duration = turns * timing.turn_time + timing.cell_time * (grid.cost(target) if grid.in_bounds(target) else 1.0)
+                cost = grid.cost(target) if grid.in_bounds(target) else 1.0
+                duration = turns * timing.turn_time + timing.cell_time * cost
                 heading = new_heading
-            robot.observe(target, heading)
-            result.path.append(target)
-            result.headings.append(heading)
+            if target is not None:
+                robot.arrived_at(target, heading)
+            result.path.append(robot.present)
+            result.headings.append(robot.heading)
             self._durations[robot.index].append(duration)
         self.referee.check_tick(tick, before, [robot.present for robot in robots])
         self._still_since = self._still_since + 1 if not moved else 0
+        for robot in robots:
+            self._send(robot, robot.expire(tick))
+
+    def _send(self, robot: Robot, outgoing: list[Outgoing]) -> None:
+        result = self._results[robot.index]
+        for item in outgoing:
+            payload = encode(item.message)
+            recipients = item.recipients if item.recipients is not None else self._everyone
+            for recipient in recipients:
+                if recipient != robot.index:
+                    self.network.send(robot.index, recipient, payload, self.tick)
+                    result.messages_sent += 1
+                    result.bytes_sent += len(payload)
+
+    def _drain(self) -> None:
+        """Deliver everything due by this tick, including answers sent meanwhile."""
+        robots = self.robots
+        tick = self.tick
+        decoded: dict[bytes, Message | None] = {}
+        while True:
+            batch = self.network.deliver(tick)
+            if not batch:
+                return
+            for _, recipient, payload in batch:
+                message = decoded.get(payload, False)
+                if message is False:
+                    try:
+                        message = decode(payload)
+                    except DecodeError:
+                        message = None
+                    decoded[payload] = message
+                robot = robots[recipient]
+                replies = robot.receive_datagram(payload, tick) if message is None else robot.receive(message, tick)
+                if replies:
+                    self._send(robot, replies)
 
     def _stuck(self) -> str | None:
         configuration = (tuple(robot.present for robot in self.robots), tuple(robot.heading for robot in self.robots))
         self._recurrences[configuration] += 1
-        if self._recurrences[configuration] < RECURRENCE_LIMIT or all(robot.arrived for robot in self.robots):
+        if self._recurrences[configuration] < self.recurrence_limit or all(robot.arrived for robot in self.robots):
             return None
-        return "deadlock" if self._still_since >= RECURRENCE_LIMIT - 1 else "livelock"
+        return "deadlock" if self._still_since >= self.recurrence_limit - 1 else "livelock"
 
     def _result(self, stop_reason: str, wall_time: float) -> RunResult:
         for index, result in enumerate(self._results):
@@ -178,6 +224,10 @@ class LockstepSimulator:
         network = self.network.stats.as_dict()
         network["dropped_by_robots"] = sum(sum(robot.dropped.values()) for robot in self.robots)
         network["stale"] = sum(robot.belief.stale_messages for robot in self.robots)
+        for name in ("claims", "granted", "refused", "timed_out"):
+            network[f"claims_{name}" if name != "claims" else "claims"] = sum(
+                getattr(robot.safety.stats, name) for robot in self.robots
+            )
         return RunResult(
             scenario=self.scenario.name,
             policy=self.scenario.policy.name,

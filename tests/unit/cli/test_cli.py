@@ -64,9 +64,11 @@ def test_failed_run_exits_1_and_still_writes_the_result(tmp_path):
 
 
 def test_collision_exits_1_and_is_printed():
-    result = invoke("run", EXAMPLES / "thesis-swap.yaml", "--delay", "1")
+    result = invoke("run", EXAMPLES / "thesis-swap.yaml", "--delay", "1", "--unsafe")
     assert result.exit_code == 1
     assert "collision of A, B" in result.output
+    guarded = invoke("run", EXAMPLES / "thesis-swap.yaml", "--delay", "1")
+    assert guarded.exit_code == 0 and "collisions: 0" in guarded.output
 
 
 def test_movingai_run():

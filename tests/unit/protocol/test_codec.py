@@ -8,23 +8,40 @@ from hypothesis import strategies as st
 
 from mrmp.core.heading import Heading
 from mrmp.protocol.codec import MAX_MESSAGE_BYTES, PROTOCOL_VERSION, DecodeError, decode, encode
-from mrmp.protocol.messages import StateMessage
+from mrmp.protocol.messages import ClaimMessage, ReplyMessage, StateMessage
 
 coordinates = st.integers(min_value=-(2**31), max_value=2**31 - 1)
 cells = st.tuples(coordinates, coordinates)
-states = st.builds(
-    StateMessage,
-    sender=st.integers(0, 2**32 - 1),
-    seq=st.integers(0, 2**32 - 1),
-    present=cells,
-    next=cells,
-    heading=st.sampled_from(list(Heading)),
-    arrived=st.booleans(),
+wire_cells = cells.filter(lambda cell: cell != (-(2**31), -(2**31)))
+u32 = st.integers(0, 2**32 - 1)
+claims = st.integers(1, 2**32 - 1)
+
+
+@st.composite
+def states(draw):
+    claim = draw(st.sampled_from([0, 1, 2**32 - 1]) | claims)
+    return StateMessage(
+        sender=draw(u32),
+        seq=draw(u32),
+        present=draw(cells),
+        next=draw(cells),
+        heading=draw(st.sampled_from(list(Heading))),
+        arrived=draw(st.booleans()),
+        target=draw(st.none() | wire_cells),
+        claim=claim,
+        claim_cell=draw(wire_cells) if claim else None,
+    )
+
+
+messages = (
+    states()
+    | st.builds(ClaimMessage, sender=u32, seq=u32, claim=claims, cell=cells)
+    | st.builds(ReplyMessage, sender=u32, seq=u32, claimant=u32, claim=claims, cell=cells, granted=st.booleans())
 )
 
 
-@settings(max_examples=300, derandomize=True)
-@given(states)
+@settings(max_examples=500, derandomize=True)
+@given(messages)
 def test_round_trip(message):
     data = encode(message)
     assert data[0] == PROTOCOL_VERSION
@@ -47,6 +64,9 @@ def _valid():
     return encode(StateMessage(3, 9, (1, 2), (2, 2), Heading.EAST, True))
 
 
+HEADING_AT, FLAGS_AT = 10 + 32, 10 + 33
+
+
 @pytest.mark.parametrize(
     ("data", "reason"),
     [
@@ -55,8 +75,11 @@ def _valid():
         (_valid() + b"\x00", "malformed"),
         (bytes([PROTOCOL_VERSION + 1]) + _valid()[1:], "version"),
         (_valid()[:1] + b"\x63" + _valid()[2:], "type"),
-        (_valid()[:-2] + b"\x07\x00", "malformed"),  # heading 7
-        (_valid()[:-1] + b"\x80", "malformed"),  # unknown flag
+        (_valid()[:HEADING_AT] + b"\x07" + _valid()[HEADING_AT + 1 :], "malformed"),  # heading 7
+        (_valid()[:FLAGS_AT] + b"\x81" + _valid()[FLAGS_AT + 1 :], "malformed"),  # unknown flag
+        (_valid()[:FLAGS_AT] + b"\x03" + _valid()[FLAGS_AT + 1 :], "malformed"),  # moving without a target
+        (encode(ClaimMessage(1, 2, 3, (0, 0)))[:10] + bytes(12), "malformed"),  # claim number 0
+        (encode(ReplyMessage(1, 2, 3, 4, (0, 0), True))[:-1] + b"\x02", "malformed"),  # granted = 2
         (b"\x01" * (MAX_MESSAGE_BYTES + 1), "oversized"),
     ],
 )
@@ -64,6 +87,12 @@ def test_each_rejection_reason(data, reason):
     with pytest.raises(DecodeError) as caught:
         decode(data)
     assert caught.value.reason == reason
+
+
+def test_sizes_stay_small():
+    assert len(_valid()) == 48
+    assert len(encode(ClaimMessage(1, 2, 3, (4, 5)))) == 22
+    assert len(encode(ReplyMessage(1, 2, 3, 4, (5, 6), False))) == 27
 
 
 def test_fields_that_do_not_fit_are_refused_at_encoding():

@@ -19,18 +19,25 @@ def test_same_seed_same_run_under_faults():
     assert first.network == second.network
 
 
-def test_delayed_messages_leave_robots_with_stale_knowledge_and_they_collide():
-    """With a one-tick delay the robots decide on last tick's Next: the thesis's rule misses the conflict."""
+def test_stale_knowledge_race_collides_as_written_and_not_when_guarded():
+    """The thesis's race: with a one-tick delay both robots decide on last tick's Next and walk into each other.
+
+    Under the same schedule (same seed, same delays) the safety layer lets no two robots into one cell.
+    """
     delayed = SWAP.with_changes(network=NetworkFaults(delay_min=1, delay_max=1))
-    result = simulate(delayed)
-    assert not result.success
-    assert result.collisions, "the referee must report what stale knowledge caused"
+    as_written = simulate(delayed.with_changes(safety=False))
+    assert {c.kind for c in as_written.collisions} & {"vertex", "swap"}
+    guarded = simulate(delayed)
+    assert guarded.collisions == [] and guarded.success
 
 
-def test_total_loss_hides_each_robot_from_the_other():
-    result = simulate(SWAP.with_changes(network=NetworkFaults(loss=1.0)))
-    assert result.network["lost"] == result.network["sent"] > 0
-    assert {c.kind for c in result.collisions} & {"vertex", "swap"}
+def test_total_loss_as_written_collides_guarded_stands_still():
+    as_written = simulate(SWAP.with_changes(network=NetworkFaults(loss=1.0), safety=False))
+    assert as_written.network["lost"] == as_written.network["sent"] > 0
+    assert {c.kind for c in as_written.collisions} & {"vertex", "swap"}
+    guarded = simulate(SWAP.with_changes(network=NetworkFaults(loss=1.0)))
+    assert guarded.collisions == [] and guarded.stop_reason == "deadlock"
+    assert [robot.path[-1] for robot in guarded.robots] == [(0, 2), (4, 2)]  # nobody hears a majority: nobody moves
 
 
 def test_deadlock_is_detected_and_named():
@@ -44,7 +51,8 @@ def test_deadlock_is_detected_and_named():
     result = simulator.run()
     assert result.stop_reason == "deadlock" and not result.collisions
     assert result.robots[0].path[-1] == (0, 1) and result.not_arrived == ["A"]
-    assert result.ticks == 1 + RECURRENCE_LIMIT - 1  # one move, then the same configuration recurs
+    assert result.ticks == 1 + simulator.recurrence_limit - 1  # one move, then the same configuration recurs
+    assert simulator.recurrence_limit == RECURRENCE_LIMIT + 2 * 4  # zero delay: claims time out after 4 ticks
     assert simulator.decisions[-1][0].reason == "blocked"
 
 
@@ -72,10 +80,14 @@ def test_interrupt_returns_what_was_computed(monkeypatch):
 
 
 def test_messages_are_counted_per_datagram():
-    result = simulate(SWAP)
+    result = simulate(SWAP.with_changes(safety=False))
     assert result.messages == 2 * result.ticks  # each robot, each tick, one datagram to its one peer
     assert result.network["sent"] == result.messages
-    assert all(robot.bytes_sent == 28 * robot.messages_sent for robot in result.robots)
+    assert all(robot.bytes_sent == 48 * robot.messages_sent for robot in result.robots)
+    guarded = simulate(SWAP)  # each move adds a claim and its answer
+    moves = sum(robot.steps for robot in guarded.robots)
+    assert guarded.messages == result.messages + 2 * moves
+    assert guarded.network["claims"] == guarded.network["claims_granted"] == moves
 
 
 @pytest.mark.parametrize("policy", ["thesis", "astar"])
