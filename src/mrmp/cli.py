@@ -17,7 +17,7 @@ from rich.table import Table
 
 from mrmp.core.errors import InputError, MrmpError, Problem
 from mrmp.core.result import RunResult
-from mrmp.core.scenario import NetworkFaults, PolicyOptions, RESOLUTIONS, Scenario, scenario_problems
+from mrmp.core.scenario import RESOLUTIONS, NetworkFaults, PolicyOptions, Scenario, scenario_problems
 from mrmp.io import load_movingai_scenario, load_scenario, validate_file, write_result_json
 from mrmp.policies.registry import POLICY_NAMES
 from mrmp.sim.simulator import simulate
@@ -93,6 +93,68 @@ def _apply_options(scenario: Scenario, **options: object) -> Scenario:
     return updated
 
 
+def _positive(value: float, option: str) -> float:
+    if not value > 0:
+        raise InputError(Problem(option, f"must be positive, got {value}"))
+    return value
+
+
+def _fraction(value: float, option: str) -> float:
+    if not 0.0 <= value <= 1.0:
+        raise InputError(Problem(option, f"must be in [0, 1], got {value}"))
+    return value
+
+
+def parse_range_ms(text: str, option: str) -> tuple[float, float]:
+    """Read ``N`` or ``A..B`` milliseconds as seconds.
+
+    >>> parse_range_ms("20..80", "--delay-ms")
+    (0.02, 0.08)
+    """
+    low, separator, high = text.partition("..")
+    try:
+        bounds = (float(low), float(high)) if separator else (float(low), float(low))
+    except ValueError:
+        raise InputError(Problem(option, f"expected N or A..B milliseconds, got {text!r}")) from None
+    if not 0 <= bounds[0] <= bounds[1]:
+        raise InputError(Problem(option, f"expected 0 <= A <= B, got {text!r}"))
+    return bounds[0] / 1000.0, bounds[1] / 1000.0
+
+
+def parse_kills(items: list[str]) -> dict[str, float]:
+    """Read ``--kill ID@SECONDS`` options.
+
+    >>> parse_kills(["B@2.5"])
+    {'B': 2.5}
+    """
+    kills = {}
+    for item in items:
+        robot, separator, seconds = item.rpartition("@")
+        try:
+            kills[robot] = float(seconds)
+        except ValueError:
+            robot = ""
+        if not separator or not robot:
+            raise InputError(Problem("--kill", f"expected ROBOT@SECONDS, got {item!r}"))
+    return kills
+
+
+def live_faults(scenario: Scenario, time_scale: float, delay_ms: str | None) -> "LiveFaults":
+    """The scenario's network faults for a live run: probabilities as given, delays in seconds.
+
+    A delay of one tick in the simulator is one cell time at the run's speed;
+    ``--delay-ms`` overrides it.
+    """
+    from mrmp.live.transport import LiveFaults
+
+    network = scenario.network
+    tick = scenario.timing.cell_time / time_scale
+    low, high = network.delay_min * tick, network.delay_max * tick
+    if delay_ms is not None:
+        low, high = parse_range_ms(delay_ms, "--delay-ms")
+    return LiveFaults(network.loss, low, high, network.duplicate, network.reorder)
+
+
 def _cell(cell: tuple[int, int]) -> str:
     return f"({cell[0]},{cell[1]})"
 
@@ -102,8 +164,12 @@ def print_result(result: RunResult, console: Console) -> None:
     table = Table(title=f"{result.scenario or 'run'}: policy {result.policy}, seed {result.seed}")
     for column in ("robot", "start", "goal", "arrived", "steps", "turns", "waits", "messages"):
         table.add_column(column, justify="left" if column in ("robot", "start", "goal") else "right")
+    live = result.mode == "live"
     for robot in result.robots[:TABLE_ROWS]:
-        arrived = f"yes @{robot.arrival_tick}" if robot.arrived else "[red]no[/red]"
+        if not robot.arrived:
+            arrived = "[red]no[/red]"
+        else:
+            arrived = f"yes @{robot.time_s:.2f}s" if live else f"yes @{robot.arrival_tick}"
         table.add_row(
             robot.id,
             _cell(robot.start),
@@ -111,18 +177,32 @@ def print_result(result: RunResult, console: Console) -> None:
             arrived,
             str(robot.steps),
             str(robot.turns),
-            str(robot.waits),
+            "-" if live else str(robot.waits),
             str(robot.messages_sent),
         )
     if len(result.robots) > TABLE_ROWS:
         table.caption = f"{len(result.robots) - TABLE_ROWS} more robots in the --json result"
     console.print(table)
     verdict = "[green]success[/green]" if result.success else "[red]failure[/red]"
-    console.print(
-        f"{verdict} ({result.stop_reason} at tick {result.ticks}): makespan {result.makespan} ticks "
-        f"({result.time_makespan_s:.1f} s), sum of costs {result.sum_of_costs}, lower bound {result.lower_bound}, "
-        f"collisions: {len(result.collisions)}, messages {result.messages}, wall time {result.wall_time_s:.3f} s"
-    )
+    if result.mode == "live":
+        network = result.network
+        rejected = {key[9:]: value for key, value in network.items() if key.startswith("rejected_") and value}
+        injected = {key[9:]: value for key, value in network.items() if key.startswith("injected_") and value}
+        moves = sum(robot.steps for robot in result.robots)
+        arrivals = sum(robot.time_s for robot in result.robots if robot.arrived)
+        console.print(
+            f"{verdict} ({result.stop_reason}): wall-clock makespan {result.time_makespan_s:.2f} s "
+            f"(ideal {result.ideal_makespan_s or 0:.2f} s), sum of arrival times {arrivals:.2f} s, "
+            f"moves {moves} (lower bound {result.lower_bound}), collisions: {len(result.collisions)}, "
+            f"messages {result.messages}, wall time {result.wall_time_s:.1f} s"
+        )
+        console.print(f"  dropped by robots: {rejected or 'none'}; injected faults: {injected or 'none'}", markup=False)
+    else:
+        console.print(
+            f"{verdict} ({result.stop_reason} at tick {result.ticks}): makespan {result.makespan} ticks "
+            f"({result.time_makespan_s:.1f} s), sum of costs {result.sum_of_costs}, lower bound {result.lower_bound}, "
+            f"collisions: {len(result.collisions)}, messages {result.messages}, wall time {result.wall_time_s:.3f} s"
+        )
     for collision in result.collisions[:10]:
         console.print(f"  [red]{collision.describe()}[/red]")
     if len(result.collisions) > 10:
@@ -150,8 +230,16 @@ def run(
     reorder: Annotated[Optional[float], typer.Option(help="Probability that a message overtakes earlier ones.")] = None,
     json_path: Annotated[Optional[str], typer.Option("--json", help="Write the whole result as JSON (- for stdout).")] = None,
     animate: Annotated[Optional[Path], typer.Option(help="Write an animation: .gif or .svg.")] = None,
+    live: Annotated[bool, typer.Option("--live", help="One OS process per robot, in real time, over a loopback network.")] = False,
+    transport: Annotated[str, typer.Option(help="Live transport: udp, multicast or zenoh.")] = "udp",
+    time_scale: Annotated[float, typer.Option(help="Live: run this many times faster than the robots' real speed.")] = 1.0,
+    delay_ms: Annotated[Optional[str], typer.Option(help="Live: message delay in milliseconds, N or A..B.")] = None,
+    jitter: Annotated[float, typer.Option(help="Live: each move takes its time times 1 +- jitter.")] = 0.0,
+    miss_line: Annotated[float, typer.Option(help="Live: probability that a body misses a grid line.")] = 0.0,
+    results: Annotated[Optional[Path], typer.Option(help="Live: folder for traces and reports (default: a new temporary one).")] = None,
+    kill: Annotated[Optional[list[str]], typer.Option(help="Live: kill robot ID's process after S seconds: ID@S (repeatable).")] = None,
 ) -> None:
-    """Run a scenario in the lockstep simulator and report what happened."""
+    """Run a scenario (lockstep simulator, or --live processes) and report what happened."""
     console = Console(stderr=json_path == "-", highlight=False)
     try:
         scenario = _load(scenario_path, map_path, scen_path, agents)
@@ -170,9 +258,25 @@ def run(
         )
         if animate is not None and animate.suffix.lower() not in (".gif", ".svg"):
             raise InputError(Problem("--animate", f"unsupported suffix {animate.suffix!r}; use .gif or .svg"))
+        if live:
+            from mrmp.live.launcher import LiveOptions, run_live
+
+            options = LiveOptions(
+                transport=transport,
+                time_scale=_positive(time_scale, "--time-scale"),
+                faults=live_faults(scenario, time_scale, delay_ms),
+                jitter=_fraction(jitter, "--jitter"),
+                miss_line=_fraction(miss_line, "--miss-line"),
+                guarded=scenario.safety,
+                results=results,
+                kill=parse_kills(kill or []),
+                seed=scenario.seed,
+            )
+            result = run_live(scenario, options, say=lambda text: console.print(text, markup=False))
+        else:
+            result = simulate(scenario)
     except InputError as error:
         raise _fail(error.problems) from None
-    result = simulate(scenario)
     print_result(result, console)
     try:
         if json_path is not None:
@@ -203,6 +307,115 @@ def validate(
             console.print(f"{path}: ok", markup=False)
     if problems:
         raise _fail(problems)
+
+
+@app.command()
+def agent(
+    scenario_path: Annotated[Path, typer.Option("--scenario", help="The fleet's scenario (the same file on every robot).")],
+    robot: Annotated[str, typer.Option(help="Which robot of the scenario this process is (its id).")],
+    transport: Annotated[str, typer.Option(help="udp, multicast or zenoh.")] = "udp",
+    bind: Annotated[str, typer.Option(help="UDP: address to receive on, HOST:PORT.")] = "127.0.0.1:9001",
+    peer: Annotated[Optional[list[str]], typer.Option(help="UDP: a peer, ID=HOST:PORT (repeat for each).")] = None,
+    group: Annotated[str, typer.Option(help="Multicast: group HOST:PORT.")] = "239.255.77.1:47000",
+    interface: Annotated[str, typer.Option(help="Multicast: IPv4 address of the interface to use.")] = "127.0.0.1",
+    listen: Annotated[str, typer.Option(help="Zenoh: this robot's endpoint, e.g. tcp/127.0.0.1:7447.")] = "",
+    connect: Annotated[Optional[list[str]], typer.Option(help="Zenoh: a peer's endpoint (repeat for each).")] = None,
+    fleet: Annotated[str, typer.Option(help="Zenoh: key-expression prefix of the fleet.")] = "mrmp",
+    key_file: Annotated[Optional[Path], typer.Option(help="Fleet key file (or set MRMP_FLEET_KEY).")] = None,
+    session: Annotated[int, typer.Option(help="Run number shared by the fleet; other runs' messages are dropped.")] = 1,
+    results: Annotated[Path, typer.Option(help="Folder for this robot's report and trace.")] = Path("results"),
+    time_scale: Annotated[float, typer.Option(help="Run this many times faster than the robot's real speed.")] = 1.0,
+    jitter: Annotated[float, typer.Option(help="Each move takes its time times 1 +- jitter.")] = 0.0,
+    miss_line: Annotated[float, typer.Option(help="Probability that the body misses a grid line.")] = 0.0,
+    loss: Annotated[float, typer.Option(help="Inject: probability that a sent message is lost.")] = 0.0,
+    delay_ms: Annotated[str, typer.Option(help="Inject: delay of sent messages, N or A..B milliseconds.")] = "0",
+    duplicate: Annotated[float, typer.Option(help="Inject: probability that a sent message is duplicated.")] = 0.0,
+    reorder: Annotated[float, typer.Option(help="Inject: probability that a sent message is held back.")] = 0.0,
+    listen_time: Annotated[float, typer.Option(help="Seconds between announcing Next and deciding.")] = 0.05,
+    unsafe: Annotated[bool, typer.Option("--unsafe", help="No safety layer: the policy as written.")] = False,
+    seed: Annotated[int, typer.Option(help="Seed of the body's and the fault injector's randomness.")] = 0,
+    timeout: Annotated[float, typer.Option(help="Give up after this many seconds.")] = 600.0,
+) -> None:
+    """Run one robot of a fleet as this process (one command per robot, on its own computer)."""
+    import os
+
+    from mrmp.io.live_files import read_key_file
+    from mrmp.live.agent import AgentTiming
+    from mrmp.live.process import AgentOptions, TransportSpec, check_key_policy, die_with_parent, run_agent, warn
+    from mrmp.live.transport import LiveFaults, parse_address
+
+    die_with_parent()
+    try:
+        scenario = load_scenario(scenario_path, known_policies=POLICY_NAMES)
+        ids = [spec.id for spec in scenario.robots]
+        if robot not in ids:
+            raise InputError(Problem("--robot", f"no robot has the id {robot!r} in {scenario_path}"))
+        index = ids.index(robot)
+        peers = {}
+        for item in peer or []:
+            name, separator, address = item.partition("=")
+            if not separator or name not in ids:
+                raise InputError(Problem("--peer", f"expected ID=HOST:PORT with a robot id of the scenario, got {item!r}"))
+            try:
+                peers[ids.index(name)] = parse_address(address)
+            except ValueError as error:
+                raise InputError(Problem("--peer", str(error))) from None
+        try:
+            spec = TransportSpec(
+                transport,
+                bind=parse_address(bind),
+                peers=peers,
+                group=parse_address(group),
+                interface=interface,
+                listen=listen,
+                connect=tuple(connect or ()),
+                fleet=fleet,
+            )
+        except ValueError as error:
+            raise InputError(Problem("--bind/--group", str(error))) from None
+        if transport not in ("udp", "multicast", "zenoh"):
+            raise InputError(Problem("--transport", f"unknown transport {transport!r}; known: udp, multicast, zenoh"))
+        environment_key = os.environ.get("MRMP_FLEET_KEY", "").encode()
+        key = read_key_file(key_file) if key_file is not None else environment_key
+        key = check_key_policy(key, spec, warn)
+        low, high = parse_range_ms(delay_ms, "--delay-ms")
+        options = AgentOptions(
+            index=index,
+            transport=spec,
+            key=key,
+            session=session,
+            results=results,
+            time_scale=_positive(time_scale, "--time-scale"),
+            faults=LiveFaults(_fraction(loss, "--loss"), low, high, _fraction(duplicate, "--duplicate"), _fraction(reorder, "--reorder")),
+            jitter=_fraction(jitter, "--jitter"),
+            miss_line=_fraction(miss_line, "--miss-line"),
+            guarded=not unsafe and scenario.safety,
+            seed=seed,
+            timing=AgentTiming(listen_time=listen_time, timeout=timeout),
+        )
+    except InputError as error:
+        raise _fail(error.problems) from None
+    report = run_agent(scenario, options)
+    raise typer.Exit(0 if report.arrived else 1)
+
+
+@app.command()
+def referee(
+    scenario_path: Annotated[Path, typer.Option("--scenario", help="The fleet's scenario.")],
+    results: Annotated[Path, typer.Option(help="The folder the robots write their traces to.")],
+    start_time: Annotated[float, typer.Option(help="The run's start on this machine's monotonic clock.")],
+    done_file: Annotated[Path, typer.Option(help="Stop when this file appears.")],
+) -> None:
+    """Judge a live run from the robots' ground-truth traces, until told to stop."""
+    from mrmp.live.process import die_with_parent, run_referee, warn
+
+    die_with_parent()
+    try:
+        scenario = load_scenario(scenario_path, known_policies=POLICY_NAMES)
+    except InputError as error:
+        raise _fail(error.problems) from None
+    collisions = run_referee(scenario, results, start_time, done_file, warn)
+    raise typer.Exit(1 if collisions else 0)
 
 
 def main() -> None:

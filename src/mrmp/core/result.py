@@ -98,7 +98,14 @@ class RobotResult:
 
 @dataclass
 class RunResult:
-    """Everything a run produced. ``to_dict`` in :mod:`mrmp.io.results` gives its JSON form."""
+    """Everything a run produced. ``to_dict`` in :mod:`mrmp.io.results` gives its JSON form.
+
+    ``mode`` is ``"simulated"`` (lockstep ticks) or ``"live"``; a live run's
+    paths are its ground truth sampled every ``tick_seconds`` of wall-clock
+    time, its robots' ``time_s`` are wall-clock arrival times, and
+    ``ideal_makespan_s`` is the longest single-robot path time at the run's
+    speed.
+    """
 
     scenario: str
     policy: str
@@ -110,6 +117,9 @@ class RunResult:
     lower_bound: int
     wall_time_s: float
     network: dict[str, int] = field(default_factory=dict)
+    mode: str = "simulated"
+    tick_seconds: float | None = None
+    ideal_makespan_s: float | None = None
 
     @property
     def all_arrived(self) -> bool:

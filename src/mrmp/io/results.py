@@ -105,6 +105,9 @@ def result_to_dict(result: RunResult, grid: Grid | None = None) -> dict[str, Any
         "messages": result.messages,
         "network": dict(result.network),
         "wall_time_s": result.wall_time_s,
+        "mode": result.mode,
+        "tick_seconds": result.tick_seconds,
+        "ideal_makespan_s": result.ideal_makespan_s,
         "collisions": [_collision_to_dict(collision) for collision in result.collisions],
         "robots": [_robot_to_dict(robot) for robot in result.robots],
     }
@@ -278,7 +281,16 @@ def result_from_dict(data: Mapping[str, Any], source: str = "result") -> RunResu
         lower_bound=fields.get("lower_bound", int, "an integer", 0),
         wall_time_s=float(fields.get("wall_time_s", (int, float), "a number", 0.0)),
         network=dict(network),
+        mode=fields.get("mode", str, "a string", "simulated"),
+        tick_seconds=_optional_number(fields.get("tick_seconds", (int, float, type(None)), "a number or null", None)),
+        ideal_makespan_s=_optional_number(
+            fields.get("ideal_makespan_s", (int, float, type(None)), "a number or null", None)
+        ),
     )
+
+
+def _optional_number(value: Any) -> float | None:
+    return None if value is None else float(value)
 
 
 def grid_from_result_dict(data: Mapping[str, Any]) -> Grid | None:

@@ -10,8 +10,8 @@ higher-priority robots in its way, treating their Present and Next cells as
 blocked for this step (``resolve="divert"``). The new plan is kept.
 
 One departure from the thesis's rule, because A* plans around obstacles: a peer
-that has arrived and stays (its Present equals its Next) is a static obstacle
-for as long as it stays there. A conflict with it is resolved by replanning
+that has arrived and stays (its Present equals its Next), or that has fallen
+silent, is a static obstacle for as long as it stays there. A conflict with it is resolved by replanning
 around it whatever the priorities (the thesis's higher-priority robot would
 drive into it; waiting for it would never end).
 
@@ -78,8 +78,8 @@ class AstarPolicy:
             self._advance(intended)
             return Decision(intended, "clear")
         conflict_ids = tuple(peer.index for peer in conflicts)
-        parked = [peer for peer in situation.peers.values() if peer.arrived and peer.present == peer.next]
-        blocked_by_parked = any(peer.arrived and peer.present == peer.next for peer in conflicts)
+        parked = [peer for peer in situation.peers.values() if peer.parked]
+        blocked_by_parked = any(peer.parked for peer in conflicts)
         if not blocked_by_parked:
             if outranks_all(present, situation.index, conflicts):
                 self._advance(intended)

@@ -24,7 +24,11 @@ from mrmp.core.heading import Heading
 
 @dataclass(frozen=True, slots=True)
 class PeerState:
-    """What a robot last heard from one peer, and when (in the driver's time)."""
+    """What a robot last heard from one peer, and when (in the driver's time).
+
+    ``silent`` marks a peer not heard from for longer than the robot's silence
+    timeout: it is treated as standing still at its last known cells.
+    """
 
     index: int
     present: Cell
@@ -33,6 +37,12 @@ class PeerState:
     arrived: bool
     seq: int
     heard_at: float
+    silent: bool = False
+
+    @property
+    def parked(self) -> bool:
+        """Standing still for the foreseeable future: arrived, or silent (treated as standing at its last cells)."""
+        return (self.arrived or self.silent) and self.present == self.next
 
 
 @dataclass(frozen=True, slots=True)

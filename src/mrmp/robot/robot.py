@@ -85,6 +85,9 @@ class Robot:
         Whether the safety layer guards every move (``False`` reproduces the thesis as written).
     claim_timeout, retry_interval:
         Safety-layer timers, in the driver's time units.
+    silence_timeout:
+        A peer not heard from for this long is *silent*: its policy treats it as
+        standing still at its last known cells (None: never).
     """
 
     def __init__(
@@ -97,8 +100,11 @@ class Robot:
         guarded: bool = True,
         claim_timeout: float = 4.0,
         retry_interval: float = 1.0,
+        silence_timeout: float | None = None,
     ) -> None:
         self.id = spec.id
+        self.silence_timeout = silence_timeout
+        self.now = 0.0
         self.index = index
         self.goal = spec.goal
         self.grid = grid
@@ -121,8 +127,25 @@ class Robot:
         return self.present == self.goal and not self.moving
 
     def situation(self) -> Situation:
-        """The robot's state and beliefs, as its policy sees them."""
-        return Situation(self.index, self.present, self.heading, self.goal, self.grid, self.belief.peers)
+        """The robot's state and beliefs at the time of its last step, as its policy sees them."""
+        peers = self.belief.peers
+        if self.silence_timeout is not None:
+            horizon = self.now - self.silence_timeout
+            if any(peer.heard_at < horizon for peer in peers.values()):
+                peers = {
+                    index: replace(peer, silent=True, next=peer.present) if peer.heard_at < horizon else peer
+                    for index, peer in peers.items()
+                }
+        return Situation(self.index, self.present, self.heading, self.goal, self.grid, peers)
+
+    def silent_peers(self) -> list[int]:
+        """Indices of peers not heard from within the silence timeout (never heard counts as silent)."""
+        if self.silence_timeout is None:
+            return []
+        horizon = self.now - self.silence_timeout
+        known = self.belief.peers
+        return [index for index in range(self.safety.fleet_size) if index != self.index
+                and (index not in known or known[index].heard_at < horizon)]
 
     def _stamp(self, message: Message) -> Message:
         self.seq += 1
@@ -139,12 +162,14 @@ class Robot:
 
     def announce(self, now: float) -> list[Outgoing]:
         """Compute the intended Next (unless moving) and return the state message announcing it."""
+        self.now = now
         if not self.moving:
             self.intended = self.policy.intend(self.situation())
         return [Outgoing(self.state_message())]
 
     def decide(self, now: float) -> list[Outgoing]:
         """Apply the policy; when guarded, return the claim for the chosen cell."""
+        self.now = now
         if self.moving or (self.guarded and self.safety.pending is not None):
             return []
         decision = self.policy.decide(self.situation(), self.intended)

@@ -1,0 +1,295 @@
+"""Robot bodies: what carries out a move in real time, and what the robot's sensors tell it.
+
+A :class:`Body` moves its robot one cell at a time: it turns right as often as
+needed (thesis section 3.3: the robot only turns right), drives forward, and
+reports the cell it believes it stands on, as the Khepera III does by counting
+the black grid lines its infrared floor sensor crosses (section 2.3). Bodies
+are polled by the live driver with the current time; they never sleep.
+
+* :class:`SimulatedBody` takes ``cell_time`` per cell and ``turn_time`` per
+  right turn, divided by a time scale, with optional jitter (robots running at
+  different, varying speeds) and an optional probability of missing a grid
+  line, after which the body overshoots one cell and the robot's belief of its
+  position lags the truth: position errors to be studied.
+* :class:`LineCountingBody` is the body of a real robot: it drives a
+  :class:`KheperaDriver` (two motor speeds and a floor line sensor) and counts
+  line crossings. A real Khepera III driver implements :class:`KheperaDriver`.
+
+Both report ground truth, where they know it, to an :class:`OccupancyRecorder`
+(the referee's input): when the body starts to enter a cell and when it has
+left one.
+"""
+
+from __future__ import annotations
+
+import random
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Protocol
+
+from mrmp.core.cell import Cell
+from mrmp.core.grid import Grid
+from mrmp.core.heading import Heading, right_turns
+from mrmp.core.scenario import Timing
+
+
+class OccupancyRecorder:
+    """Collects a body's ground-truth occupancy events and passes each to an optional sink.
+
+    The sink (for example :class:`mrmp.io.live_files.TraceWriter`'s ``write``)
+    receives ``(event, cell, t)`` as each event happens, so nothing is lost if
+    the process dies.
+    """
+
+    def __init__(self, sink: Callable[[str, Cell, float], None] | None = None) -> None:
+        self.sink = sink
+        self.events: list[tuple[str, Cell, float]] = []
+
+    def record(self, event: str, cell: Cell, t: float) -> None:
+        """Record that the body started to enter (``"enter"``) or has left (``"leave"``) ``cell`` at ``t``."""
+        self.events.append((event, cell, t))
+        if self.sink is not None:
+            self.sink(event, cell, t)
+
+
+class Body(Protocol):
+    """What the live driver needs from a robot's body."""
+
+    cell: Cell
+    """The cell the robot believes it stands on (from its own sensors)."""
+    heading: Heading
+    moving: bool
+
+    def start_move(self, target: Cell, now: float) -> None:
+        """Turn toward the adjacent ``target`` and drive into it."""
+        ...
+
+    def poll(self, now: float) -> bool:
+        """Advance to ``now``; True exactly once, when the move in progress ends."""
+        ...
+
+
+@dataclass
+class _Segment:
+    """One cell of a move: from ``source`` into ``target`` over [start, end]."""
+
+    source: Cell
+    target: Cell
+    enter_at: float
+    end: float
+
+
+class SimulatedBody:
+    """A body moving in real time, with jitter and missed grid lines (see the module docstring).
+
+    Parameters
+    ----------
+    start, heading:
+        Where the body stands and faces.
+    grid:
+        The map (entering a cell of cost c takes ``c * cell_time``).
+    timing:
+        Seconds per cell and per right turn, at the robot's real speed.
+    time_scale:
+        Run this many times faster than the real robot.
+    jitter:
+        Each move's duration is multiplied by a factor drawn from ``1 ± jitter``.
+    miss_line:
+        Probability that the line sensor misses the grid line ending a move: the
+        body then drives one more cell (if the grid allows) and believes it
+        moved one.
+    rng:
+        Random generator of this body.
+    recorder:
+        Where ground truth goes.
+    """
+
+    def __init__(
+        self,
+        start: Cell,
+        heading: Heading,
+        grid: Grid,
+        timing: Timing,
+        time_scale: float = 1.0,
+        jitter: float = 0.0,
+        miss_line: float = 0.0,
+        rng: random.Random | None = None,
+        recorder: OccupancyRecorder | None = None,
+    ) -> None:
+        self.cell = start
+        self.true_cell = start
+        self.heading = heading
+        self.grid = grid
+        self.timing = timing
+        self.time_scale = time_scale
+        self.jitter = jitter
+        self.miss_line = miss_line
+        self.random = rng or random.Random(0)
+        self.recorder = recorder or OccupancyRecorder()
+        self.moving = False
+        self.turns = 0
+        self.missed_lines = 0
+        self._segments: list[_Segment] = []
+        self._target: Cell = start
+
+    def start_move(self, target: Cell, now: float) -> None:
+        """Plan the turns and the drive into ``target``; record when each cell is entered."""
+        direction = Heading.between(self.cell, target)
+        turns = right_turns(self.heading, direction)
+        self.turns += turns
+        factor = 1.0 + (self.random.uniform(-self.jitter, self.jitter) if self.jitter else 0.0)
+        scale = factor / self.time_scale
+        t = now + turns * self.timing.turn_time * scale
+        source = self.true_cell
+        first = direction.ahead(source)
+        t_end = t + self.timing.cell_time * self.grid.cost(first) * scale if self.grid.in_bounds(first) else t
+        self._segments = [_Segment(source, first, t, t_end)]
+        if self.miss_line and self.random.random() < self.miss_line:
+            beyond = direction.ahead(first)
+            if self.grid.is_free(beyond):
+                self.missed_lines += 1
+                self._segments.append(
+                    _Segment(first, beyond, t_end, t_end + self.timing.cell_time * self.grid.cost(beyond) * scale)
+                )
+        self.heading = direction
+        self._target = target
+        self.moving = True
+        self._entered = 0
+
+    def poll(self, now: float) -> bool:
+        """Record entries and exits due by ``now``; True when the whole move is over."""
+        if not self.moving:
+            return False
+        while self._entered < len(self._segments) and self._segments[self._entered].enter_at <= now:
+            segment = self._segments[self._entered]
+            self.recorder.record("enter", segment.target, segment.enter_at)
+            self._entered += 1
+        last = self._segments[-1]
+        if now < last.end:
+            return False
+        for segment in self._segments:
+            self.recorder.record("leave", segment.source, segment.end)
+        self.true_cell = last.target
+        self.cell = self._target  # what the line count says
+        self.moving = False
+        self._segments = []
+        return True
+
+
+class KheperaDriver(Protocol):
+    """The hardware a real Khepera III exposes to mrmp (thesis section 2.3).
+
+    Two wheel motors and an infrared floor sensor that sees the black lines
+    separating grid cells. A driver for the robot's KoreBot board implements
+    these three methods.
+    """
+
+    def set_speeds(self, left: float, right: float) -> None:
+        """Set the left and right wheel speeds (same units as :class:`LineCountingBody`'s speeds)."""
+        ...
+
+    def line_detected(self) -> bool:
+        """Whether the floor sensor currently sees a black grid line."""
+        ...
+
+    def stop(self) -> None:
+        """Stop both motors."""
+        ...
+
+
+class LineCountingBody:
+    """A real robot's body: timed right turns, then forward until a grid line is crossed.
+
+    The robot knows its cell only by counting line crossings (thesis sections
+    2.3 and 3.6: "as these black lines are passed by the robots, the position
+    coordinate values are updated"). A move is: turn right in place for
+    ``turn_seconds`` per quarter turn; drive forward until the floor sensor sees
+    a line and then loses it (one crossing: the robot is in the next cell);
+    drive on for ``settle_seconds`` to reach the cell's middle; stop.
+
+    Parameters
+    ----------
+    driver:
+        The robot's motors and line sensor.
+    start, heading:
+        Where the robot stands and faces.
+    speed:
+        Forward wheel speed; a right turn spins the wheels at ``speed`` and ``-speed``.
+    turn_seconds:
+        Calibrated time of one right quarter turn at ``speed``.
+    settle_seconds:
+        Time to drive on after a crossing to reach the middle of the cell.
+    recorder:
+        Where the body's own account of entries and exits goes (a real robot's
+        ground truth must come from outside, e.g. an overhead tracker).
+    """
+
+    def __init__(
+        self,
+        driver: KheperaDriver,
+        start: Cell,
+        heading: Heading,
+        speed: float = 1.0,
+        turn_seconds: float = 1.0,
+        settle_seconds: float = 0.5,
+        recorder: OccupancyRecorder | None = None,
+    ) -> None:
+        self.driver = driver
+        self.cell = start
+        self.heading = heading
+        self.speed = speed
+        self.turn_seconds = turn_seconds
+        self.settle_seconds = settle_seconds
+        self.recorder = recorder or OccupancyRecorder()
+        self.moving = False
+        self.turns = 0
+        self._phase = "idle"
+        self._until = 0.0
+        self._turns_left = 0
+        self._on_line = False
+        self._direction = heading
+        self._target = start
+
+    def start_move(self, target: Cell, now: float) -> None:
+        """Begin the turns toward ``target``, then the drive."""
+        self._direction = Heading.between(self.cell, target)
+        self._turns_left = right_turns(self.heading, self._direction)
+        self.turns += self._turns_left
+        self._target = target
+        self.moving = True
+        self._begin_turn_or_drive(now)
+
+    def _begin_turn_or_drive(self, now: float) -> None:
+        if self._turns_left:
+            self._phase = "turning"
+            self._until = now + self.turn_seconds
+            self.driver.set_speeds(self.speed, -self.speed)
+        else:
+            self.heading = self._direction
+            self._phase = "driving"
+            self._on_line = self.driver.line_detected()
+            self.driver.set_speeds(self.speed, self.speed)
+
+    def poll(self, now: float) -> bool:
+        """Run the control loop one step; True when the robot has reached the next cell's middle."""
+        if self._phase == "turning" and now >= self._until:
+            self._turns_left -= 1
+            self.heading = Heading((self.heading % 4) + 1)
+            self._begin_turn_or_drive(now)
+        elif self._phase == "driving":
+            seen = self.driver.line_detected()
+            if seen and not self._on_line:
+                self.recorder.record("enter", self._target, now)
+            if self._on_line and not seen:  # the line is behind the sensor: one crossing counted
+                self._phase = "settling"
+                self._until = now + self.settle_seconds
+            self._on_line = seen
+        elif self._phase == "settling" and now >= self._until:
+            self.driver.stop()
+            self.recorder.record("leave", self.cell, now)
+            self.cell = self._target
+            self._phase = "idle"
+            self.moving = False
+            return True
+        return False
+

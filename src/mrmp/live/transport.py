@@ -1,0 +1,269 @@
+"""Transports: how a live robot's datagrams reach its peers.
+
+A transport moves opaque byte strings; sealing and opening them is the
+protocol layer's job (:mod:`mrmp.protocol.auth`). Three implementations:
+
+* :class:`UdpTransport`: UDP unicast to a list of peers (the thesis's design,
+  section 3.5: "Server and Client are implemented using the UDP Protocol");
+* :class:`UdpMulticastTransport`: one UDP multicast group for the fleet, with
+  the sending interface always set explicitly (``IP_MULTICAST_IF``);
+* ``ZenohTransport`` in :mod:`mrmp.live.zenoh_transport`.
+
+:class:`FaultyTransport` wraps any of them to inject loss, delay, duplication
+and reordering into a live run.
+"""
+
+from __future__ import annotations
+
+import heapq
+import random
+import socket
+import struct
+import threading
+import time
+from collections.abc import Mapping
+from dataclasses import dataclass
+from typing import Protocol
+
+from mrmp.protocol.auth import MAX_DATAGRAM_BYTES
+
+Address = tuple[str, int]
+
+
+class Transport(Protocol):
+    """Sends datagrams to peers by robot index and receives datagrams addressed to this robot."""
+
+    def send(self, data: bytes, recipient: int | None = None) -> None:
+        """Send ``data`` to one peer, or to every peer when ``recipient`` is None."""
+        ...
+
+    def receive(self, timeout: float) -> bytes | None:
+        """The next datagram, or None after ``timeout`` seconds (or once closed)."""
+        ...
+
+    def close(self) -> None:
+        """Release the transport's sockets; ``receive`` then returns None."""
+        ...
+
+
+def parse_address(text: str) -> Address:
+    """Read ``HOST:PORT``.
+
+    Raises
+    ------
+    ValueError
+        If the text is not ``HOST:PORT`` with a port in 0..65535.
+
+    >>> parse_address("127.0.0.1:9001")
+    ('127.0.0.1', 9001)
+    """
+    host, separator, port = text.rpartition(":")
+    if not separator or not host or not port.isdigit() or not 0 <= int(port) <= 65535:
+        raise ValueError(f"expected HOST:PORT, got {text!r}")
+    return host.strip("[]"), int(port)
+
+
+def is_loopback(host: str) -> bool:
+    """Whether ``host`` names a loopback address.
+
+    >>> is_loopback("127.0.0.1"), is_loopback("localhost"), is_loopback("10.0.0.1")
+    (True, True, False)
+    """
+    if host == "localhost":
+        return True
+    try:
+        return socket.inet_aton(host)[0] == 127
+    except OSError:
+        return host == "::1"
+
+
+class UdpTransport:
+    """UDP unicast: one socket bound to ``bind``, datagrams sent to each peer's address.
+
+    Parameters
+    ----------
+    bind:
+        Local address to receive on (port 0 picks a free port; see :attr:`address`).
+    peers:
+        Each peer's address, by robot index.
+    """
+
+    def __init__(self, bind: Address, peers: Mapping[int, Address]) -> None:
+        self.peers = dict(peers)
+        self._socket = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
+        self._socket.bind(bind)
+        self.address: Address = self._socket.getsockname()
+        self._closed = False
+
+    def send(self, data: bytes, recipient: int | None = None) -> None:
+        targets = self.peers.values() if recipient is None else [self.peers[recipient]]
+        for address in targets:
+            try:
+                self._socket.sendto(data, address)
+            except OSError:
+                pass  # an unreachable peer is a lost datagram, as on any network
+
+    def receive(self, timeout: float) -> bytes | None:
+        if self._closed:
+            return None
+        try:
+            self._socket.settimeout(timeout)
+            data, _ = self._socket.recvfrom(MAX_DATAGRAM_BYTES + 1)
+        except (TimeoutError, OSError):
+            return None
+        return data
+
+    def close(self) -> None:
+        self._closed = True
+        self._socket.close()
+
+
+class UdpMulticastTransport:
+    """UDP multicast: every robot joins one group; every datagram goes to all of them.
+
+    The sending and receiving interface is always set explicitly
+    (``IP_MULTICAST_IF`` and the membership's interface), never left to the
+    routing table. Datagrams addressed to one robot are sent to the group too;
+    receivers ignore what is not for them (a robot also hears its own datagrams
+    and drops them).
+
+    Parameters
+    ----------
+    group:
+        Multicast group and port, e.g. ``("239.255.77.1", 47000)``.
+    interface:
+        IPv4 address of the interface to use (``"127.0.0.1"`` on loopback).
+    """
+
+    def __init__(self, group: Address, interface: str) -> None:
+        self.group = group
+        self.interface = interface
+        sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
+        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+        if hasattr(socket, "SO_REUSEPORT"):
+            sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEPORT, 1)
+        sock.bind(("", group[1]))
+        interface_bytes = socket.inet_aton(interface)
+        sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_IF, interface_bytes)
+        sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, 1)
+        sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_LOOP, 1)
+        membership = struct.pack("4s4s", socket.inet_aton(group[0]), interface_bytes)
+        sock.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP, membership)
+        self._socket = sock
+        self._closed = False
+
+    def send(self, data: bytes, recipient: int | None = None) -> None:
+        try:
+            self._socket.sendto(data, self.group)
+        except OSError:
+            pass
+
+    def receive(self, timeout: float) -> bytes | None:
+        if self._closed:
+            return None
+        try:
+            self._socket.settimeout(timeout)
+            data, _ = self._socket.recvfrom(MAX_DATAGRAM_BYTES + 1)
+        except (TimeoutError, OSError):
+            return None
+        return data
+
+    def close(self) -> None:
+        self._closed = True
+        self._socket.close()
+
+
+@dataclass(frozen=True)
+class LiveFaults:
+    """Faults injected into a live transport: probabilities, and a delay range in seconds."""
+
+    loss: float = 0.0
+    delay_min: float = 0.0
+    delay_max: float = 0.0
+    duplicate: float = 0.0
+    reorder: float = 0.0
+
+    @property
+    def is_perfect(self) -> bool:
+        """Whether nothing is injected."""
+        return self == LiveFaults()
+
+
+@dataclass
+class FaultCounts:
+    """What a :class:`FaultyTransport` did to the datagrams it was given."""
+
+    sent: int = 0
+    lost: int = 0
+    duplicated: int = 0
+    delayed: int = 0
+    reordered: int = 0
+
+
+class FaultyTransport:
+    """Wraps a transport to lose, delay, duplicate and reorder outgoing datagrams (seeded).
+
+    Delayed datagrams are sent by a background thread at their due time; a
+    reordered datagram is held back an extra random time so that later ones
+    overtake it.
+    """
+
+    def __init__(self, inner: Transport, faults: LiveFaults, seed: int = 0) -> None:
+        self.inner = inner
+        self.faults = faults
+        self.counts = FaultCounts()
+        self._random = random.Random(seed)
+        self._queue: list[tuple[float, int, bytes, int | None]] = []
+        self._order = 0
+        self._wake = threading.Condition()
+        self._closed = False
+        self._thread = threading.Thread(target=self._deliver_late, name="faulty-transport", daemon=True)
+        self._thread.start()
+
+    def send(self, data: bytes, recipient: int | None = None) -> None:
+        faults = self.faults
+        rng = self._random
+        self.counts.sent += 1
+        copies = 1
+        if faults.duplicate and rng.random() < faults.duplicate:
+            copies = 2
+            self.counts.duplicated += 1
+        for _ in range(copies):
+            if faults.loss and rng.random() < faults.loss:
+                self.counts.lost += 1
+                continue
+            delay = rng.uniform(faults.delay_min, faults.delay_max) if faults.delay_max else 0.0
+            if faults.reorder and rng.random() < faults.reorder:
+                self.counts.reordered += 1
+                delay += rng.uniform(0.0, max(faults.delay_max, 0.02))
+            if delay <= 0:
+                self.inner.send(data, recipient)
+                continue
+            self.counts.delayed += 1
+            with self._wake:
+                self._order += 1
+                heapq.heappush(self._queue, (time.monotonic() + delay, self._order, data, recipient))
+                self._wake.notify()
+
+    def _deliver_late(self) -> None:
+        with self._wake:
+            while not self._closed:
+                if not self._queue:
+                    self._wake.wait()
+                    continue
+                due = self._queue[0][0] - time.monotonic()
+                if due > 0:
+                    self._wake.wait(due)
+                    continue
+                _, _, data, recipient = heapq.heappop(self._queue)
+                self.inner.send(data, recipient)
+
+    def receive(self, timeout: float) -> bytes | None:
+        return self.inner.receive(timeout)
+
+    def close(self) -> None:
+        with self._wake:
+            self._closed = True
+            self._wake.notify()
+        self._thread.join(timeout=1.0)
+        self.inner.close()
