@@ -1,0 +1,104 @@
+"""Bodies: real-time timing, jitter, missed grid lines, and the line-counting body of a real robot."""
+
+import random
+
+from mrmp.core import Grid, Heading, Timing
+from mrmp.live.body import LineCountingBody, OccupancyRecorder, SimulatedBody
+
+
+def drive(body, target, start=0.0, step=0.01, limit=100.0):
+    body.start_move(target, start)
+    t = start
+    while not body.poll(t):
+        t += step
+        assert t < limit, "the move never ended"
+    return t
+
+
+def test_simulated_body_takes_turns_and_cells_scaled():
+    recorder = OccupancyRecorder()
+    body = SimulatedBody((0, 0), Heading.NORTH, Grid(5, 5), Timing(2.0, 1.0), time_scale=10, recorder=recorder)
+    end = drive(body, (0, 1))  # one right turn (0.1 s) then one cell (0.2 s)
+    assert 0.3 <= end < 0.32
+    assert body.cell == body.true_cell == (0, 1) and body.heading is Heading.EAST and body.turns == 1
+    assert [(event, cell) for event, cell, _ in recorder.events] == [("enter", (0, 1)), ("leave", (0, 0))]
+    enter_time = recorder.events[0][2]
+    assert abs(enter_time - 0.1) < 1e-9  # it covers the new cell once it starts driving into it
+
+
+def test_jitter_varies_durations_within_bounds():
+    durations = []
+    for seed in range(20):
+        body = SimulatedBody((0, 0), Heading.NORTH, Grid(5, 5), Timing(1.0, 0.0), jitter=0.3, rng=random.Random(seed))
+        durations.append(drive(body, (1, 0), step=0.001))
+    assert min(durations) >= 0.7 - 0.002 and max(durations) <= 1.3 + 0.002
+    assert max(durations) - min(durations) > 0.2
+
+
+def test_missed_line_overshoots_and_the_belief_lags_the_truth():
+    recorder = OccupancyRecorder()
+    body = SimulatedBody((0, 0), Heading.NORTH, Grid(5, 5), Timing(1.0, 0.0), miss_line=1.0, recorder=recorder)
+    drive(body, (1, 0))
+    assert body.cell == (1, 0) and body.true_cell == (2, 0) and body.missed_lines == 1
+    entered = [cell for event, cell, _ in recorder.events if event == "enter"]
+    assert entered == [(1, 0), (2, 0)]
+
+
+def test_missed_line_at_a_wall_stops_at_the_wall():
+    body = SimulatedBody((3, 0), Heading.NORTH, Grid(5, 5), Timing(1.0, 0.0), miss_line=1.0)
+    drive(body, (4, 0))
+    assert body.true_cell == (4, 0) and body.missed_lines == 0
+
+
+class FakeKhepera:
+    """A Khepera on a straight track: position in cells, lines at every integer + 0.5, a narrow sensor."""
+
+    def __init__(self, speed_cells_per_second=1.0):
+        self.position = 0.0
+        self.left = self.right = 0.0
+        self.speed = speed_cells_per_second
+        self.t = 0.0
+
+    def set_speeds(self, left, right):
+        self.left, self.right = left, right
+
+    def stop(self):
+        self.left = self.right = 0.0
+
+    def advance(self, t):
+        if self.left == self.right:  # straight ahead; turning in place does not move it
+            self.position += self.left * self.speed * (t - self.t)
+        self.t = t
+
+    def line_detected(self):
+        distance = (self.position - 0.5) % 1.0
+        return distance < 0.05 or distance > 0.95
+
+
+def test_line_counting_body_counts_one_crossing_per_cell():
+    driver = FakeKhepera()
+    recorder = OccupancyRecorder()
+    body = LineCountingBody(driver, (0, 0), Heading.NORTH, speed=1.0, turn_seconds=0.5, settle_seconds=0.45, recorder=recorder)
+    t = 0.0
+    for target in [(1, 0), (2, 0)]:
+        body.start_move(target, t)
+        while True:
+            t += 0.001
+            driver.advance(t)
+            if body.poll(t):
+                break
+    assert body.cell == (2, 0) and not body.moving
+    assert 1.9 < driver.position < 2.1  # two lines crossed: the middle of the cell two ahead
+    assert [event for event, _, _ in recorder.events] == ["enter", "leave", "enter", "leave"]
+
+
+def test_line_counting_body_turns_right_before_driving():
+    driver = FakeKhepera()
+    body = LineCountingBody(driver, (0, 0), Heading.NORTH, turn_seconds=0.5, settle_seconds=0.45)
+    body.start_move((0, 1), 0.0)
+    assert (driver.left, driver.right) == (1.0, -1.0)  # spinning right in place
+    t = 0.0
+    while not body.poll(t):
+        t += 0.001
+        driver.advance(t)
+    assert body.heading is Heading.EAST and body.turns == 1 and t > 0.5
