@@ -15,6 +15,10 @@ clock:
   are repaired and silent robots are noticed;
 * run the safety layer's timers (resend or abandon a claim).
 
+Before its first step a robot waits (at most ``start_wait`` seconds) until it
+has heard from every peer, so that a fleet whose processes start one by one
+begins together; its clock starts then.
+
 The run ends when this robot and every peer have arrived (and a short linger
 has passed so that late claims are still answered), when every peer that has
 not arrived has been silent for ``give_up_after`` seconds, on timeout, or on a
@@ -56,6 +60,7 @@ class AgentTiming:
     linger: float = 0.6
     poll: float = 0.004
     timeout: float = 120.0
+    start_wait: float = 15.0
 
 
 @dataclass
@@ -198,6 +203,7 @@ class Agent:
         self._receiving.set()
         receiver = threading.Thread(target=self._receive_loop, name=f"robot-{self.index}-server", daemon=True)
         receiver.start()
+        self._wait_for_fleet()
         started = clock()
         report.started_at = started
         report.believed_path.append((started, robot.present))
@@ -272,6 +278,25 @@ class Agent:
             receiver.join(timeout=1.0)
             self._fill_report(clock())
         return report
+
+    def _wait_for_fleet(self) -> None:
+        """Announce every heartbeat, and answer, until every peer has been heard (or ``start_wait`` passes)."""
+        robot, clock = self.robot, self.clock
+        deadline = clock() + self.timing.start_wait
+        last_state = -float("inf")
+        while not self.stop_requested.is_set() and len(robot.belief.peers) < self._peers and clock() < deadline:
+            now = clock()
+            while True:
+                try:
+                    message = self._inbox.get_nowait()
+                except queue.Empty:
+                    break
+                self.report.messages_received += 1
+                self._send(robot.receive(message, now))
+            if now - last_state >= self.timing.heartbeat:
+                self._send([Outgoing(robot.state_message())])
+                last_state = now
+            time.sleep(self.timing.poll)
 
     def _everyone_done(self, now: float) -> bool:
         robot = self.robot

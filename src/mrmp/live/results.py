@@ -61,14 +61,15 @@ def live_result(
 ) -> RunResult:
     """Build the result of a live run from the agents' reports and the referee's verdict.
 
-    Arrival is judged on ground truth (where the body really ended), not on
+    Wall-clock arrival times count from the fleet's start (the first robot to
+    begin its first step). Arrival is judged on ground truth (where the body really ended), not on
     the robot's own belief, which a missed grid line can make wrong. A robot
     without a report (its process died before writing one) still has its path
     from the referee.
     """
     starts = [float(report["started_at"]) for report in reports if report]
-    t0 = float(referee["start_time"]) if referee else min(starts, default=0.0)
-    t0 = min([t0, *starts]) if starts else t0
+    fleet_start = min(starts, default=0.0)
+    t0 = min(float(referee["start_time"]), fleet_start) if referee else fleet_start
     end = max([float(report["ended_at"]) for report in reports if report] or [t0])
     ticks = max(1, int(math.ceil((end - t0) / tick_seconds)))
     times = [t0 + k * tick_seconds for k in range(ticks + 1)]
@@ -89,7 +90,7 @@ def live_result(
             result.bytes_sent = int(report.get("bytes_sent", 0))
             arrival = report.get("arrival_time")
             if arrival is not None:
-                result.time_s = float(report["started_at"]) + float(arrival) - t0
+                result.time_s = float(report["started_at"]) + float(arrival) - fleet_start
             network["messages_sent"] += int(report.get("messages_sent", 0))
             network["datagrams_sent"] += int(report.get("datagrams_sent", 0))
             network["messages_received"] += int(report.get("messages_received", 0))
