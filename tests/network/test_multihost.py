@@ -92,7 +92,7 @@ seed: 0
 def run_command(*command: str, namespace: str | None = None, timeout: float = 10.0) -> subprocess.CompletedProcess[str]:
     """Run ``command`` (inside ``namespace`` when given) and return it, without raising on failure."""
     prefix = ["ip", "netns", "exec", namespace] if namespace else []
-    return subprocess.run([*prefix, *command], capture_output=True, text=True, timeout=timeout, stdin=subprocess.DEVNULL)
+    return subprocess.run([*prefix, *command], check=False, capture_output=True, text=True, timeout=timeout, stdin=subprocess.DEVNULL)
 
 
 def must(*command: str, namespace: str | None = None) -> str:
@@ -226,7 +226,7 @@ def write_scenario(folder: Path) -> Path:
     """Write the three-robot scenario and check it with ``mrmp validate``."""
     path = folder / "multihost.yaml"
     path.write_text(SCENARIO_YAML, encoding="utf-8")
-    checked = subprocess.run([sys.executable, "-m", "mrmp", "validate", str(path)], capture_output=True, text=True, timeout=60)
+    checked = subprocess.run([sys.executable, "-m", "mrmp", "validate", str(path)], check=False, capture_output=True, text=True, timeout=60)
     assert checked.returncode == 0, f"mrmp validate rejected the test scenario: {checked.stdout}{checked.stderr}"
     return path
 
@@ -366,7 +366,7 @@ def test_agent_refuses_to_run_keyless_off_loopback(network: Network, tmp_path: P
     scenario_path = write_scenario(tmp_path)
     results = tmp_path / "results"
     command = agent_command(network, "A", scenario_path, results, ["--time-scale=10", "--timeout=5"])
-    done = subprocess.run(command, capture_output=True, text=True, timeout=60, env=without_fleet_key(), stdin=subprocess.DEVNULL)
+    done = subprocess.run(command, check=False, capture_output=True, text=True, timeout=60, env=without_fleet_key(), stdin=subprocess.DEVNULL)
     assert done.returncode == 2, f"exit code {done.returncode}\nstdout: {done.stdout}\nstderr: {done.stderr}"
     assert "no fleet key" in done.stderr and f"{SUBNET}." in done.stderr, done.stderr
     assert not (results / "agent-0.json").exists(), "the keyless agent ran anyway"
