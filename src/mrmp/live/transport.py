@@ -77,7 +77,30 @@ def is_loopback(host: str) -> bool:
         return host == "::1"
 
 
-class UdpTransport:
+class _UdpSocket:
+    """Receiving and closing, shared by the UDP transports."""
+
+    _socket: socket.socket
+    _closed: bool
+
+    def receive(self, timeout: float) -> bytes | None:
+        """The next datagram (read up to one byte past the bound, so oversized ones show), or None."""
+        if self._closed:
+            return None
+        try:
+            self._socket.settimeout(timeout)
+            data, _ = self._socket.recvfrom(MAX_DATAGRAM_BYTES + 1)
+        except (TimeoutError, OSError):
+            return None
+        return data
+
+    def close(self) -> None:
+        """Close the socket; ``receive`` returns None from now on."""
+        self._closed = True
+        self._socket.close()
+
+
+class UdpTransport(_UdpSocket):
     """UDP unicast: one socket bound to ``bind``, datagrams sent to each peer's address.
 
     Parameters
@@ -103,22 +126,9 @@ class UdpTransport:
             except OSError:
                 pass  # an unreachable peer is a lost datagram, as on any network
 
-    def receive(self, timeout: float) -> bytes | None:
-        if self._closed:
-            return None
-        try:
-            self._socket.settimeout(timeout)
-            data, _ = self._socket.recvfrom(MAX_DATAGRAM_BYTES + 1)
-        except (TimeoutError, OSError):
-            return None
-        return data
-
-    def close(self) -> None:
-        self._closed = True
-        self._socket.close()
 
 
-class UdpMulticastTransport:
+class UdpMulticastTransport(_UdpSocket):
     """UDP multicast: every robot joins one group; every datagram goes to all of them.
 
     The sending and receiving interface is always set explicitly
@@ -158,19 +168,6 @@ class UdpMulticastTransport:
         except OSError:
             pass
 
-    def receive(self, timeout: float) -> bytes | None:
-        if self._closed:
-            return None
-        try:
-            self._socket.settimeout(timeout)
-            data, _ = self._socket.recvfrom(MAX_DATAGRAM_BYTES + 1)
-        except (TimeoutError, OSError):
-            return None
-        return data
-
-    def close(self) -> None:
-        self._closed = True
-        self._socket.close()
 
 
 @dataclass(frozen=True)
