@@ -1,0 +1,261 @@
+"""The Zenoh transport: three robots in a full mesh of explicit loopback TCP endpoints."""
+
+import socket
+import threading
+import time
+import uuid
+
+import pytest
+
+zenoh = pytest.importorskip("zenoh")
+
+from mrmp.live.zenoh_transport import ZenohTransport, session_config  # noqa: E402
+from mrmp.protocol.auth import MAX_DATAGRAM_BYTES  # noqa: E402
+
+LOOPBACK = "127.0.0.1"
+
+
+def free_ports(count):
+    """``count`` distinct TCP ports free on loopback right now (bound together, then released)."""
+    sockets = []
+    try:
+        for _ in range(count):
+            sock = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+            sock.bind((LOOPBACK, 0))
+            sockets.append(sock)
+        return [sock.getsockname()[1] for sock in sockets]
+    finally:
+        for sock in sockets:
+            sock.close()
+
+
+def endpoint(port):
+    return f"tcp/{LOOPBACK}:{port}"
+
+
+class Fleet:
+    """Opens robots of one fleet (a fresh key prefix) on fresh ports; closes them all at the end."""
+
+    def __init__(self, size):
+        self.size = size
+        self.name = f"mrmp-test/{uuid.uuid4().hex}"
+        self.ports = free_ports(size)
+        self.robots = {}
+
+    def start(self, index, connect=None, **options):
+        if connect is None:
+            connect = [endpoint(port) for other, port in enumerate(self.ports) if other != index]
+        robot = ZenohTransport(index, self.name, endpoint(self.ports[index]), connect, self.size, **options)
+        self.robots[index] = robot
+        return robot
+
+    def close(self):
+        for robot in self.robots.values():
+            robot.close()
+
+
+@pytest.fixture
+def fleet():
+    fleets = []
+
+    def make(size=3):
+        fleets.append(Fleet(size))
+        return fleets[-1]
+
+    yield make
+    for made in fleets:
+        made.close()
+
+
+@pytest.fixture
+def mesh(fleet):
+    """Three connected robots."""
+    three = fleet(3)
+    robots = [three.start(index) for index in range(3)]
+    assert all(robot.wait_for_peers(2, timeout=5.0) for robot in robots)
+    return robots
+
+
+def receive_within(transport, timeout=2.0):
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline:
+        data = transport.receive(0.05)
+        if data is not None:
+            return data
+    return None
+
+
+def drain(transport, duration):
+    received = []
+    deadline = time.monotonic() + duration
+    while (remaining := deadline - time.monotonic()) > 0:
+        data = transport.receive(min(remaining, 0.05))
+        if data is not None:
+            received.append(data)
+    return received
+
+
+def test_configuration_is_peer_mode_with_explicit_endpoints_only():
+    config = session_config(endpoint(7447), [endpoint(7448), endpoint(7449)])
+    assert config["mode"] == "peer"
+    assert config["scouting/multicast/enabled"] is False and config["scouting/gossip/enabled"] is False
+    assert config["listen/endpoints"] == ["tcp/127.0.0.1:7447"]
+    assert config["connect/endpoints"] == ["tcp/127.0.0.1:7448", "tcp/127.0.0.1:7449"]
+    assert config["connect/exit_on_failure"] is False and config["connect/timeout_ms"] == -1
+
+
+def test_broadcast_reaches_the_two_others_not_the_sender(mesh):
+    a, b, c = mesh
+    a.send(b"from a to all")
+    assert receive_within(b) == b"from a to all"
+    assert receive_within(c) == b"from a to all"
+    assert drain(a, 0.2) == []
+    assert a.peers() == {1, 2} and b.peers() == {0, 2} and c.peers() == {0, 1}
+
+
+def test_everyone_broadcasting_at_once(mesh):
+    for robot in mesh:
+        robot.send(b"hello from %d" % robot.index)
+    for robot in mesh:
+        heard = sorted(drain(robot, 0.3))
+        assert heard == sorted(b"hello from %d" % other for other in range(3) if other != robot.index)
+
+
+def test_addressed_send_reaches_only_the_addressee(mesh):
+    a, b, c = mesh
+    a.send(b"a to c", recipient=2)
+    c.send(b"c to b", recipient=1)
+    assert receive_within(c) == b"a to c"
+    assert receive_within(b) == b"c to b"
+    assert drain(a, 0.2) == [] and drain(b, 0.05) == [] and drain(c, 0.05) == []
+
+
+def test_payloads_pass_through_unchanged_even_oversized(mesh):
+    a, b, _ = mesh
+    oversized = bytes(range(256)) * ((MAX_DATAGRAM_BYTES + 500) // 256)
+    assert len(oversized) > MAX_DATAGRAM_BYTES + 1
+    a.send(oversized, recipient=1)
+    a.send(b"")
+    assert receive_within(b) == oversized
+    assert receive_within(b) == b""
+
+
+def test_a_robot_started_before_its_peers_still_connects(fleet):
+    three = fleet(3)
+    first = three.start(0)
+    assert not first.wait_for_peers(1, timeout=0.5)  # nobody there yet
+    others = [three.start(1), three.start(2)]
+    started = time.monotonic()
+    assert all(robot.wait_for_peers(2, timeout=5.0) for robot in (first, *others))
+    assert time.monotonic() - started < 3.0
+    first.send(b"first to all")
+    others[1].send(b"third to first", recipient=0)
+    assert [receive_within(robot) for robot in others] == [b"first to all"] * 2
+    assert receive_within(first) == b"third to first"
+
+
+def test_a_peer_that_comes_up_later_is_dialled_again(fleet):
+    two = fleet(2)
+    dialler = two.start(0)  # dials robot 1, which is not up
+    time.sleep(0.5)
+    listener = two.start(1, connect=[])  # never dials: the link can only come from robot 0's retries
+    started = time.monotonic()
+    assert dialler.wait_for_peers(1, timeout=5.0) and listener.wait_for_peers(1, timeout=5.0)
+    assert time.monotonic() - started < 2.0  # the retry period is at most 0.5 s
+    listener.send(b"you found me")
+    assert receive_within(dialler) == b"you found me"
+
+
+def test_robots_find_each_other_only_through_explicit_endpoints(fleet):
+    two = fleet(2)
+    a = two.start(0, connect=[])
+    b = two.start(1, connect=[])
+    assert not a.wait_for_peers(1, timeout=1.0)  # no scouting: same fleet, same host, never connected
+    assert b.peers() == set()
+
+
+def test_fleets_do_not_hear_each_other(fleet):
+    ours, theirs = fleet(2), fleet(2)
+    a0, a1 = ours.start(0), ours.start(1)
+    stranger = theirs.start(0, connect=[endpoint(ours.ports[0])])  # same Zenoh network, other fleet prefix
+    assert a0.wait_for_peers(1, timeout=5.0) and a1.wait_for_peers(1, timeout=5.0)
+    stranger.send(b"wrong fleet")
+    stranger.send(b"wrong fleet to 1", recipient=1)
+    assert drain(a0, 0.3) == [] and drain(a1, 0.05) == []
+    assert stranger.peers() == set() and a0.peers() == {1}
+
+
+def test_close_is_prompt_and_peers_see_it(mesh):
+    a, b, c = mesh
+    for robot in (c, b):
+        started = time.monotonic()
+        robot.close()
+        assert time.monotonic() - started < 2.0
+        assert robot.closed and robot.receive(5.0) is None
+    deadline = time.monotonic() + 5.0
+    while a.peers() and time.monotonic() < deadline:
+        time.sleep(0.02)
+    assert a.peers() == set()
+    b.close()  # closing twice is harmless
+    b.send(b"after close")  # a lost datagram, not an error
+    started = time.monotonic()
+    a.close()
+    assert time.monotonic() - started < 2.0
+
+
+def test_close_wakes_a_blocked_receive(mesh):
+    a = mesh[0]
+    outcome = {}
+
+    def receive():
+        started = time.monotonic()
+        outcome["data"] = a.receive(5.0)
+        outcome["took"] = time.monotonic() - started
+
+    thread = threading.Thread(target=receive)
+    thread.start()
+    time.sleep(0.1)
+    a.close()
+    thread.join(timeout=2.0)
+    assert not thread.is_alive()
+    assert outcome["data"] is None and outcome["took"] < 1.0
+
+
+def test_the_queue_is_capped_dropping_the_oldest(fleet):
+    two = fleet(2)
+    sender = two.start(0)
+    receiver = two.start(1, queue_limit=5)
+    assert sender.wait_for_peers(1, timeout=5.0) and receiver.wait_for_peers(1, timeout=5.0)
+    for number in range(20):
+        sender.send(b"%d" % number)
+    deadline = time.monotonic() + 3.0
+    while receiver.received < 20 and time.monotonic() < deadline:
+        time.sleep(0.01)
+    assert receiver.received == 20 and receiver.dropped == 15
+    assert drain(receiver, 0.1) == [b"%d" % number for number in range(15, 20)]
+
+
+def test_receive_times_out_with_none(mesh):
+    started = time.monotonic()
+    assert mesh[0].receive(0.2) is None
+    assert 0.15 <= time.monotonic() - started < 1.0
+
+
+def test_bad_arguments_are_refused(mesh):
+    with pytest.raises(ValueError, match="no peer 3"):
+        mesh[0].send(b"x", recipient=3)
+    with pytest.raises(ValueError, match="no peer 0"):
+        mesh[0].send(b"x", recipient=0)
+    port = free_ports(1)[0]
+    with pytest.raises(ValueError, match="not in 0..2"):
+        ZenohTransport(3, "mrmp/x", endpoint(port), [], 3)
+    with pytest.raises(ValueError, match="Zenoh key"):
+        ZenohTransport(0, "mrmp/*", endpoint(port), [], 3)
+    with pytest.raises(ValueError, match="Zenoh key"):
+        ZenohTransport(0, "mrmp//x", endpoint(port), [], 3)
+
+
+def test_a_taken_listen_endpoint_fails_to_open(mesh):
+    taken = mesh[0].listen
+    with pytest.raises(zenoh.ZError):
+        ZenohTransport(0, "mrmp/other", taken, [], 2)
