@@ -104,7 +104,9 @@ class RunResult:
     paths are its ground truth sampled every ``tick_seconds`` of wall-clock
     time, its robots' ``time_s`` are wall-clock arrival times, and
     ``ideal_makespan_s`` is the longest single-robot path time at the run's
-    speed.
+    speed. Runs executing a central plan carry the wall time spent planning,
+    ``planning_time_s``, and the size of the plan handed to the robots,
+    ``plan_bytes``.
     """
 
     scenario: str
@@ -120,6 +122,8 @@ class RunResult:
     mode: str = "simulated"
     tick_seconds: float | None = None
     ideal_makespan_s: float | None = None
+    planning_time_s: float | None = None
+    plan_bytes: int | None = None
 
     @property
     def all_arrived(self) -> bool:

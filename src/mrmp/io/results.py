@@ -108,6 +108,8 @@ def result_to_dict(result: RunResult, grid: Grid | None = None) -> dict[str, Any
         "mode": result.mode,
         "tick_seconds": result.tick_seconds,
         "ideal_makespan_s": result.ideal_makespan_s,
+        "planning_time_s": result.planning_time_s,
+        "plan_bytes": result.plan_bytes,
         "collisions": [_collision_to_dict(collision) for collision in result.collisions],
         "robots": [_robot_to_dict(robot) for robot in result.robots],
     }
@@ -286,6 +288,10 @@ def result_from_dict(data: Mapping[str, Any], source: str = "result") -> RunResu
         ideal_makespan_s=_optional_number(
             fields.get("ideal_makespan_s", (int, float, type(None)), "a number or null", None)
         ),
+        planning_time_s=_optional_number(
+            fields.get("planning_time_s", (int, float, type(None)), "a number or null", None)
+        ),
+        plan_bytes=fields.get("plan_bytes", (int, type(None)), "an integer or null", None),
     )
 
 

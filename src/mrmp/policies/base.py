@@ -38,6 +38,7 @@ class PeerState:
     seq: int
     heard_at: float
     silent: bool = False
+    progress: int = 0
 
     @property
     def parked(self) -> bool:

@@ -12,7 +12,8 @@ Wire layout (network byte order)::
 Bodies (cells are two signed 32-bit integers)::
 
     1 state  present, next, target, claim cell (4 cells), heading (1 byte, 1..4),
-             flags (1 byte: bit 0 arrived, bit 1 moving, bit 2 claiming), claim (u32)   48 bytes in all
+             flags (1 byte: bit 0 arrived, bit 1 moving, bit 2 claiming), claim (u32),
+             progress (u32)                                                             52 bytes in all
     2 claim  claim (u32), cell                                                          22 bytes in all
     3 reply  claimant (u32), claim (u32), cell, granted (1 byte, 0 or 1)                 27 bytes in all
 
@@ -29,9 +30,9 @@ Examples
 >>> from mrmp.protocol.messages import StateMessage
 >>> data = encode(StateMessage(sender=1, seq=3, present=(4, 2), next=(3, 2)))
 >>> len(data)
-48
+52
 >>> decode(data)
-StateMessage(sender=1, seq=3, present=(4, 2), next=(3, 2), heading=<Heading.NORTH: 1>, arrived=False, target=None, claim=0, claim_cell=None)
+StateMessage(sender=1, seq=3, present=(4, 2), next=(3, 2), heading=<Heading.NORTH: 1>, arrived=False, target=None, claim=0, claim_cell=None, progress=0)
 >>> decode(b"hello")
 Traceback (most recent call last):
 ...
@@ -46,7 +47,7 @@ from mrmp.core.errors import MrmpError
 from mrmp.core.heading import Heading
 from mrmp.protocol.messages import NO_CELL, ClaimMessage, Message, ReplyMessage, StateMessage
 
-PROTOCOL_VERSION = 2
+PROTOCOL_VERSION = 3
 """Version byte of every datagram; a receiver drops other versions."""
 MAX_MESSAGE_BYTES = 512
 """Upper bound on the size of any encoded message."""
@@ -55,7 +56,7 @@ DECODE_REASONS = ("oversized", "truncated", "version", "type", "malformed")
 """Why a datagram can be rejected by :func:`decode`."""
 
 _HEADER = struct.Struct("!BBII")
-_STATE_BODY = struct.Struct("!iiiiiiiiBBI")
+_STATE_BODY = struct.Struct("!iiiiiiiiBBII")
 _CLAIM_BODY = struct.Struct("!Iii")
 _REPLY_BODY = struct.Struct("!IIiiB")
 _STATE, _CLAIM, _REPLY = 1, 2, 3
@@ -90,7 +91,7 @@ def encode(message: Message) -> bytes:
             | (_CLAIMING if message.claim else 0)
         )
         body = _STATE_BODY.pack(
-            *message.present, *message.next, *target, *claim_cell, int(message.heading), flags, message.claim
+            *message.present, *message.next, *target, *claim_cell, int(message.heading), flags, message.claim, message.progress
         )
         type_code = _STATE
     elif isinstance(message, ClaimMessage):
@@ -129,7 +130,7 @@ def decode(data: bytes) -> Message:
         raise DecodeError("truncated" if size < expected else "malformed", f"{size} bytes, expected {expected}")
     fields = body.unpack_from(data, _HEADER.size)
     if type_code == _STATE:
-        px, py, nx, ny, tx, ty, cx, cy, heading, flags, claim = fields
+        px, py, nx, ny, tx, ty, cx, cy, heading, flags, claim, progress = fields
         if not 1 <= heading <= 4:
             raise DecodeError("malformed", f"heading {heading} is not 1..4")
         if flags & ~(_ARRIVED | _MOVING | _CLAIMING):
@@ -147,6 +148,7 @@ def decode(data: bytes) -> Message:
             (tx, ty) if moving else None,
             claim,
             (cx, cy) if claiming else None,
+            progress,
         )
     if type_code == _CLAIM:
         claim, cx, cy = fields

@@ -60,6 +60,9 @@ class StateMessage:
         The number of the sender's current claim, or 0 when it has none.
     claim_cell:
         The cell of that claim (None when ``claim`` is 0).
+    progress:
+        How many moves the sender has completed (robots executing a central plan
+        wait on each other's progress; :mod:`mrmp.policies.plan_following`).
     """
 
     sender: int
@@ -71,6 +74,7 @@ class StateMessage:
     target: Cell | None = None
     claim: int = 0
     claim_cell: Cell | None = None
+    progress: int = 0
 
     @property
     def occupied(self) -> tuple[Cell, ...]:

@@ -43,6 +43,13 @@ class Belief:
             self.stale_messages += 1
             return False
         self.peers[message.sender] = PeerState(
-            message.sender, message.present, message.next, message.heading, message.arrived, message.seq, now
+            message.sender,
+            message.present,
+            message.next,
+            message.heading,
+            message.arrived,
+            message.seq,
+            now,
+            progress=message.progress,
         )
         return True

@@ -118,6 +118,7 @@ class Robot:
         self.belief = Belief()
         self.safety = SafetyLayer(index, starts, claim_timeout=claim_timeout, retry_interval=retry_interval)
         self.seq = 0
+        self.progress = 0
         self.dropped: Counter[str] = Counter()
         self.last_decision: Decision | None = None
 
@@ -155,8 +156,15 @@ class Robot:
         """A fresh state message: Present, Next, heading, arrival and safety state."""
         self.seq += 1
         return StateMessage(
-            self.index, self.seq, self.present, self.intended, self.heading, self.arrived, **self.safety.state_fields()
-        )  # type: ignore[arg-type]
+            self.index,
+            self.seq,
+            self.present,
+            self.intended,
+            self.heading,
+            self.arrived,
+            progress=self.progress,
+            **self.safety.state_fields(),  # type: ignore[arg-type]
+        )
 
     # -- the step -------------------------------------------------------------------
 
@@ -197,6 +205,8 @@ class Robot:
 
     def arrived_at(self, cell: Cell, heading: Heading) -> None:
         """The body reports the cell it now stands on and its heading (from its own sensors)."""
+        if cell != self.present:
+            self.progress += 1
         self.present = cell
         self.heading = heading
         self.moving = False

@@ -8,6 +8,9 @@ Examples
 [4, 4]
 >>> default_max_ticks(swap, [4, 4])
 64
+>>> from mrmp.core import NetworkFaults
+>>> default_max_ticks(swap.with_changes(network=NetworkFaults(loss=0.5, delay_max=1)), [4, 4])
+768
 """
 
 from __future__ import annotations
@@ -35,10 +38,17 @@ def shortest_steps(scenario: Scenario) -> list[int]:
 
 
 def default_max_ticks(scenario: Scenario, lengths: Sequence[int]) -> int:
-    """The tick limit of a run that sets none: room for detours, waits and crowds.
+    """The tick limit of a run that sets none: room for detours, waits, crowds and a slow network.
 
     Four times the longest shortest path, plus two ticks per robot, and never
-    fewer than 64.
+    fewer than 64; when the safety layer guards moves over a faulty network,
+    times the ticks a claim's round trip can take (``2 * delay_max + 1``) and
+    the expected number of tries of a claim and its answer (``1 / (1 - loss)^2``).
     """
     longest = max(lengths, default=0)
-    return max(64, 4 * longest + 2 * len(scenario.robots))
+    ticks = max(64, 4 * longest + 2 * len(scenario.robots))
+    network = scenario.network
+    if scenario.safety and not network.is_perfect:
+        delivered = max(1.0 - network.loss, 0.05) ** 2
+        ticks = int(ticks * (2 * network.delay_max + 1) / delivered)
+    return ticks

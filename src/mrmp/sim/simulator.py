@@ -31,12 +31,13 @@ from __future__ import annotations
 
 import time
 from collections import Counter
+from collections.abc import Sequence
 
 from mrmp.core.cell import Cell
 from mrmp.core.heading import Heading, right_turns
 from mrmp.core.result import RobotResult, RunResult
 from mrmp.core.scenario import Scenario
-from mrmp.policies.base import Decision
+from mrmp.policies.base import Decision, Policy
 from mrmp.policies.registry import make_policy
 from mrmp.protocol.codec import DecodeError, decode, encode
 from mrmp.protocol.messages import Message
@@ -73,9 +74,14 @@ class LockstepSimulator:
     record_decisions:
         Keep every robot's :class:`~mrmp.policies.base.Decision` of every tick
         in :attr:`decisions` (for tests and traces).
+    policies:
+        One policy per robot, replacing the scenario's (for example robots
+        following a central plan).
     """
 
-    def __init__(self, scenario: Scenario, record_decisions: bool = False) -> None:
+    def __init__(
+        self, scenario: Scenario, record_decisions: bool = False, policies: Sequence[Policy] | None = None
+    ) -> None:
         self.scenario = scenario
         grid = scenario.grid
         starts = [spec.start for spec in scenario.robots]
@@ -86,7 +92,7 @@ class LockstepSimulator:
                 spec,
                 index,
                 grid,
-                make_policy(scenario.policy, scenario.timing),
+                policies[index] if policies is not None else make_policy(scenario.policy, scenario.timing),
                 starts,
                 guarded=scenario.safety,
                 claim_timeout=timeout,
@@ -230,7 +236,7 @@ class LockstepSimulator:
             )
         return RunResult(
             scenario=self.scenario.name,
-            policy=self.scenario.policy.name,
+            policy=self.robots[0].policy.name if self.robots else self.scenario.policy.name,
             seed=self.scenario.seed,
             robots=self._results,
             collisions=list(self.referee.collisions),
@@ -242,6 +248,6 @@ class LockstepSimulator:
         )
 
 
-def simulate(scenario: Scenario, record_decisions: bool = False) -> RunResult:
+def simulate(scenario: Scenario, record_decisions: bool = False, policies: Sequence[Policy] | None = None) -> RunResult:
     """Run ``scenario`` in the lockstep simulator and return its result."""
-    return LockstepSimulator(scenario, record_decisions=record_decisions).run()
+    return LockstepSimulator(scenario, record_decisions=record_decisions, policies=policies).run()

@@ -30,6 +30,7 @@ def states(draw):
         target=draw(st.none() | wire_cells),
         claim=claim,
         claim_cell=draw(wire_cells) if claim else None,
+        progress=draw(u32),
     )
 
 
@@ -90,7 +91,7 @@ def test_each_rejection_reason(data, reason):
 
 
 def test_sizes_stay_small():
-    assert len(_valid()) == 48
+    assert len(_valid()) == 52
     assert len(encode(ClaimMessage(1, 2, 3, (4, 5)))) == 22
     assert len(encode(ReplyMessage(1, 2, 3, 4, (5, 6), False))) == 27
 

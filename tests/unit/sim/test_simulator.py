@@ -83,7 +83,7 @@ def test_messages_are_counted_per_datagram():
     result = simulate(SWAP.with_changes(safety=False))
     assert result.messages == 2 * result.ticks  # each robot, each tick, one datagram to its one peer
     assert result.network["sent"] == result.messages
-    assert all(robot.bytes_sent == 48 * robot.messages_sent for robot in result.robots)
+    assert all(robot.bytes_sent == 52 * robot.messages_sent for robot in result.robots)
     guarded = simulate(SWAP)  # each move adds a claim and its answer
     moves = sum(robot.steps for robot in guarded.robots)
     assert guarded.messages == result.messages + 2 * moves

@@ -1,0 +1,93 @@
+"""Following a central plan robustly: each move waits for the robots that must use its cell first.
+
+Source: W. Hönig, S. Kiesel, A. Tinka, J. W. Durham and N. Ayanian, "Persistent
+and Robust Execution of MAPF Schedules in Warehouses", IEEE Robotics and
+Automation Letters 4(2), 2019: the *Action Dependency Graph*. A robot's plan is
+reduced to its moves (the cells it enters, in order); each move depends on the
+moves by which other robots leave that cell earlier in the plan. A robot starts
+a move only when every robot it depends on reports (in its state messages, field
+``progress``) that it has completed the move it depends on. Late robots and
+lost messages then only delay the fleet; the order of visits to every cell is
+the plan's, so the execution never collides and, the dependency graph being
+acyclic, never deadlocks.
+
+The dependencies themselves are computed from the plan by
+:func:`mrmp.centralized.dependencies.action_dependencies`; this policy only
+follows them, knowing its peers only through their messages.
+
+Examples
+--------
+>>> from mrmp.core import Grid, Heading
+>>> from mrmp.policies.base import PeerState, Situation
+>>> policy = PlanFollowingPolicy(moves=[(0, 1), (0, 2)], dependencies={1: [(1, 1)]})
+>>> def at(cell, peer_progress):
+...     peer = PeerState(1, (1, 1), (1, 1), Heading.NORTH, False, 1, 0.0, progress=peer_progress)
+...     return Situation(0, cell, Heading.EAST, (0, 2), Grid(2, 3), {1: peer})
+>>> policy.intend(at((0, 0), 0))
+(0, 1)
+>>> policy.intend(at((0, 1), 0))   # move 1 waits until robot 1 has completed its first move
+(0, 1)
+>>> policy.intend(at((0, 1), 1))
+(0, 2)
+"""
+
+from __future__ import annotations
+
+from collections.abc import Mapping, Sequence
+
+from mrmp.core.cell import Cell
+from mrmp.policies.base import Decision, Situation
+
+
+class PlanFollowingPolicy:
+    """Execute one robot's share of a central plan, honouring its action dependencies.
+
+    Parameters
+    ----------
+    moves:
+        The cells the robot enters, in order (its planned path without waits).
+    dependencies:
+        For a move index, the ``(robot, progress)`` pairs it waits for: robot
+        ``robot`` must have completed at least ``progress`` moves.
+    """
+
+    name = "plan"
+
+    def __init__(self, moves: Sequence[Cell], dependencies: Mapping[int, Sequence[tuple[int, int]]]) -> None:
+        self.moves = list(moves)
+        self.dependencies = {move: list(needs) for move, needs in dependencies.items()}
+        self.done = 0
+        self.waits_for: list[int] = []
+
+    def _catch_up(self, present: Cell) -> None:
+        while self.done < len(self.moves) and present == self.moves[self.done]:
+            self.done += 1
+
+    def ready(self, situation: Situation) -> bool:
+        """Whether every dependency of the next move is met, by what the peers have said."""
+        waiting = []
+        for robot, progress in self.dependencies.get(self.done, ()):
+            peer = situation.peers.get(robot)
+            if peer is None or peer.progress < progress:
+                waiting.append(robot)
+        self.waits_for = waiting
+        return not waiting
+
+    def intend(self, situation: Situation) -> Cell:
+        """The next cell of the plan once its dependencies are met, else the present cell."""
+        self._catch_up(situation.present)
+        if self.done >= len(self.moves) or not self.ready(situation):
+            return situation.present
+        return self.moves[self.done]
+
+    def decide(self, situation: Situation, intended: Cell) -> Decision:
+        """Follow the plan: the dependencies already ruled out every conflict.
+
+        Readiness is checked again with what the peers said since :meth:`intend`
+        (a dependency met meanwhile lets the robot go now rather than a step later).
+        """
+        intended = self.intend(situation)
+        if intended == situation.present:
+            reason = "arrived" if situation.present == situation.goal and self.done >= len(self.moves) else "wait"
+            return Decision(situation.present, reason, tuple(self.waits_for))
+        return Decision(intended, "clear")
