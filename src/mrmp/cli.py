@@ -155,6 +155,20 @@ def live_faults(scenario: Scenario, time_scale: float, delay_ms: str | None) -> 
     return LiveFaults(network.loss, low, high, network.duplicate, network.reorder)
 
 
+def _plan(name: str, scenario: Scenario, time_limit: float, console: Console) -> "PlanningResult":
+    """Run a central planner; an unsolved plan ends the command with status 1 and its reason."""
+    from mrmp.centralized.registry import PLANNER_NAMES, plan_with
+
+    if name not in PLANNER_NAMES:
+        raise InputError(Problem("--planner", f"unknown planner {name!r}; known: {', '.join(PLANNER_NAMES)}"))
+    plan = plan_with(name, scenario, time_limit_s=_positive(time_limit, "--time-limit"))
+    if not plan.solved:
+        console.print(f"[red]{name}: no plan[/red] ({plan.status}: {plan.message}) after {plan.planning_time_s:.2f} s")
+        raise typer.Exit(1)
+    console.print(f"{name}: planned in {plan.planning_time_s:.3f} s, sum of costs {plan.sum_of_costs()}, makespan {plan.makespan()}")
+    return plan
+
+
 def _cell(cell: tuple[int, int]) -> str:
     return f"({cell[0]},{cell[1]})"
 
@@ -230,6 +244,8 @@ def run(
     reorder: Annotated[Optional[float], typer.Option(help="Probability that a message overtakes earlier ones.")] = None,
     json_path: Annotated[Optional[str], typer.Option("--json", help="Write the whole result as JSON (- for stdout).")] = None,
     animate: Annotated[Optional[Path], typer.Option(help="Write an animation: .gif or .svg.")] = None,
+    planner: Annotated[Optional[str], typer.Option(help="Plan centrally first (cbs, pp, lacam), then execute the plan.")] = None,
+    time_limit: Annotated[float, typer.Option(help="Seconds a central planner may spend.")] = 30.0,
     live: Annotated[bool, typer.Option("--live", help="One OS process per robot, in real time, over a loopback network.")] = False,
     transport: Annotated[str, typer.Option(help="Live transport: udp, multicast or zenoh.")] = "udp",
     time_scale: Annotated[float, typer.Option(help="Live: run this many times faster than the robots' real speed.")] = 1.0,
@@ -258,6 +274,9 @@ def run(
         )
         if animate is not None and animate.suffix.lower() not in (".gif", ".svg"):
             raise InputError(Problem("--animate", f"unsupported suffix {animate.suffix!r}; use .gif or .svg"))
+        plan = None
+        if planner is not None:
+            plan = _plan(planner, scenario, time_limit, console)
         if live:
             from mrmp.live.launcher import LiveOptions, run_live
 
@@ -271,8 +290,13 @@ def run(
                 results=results,
                 kill=parse_kills(kill or []),
                 seed=scenario.seed,
+                plan=plan,
             )
             result = run_live(scenario, options, say=lambda text: console.print(text, markup=False))
+        elif plan is not None:
+            from mrmp.centralized.execution import execute_in_simulator
+
+            result = execute_in_simulator(scenario, plan)
         else:
             result = simulate(scenario)
     except InputError as error:
@@ -290,6 +314,52 @@ def run(
         Console(stderr=True).print(f"error: {error}", markup=False)
         raise typer.Exit(2) from None
     raise typer.Exit(0 if result.success else 1)
+
+
+@app.command()
+def compare(
+    scenario_path: Annotated[Optional[Path], typer.Argument(metavar="SCENARIO", help="A YAML scenario.")] = None,
+    map_path: Annotated[Optional[Path], typer.Option("--map", help="A MovingAI .map file.")] = None,
+    scen_path: Annotated[Optional[Path], typer.Option("--scen", help="A MovingAI .scen file.")] = None,
+    agents: Annotated[Optional[int], typer.Option(help="Robots taken from the .scen (default: all).")] = None,
+    time_limit: Annotated[float, typer.Option(help="Seconds each central planner may spend.")] = 30.0,
+    json_path: Annotated[Optional[str], typer.Option("--json", help="Write the rows as JSON (- for stdout).")] = None,
+) -> None:
+    """Solve one scenario every way: each decentralized policy, and each central planner plus execution."""
+    from mrmp.centralized.compare import compare_methods
+
+    console = Console(stderr=json_path == "-", highlight=False)
+    try:
+        scenario = _load(scenario_path, map_path, scen_path, agents)
+        rows = compare_methods(scenario, time_limit_s=_positive(time_limit, "--time-limit"))
+    except InputError as error:
+        raise _fail(error.problems) from None
+    table = Table(title=f"{scenario.name}: {len(scenario.robots)} robots, lower bound {rows[0].lower_bound if rows else 0}")
+    for column in ("method", "kind", "success", "makespan", "SoC / LB", "planning s", "run s", "messages", "plan bytes"):
+        table.add_column(column, justify="left" if column in ("method", "kind") else "right")
+    for row in rows:
+        table.add_row(
+            row.method,
+            row.kind,
+            "yes" if row.success else f"[red]no[/red] ({row.status})",
+            str(row.makespan) if row.makespan is not None else "-",
+            f"{row.cost_ratio:.3f}" if row.cost_ratio is not None else "-",
+            f"{row.planning_time_s:.3f}" if row.planning_time_s is not None else "-",
+            f"{row.run_time_s:.3f}",
+            str(row.messages),
+            str(row.plan_bytes) if row.plan_bytes is not None else "-",
+        )
+    console.print(table)
+    if json_path is not None:
+        from mrmp.io.live_files import write_json
+
+        rows_data = [row.__dict__ for row in rows]
+        if json_path == "-":
+            import json
+
+            print(json.dumps(rows_data, indent=1))
+        else:
+            write_json(json_path, rows_data)
 
 
 @app.command()
@@ -333,6 +403,7 @@ def agent(
     reorder: Annotated[float, typer.Option(help="Inject: probability that a sent message is held back.")] = 0.0,
     listen_time: Annotated[float, typer.Option(help="Seconds between announcing Next and deciding.")] = 0.05,
     unsafe: Annotated[bool, typer.Option("--unsafe", help="No safety layer: the policy as written.")] = False,
+    plan: Annotated[Optional[Path], typer.Option(help="Follow this robot's share of a central plan (plan.json).")] = None,
     seed: Annotated[int, typer.Option(help="Seed of the body's and the fault injector's randomness.")] = 0,
     timeout: Annotated[float, typer.Option(help="Give up after this many seconds.")] = 600.0,
 ) -> None:
@@ -392,7 +463,12 @@ def agent(
             guarded=not unsafe and scenario.safety,
             seed=seed,
             timing=AgentTiming(listen_time=listen_time, timeout=timeout),
+            plan=plan,
         )
+        if plan is not None:
+            from mrmp.io.plans import read_plan
+
+            read_plan(plan, ids)  # a bad plan file is bad input: report it before any socket opens
     except InputError as error:
         raise _fail(error.problems) from None
     report = run_agent(scenario, options)

@@ -33,6 +33,17 @@ def test_thesis_scenarios_over_udp(name, tmp_path):
     assert result.network["rejected_forged"] == 0 if "rejected_forged" in result.network else True
 
 
+def test_thesis_swap_over_zenoh(tmp_path):
+    pytest.importorskip("zenoh")
+    result = live(load_scenario(EXAMPLES / "thesis-swap.yaml"), tmp_path, time_scale=20, transport="zenoh")
+    assert result.collisions == [] and result.success, result.stop_reason
+
+
+def test_thesis_swap_over_multicast(tmp_path):
+    result = live(load_scenario(EXAMPLES / "thesis-swap.yaml"), tmp_path, time_scale=20, transport="multicast")
+    assert result.collisions == [] and result.success, result.stop_reason
+
+
 def test_eight_robots_live(tmp_path):
     """Four thesis swaps at once: pairs of robots trade places head-on along four rows."""
     east = [RobotSpec(f"a{i}", (2 * i + 1, 0), (2 * i + 1, 9)) for i in range(4)]

@@ -9,8 +9,8 @@ import pytest
 
 zenoh = pytest.importorskip("zenoh")
 
-from mrmp.live.zenoh_transport import ZenohTransport, session_config  # noqa: E402
-from mrmp.protocol.auth import MAX_DATAGRAM_BYTES  # noqa: E402
+from mrmp.live.zenoh_transport import ZenohTransport, session_config
+from mrmp.protocol.auth import MAX_DATAGRAM_BYTES
 
 LOOPBACK = "127.0.0.1"
 
@@ -136,8 +136,8 @@ def test_payloads_pass_through_unchanged_even_oversized(mesh):
     assert len(oversized) > MAX_DATAGRAM_BYTES + 1
     a.send(oversized, recipient=1)
     a.send(b"")
-    assert receive_within(b) == oversized
-    assert receive_within(b) == b""
+    received = [receive_within(b), receive_within(b)]  # two publishers: no order between them
+    assert sorted(received, key=len) == [b"", oversized]
 
 
 def test_a_robot_started_before_its_peers_still_connects(fleet):

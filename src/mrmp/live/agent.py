@@ -41,6 +41,7 @@ from mrmp.core.cell import Cell
 from mrmp.core.scenario import Scenario
 from mrmp.live.body import Body
 from mrmp.live.transport import FaultyTransport, Transport
+from mrmp.policies.base import Policy
 from mrmp.policies.registry import make_policy
 from mrmp.protocol.auth import Opener, Sealer
 from mrmp.protocol.messages import Message
@@ -121,6 +122,8 @@ class Agent:
         Seed of the driver's own randomness (pauses that break symmetry).
     clock:
         The clock (``time.monotonic``; shared by every process on a machine).
+    policy:
+        The robot's policy, when not the scenario's (for example its share of a central plan).
     """
 
     def __init__(
@@ -135,6 +138,7 @@ class Agent:
         guarded: bool = True,
         seed: int = 0,
         clock: Callable[[], float] = time.monotonic,
+        policy: Policy | None = None,
     ) -> None:
         spec = scenario.robots[index]
         self.scenario = scenario
@@ -150,7 +154,7 @@ class Agent:
             spec,
             index,
             scenario.grid,
-            make_policy(scenario.policy, scenario.timing),
+            policy if policy is not None else make_policy(scenario.policy, scenario.timing),
             [robot.start for robot in scenario.robots],
             guarded=guarded,
             claim_timeout=timing.claim_timeout,

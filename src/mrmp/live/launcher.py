@@ -10,6 +10,7 @@ launcher (``PR_SET_PDEATHSIG``), so a killed launcher leaves no orphans.
 
 from __future__ import annotations
 
+import importlib.util
 import os
 import random
 import signal
@@ -19,13 +20,15 @@ import sys
 import tempfile
 import time
 from collections.abc import Callable, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from mrmp.centralized.plan import PlanningResult, plan_size_bytes
 from mrmp.core.errors import InputError, Problem
 from mrmp.core.result import RunResult
 from mrmp.core.scenario import Scenario
 from mrmp.io.live_files import read_json, write_key_file
+from mrmp.io.plans import write_plan
 from mrmp.io.scenario_file import save_scenario
 from mrmp.live.agent import AgentTiming
 from mrmp.live.process import TRANSPORTS
@@ -38,7 +41,8 @@ class LiveOptions:
     """How to run a scenario live.
 
     ``kill`` maps robot ids to seconds after the start at which their process is
-    killed (SIGKILL), to study failures.
+    killed (SIGKILL), to study failures. With a ``plan`` (a solved central plan),
+    every robot follows its share of it through the plan's action dependencies.
     """
 
     transport: str = "udp"
@@ -52,6 +56,7 @@ class LiveOptions:
     timing: AgentTiming = AgentTiming()
     kill: Mapping[str, float] = field(default_factory=dict)
     seed: int = 0
+    plan: PlanningResult | None = None
 
 
 def free_ports(count: int) -> list[int]:
@@ -102,6 +107,8 @@ def run_live(scenario: Scenario, options: LiveOptions, say: Callable[[str], None
     """
     if options.transport not in TRANSPORTS:
         raise InputError(Problem("--transport", f"unknown transport {options.transport!r}; known: {', '.join(TRANSPORTS)}"))
+    if options.transport == "zenoh" and importlib.util.find_spec("zenoh") is None:
+        raise InputError(Problem("--transport", "zenoh needs the eclipse-zenoh package: pip install 'mrmp[zenoh]'"))
     ids = [robot.id for robot in scenario.robots]
     for robot_id in options.kill:
         if robot_id not in ids:
@@ -112,6 +119,10 @@ def run_live(scenario: Scenario, options: LiveOptions, say: Callable[[str], None
         stale.unlink(missing_ok=True)
     scenario_file = results / "scenario.yaml"
     save_scenario(scenario, scenario_file)
+    plan_arguments = []
+    if options.plan is not None:
+        write_plan(results / "plan.json", options.plan, ids)
+        plan_arguments = [f"--plan={results / 'plan.json'}"]
     key_file = results / "fleet.key"
     write_key_file(key_file, os.urandom(32).hex().encode())
     session = random.SystemRandom().randrange(1, 2**31)
@@ -145,6 +156,7 @@ def run_live(scenario: Scenario, options: LiveOptions, say: Callable[[str], None
         f"--timeout={timeout}",
         f"--listen-time={options.timing.listen_time}",
         *([] if options.guarded else ["--unsafe"]),
+        *plan_arguments,
     ]
     agents = [
         subprocess.Popen(
@@ -191,7 +203,7 @@ def run_live(scenario: Scenario, options: LiveOptions, say: Callable[[str], None
         elif "arrived; peers silent" in reasons:
             stop_reason = "arrived; peers silent"
     tick_seconds = scenario.timing.cell_time / options.time_scale / 4
-    return live_result(
+    result = live_result(
         scenario,
         reports,
         verdict,
@@ -200,3 +212,6 @@ def run_live(scenario: Scenario, options: LiveOptions, say: Callable[[str], None
         tick_seconds=tick_seconds,
         time_scale=options.time_scale,
     )
+    if options.plan is not None:
+        result = replace(result, policy=options.plan.planner, planning_time_s=options.plan.planning_time_s, plan_bytes=plan_size_bytes(options.plan))
+    return result

@@ -20,7 +20,9 @@ from pathlib import Path
 
 from mrmp.core.errors import InputError, Problem
 from mrmp.core.scenario import Scenario
+from mrmp.centralized.execution import plan_policies
 from mrmp.io.live_files import TraceReader, TraceWriter, write_json
+from mrmp.io.plans import read_plan
 from mrmp.live.agent import Agent, AgentReport, AgentTiming
 from mrmp.live.body import OccupancyRecorder, SimulatedBody
 from mrmp.live.referee import IntervalReferee
@@ -126,6 +128,7 @@ class AgentOptions:
     guarded: bool = True
     seed: int = 0
     timing: AgentTiming = AgentTiming()
+    plan: Path | None = None
 
 
 def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
@@ -148,6 +151,10 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
         rng=random.Random(options.seed * 104_729 + index),
         recorder=OccupancyRecorder(trace.write),
     )
+    policy = None
+    if options.plan is not None:
+        plan = read_plan(options.plan, [robot.id for robot in scenario.robots])
+        policy = plan_policies(plan)[index]
     agent = Agent(
         scenario,
         index,
@@ -158,6 +165,7 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
         timing=options.timing,
         guarded=options.guarded,
         seed=options.seed,
+        policy=policy,
     )
     report_path = options.results / f"agent-{index}.json"
     _on_stop_signals(agent.stop_requested.set)

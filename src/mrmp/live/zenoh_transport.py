@@ -17,7 +17,8 @@ https://zenoh.io/docs/manual/abstractions/). Robot ``i`` uses:
 
 It subscribes to ``{fleet}/robot/*`` (``*`` is exactly one chunk, so this is
 every robot's broadcast key; its own is ignored) and to ``{fleet}/to/{i}``,
-both restricted to remote publications (``allowed_origin=Locality.REMOTE``),
+both restricted to remote publications (``allowed_origin=Locality.REMOTE``
+where the installed Zenoh has it, 1.1 and later),
 and to the liveliness of ``{fleet}/alive/*`` to know which peers are up.
 
 Configuration, and why
@@ -85,7 +86,7 @@ import threading
 import time
 from collections import deque
 from collections.abc import Sequence
-from typing import TYPE_CHECKING, Any
+from typing import TYPE_CHECKING, Any, Self
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
     import zenoh
@@ -277,16 +278,20 @@ class ZenohTransport:
         self._session: zenoh.Session = zenoh.open(config)
         entities: list[Any] = []
         try:
-            remote = zenoh.Locality.REMOTE
-            entities.append(self._session.declare_subscriber(keys["broadcasts"], self._on_sample, allowed_origin=remote))
-            entities.append(self._session.declare_subscriber(keys["inbox"], self._on_sample, allowed_origin=remote))
+            # Only remote publications (zenoh >= 1.1; the own-key check in _on_sample covers 1.0).
+            origin = {"allowed_origin": zenoh.Locality.REMOTE} if hasattr(zenoh, "Locality") else {}
+            for key in (keys["broadcasts"], keys["inbox"]):
+                entities.append(self._session.declare_subscriber(key, self._on_sample, **origin))
             liveliness = self._session.liveliness()
             entities.append(liveliness.declare_subscriber(keys["everyone_alive"], self._on_liveliness, history=True))
-            publish = {"congestion_control": zenoh.CongestionControl.DROP, "express": True}
-            self._broadcast = self._session.declare_publisher(keys["broadcast"], **publish)
+
+            def publisher(key: str) -> zenoh.Publisher:
+                return self._session.declare_publisher(key, congestion_control=zenoh.CongestionControl.DROP, express=True)
+
+            self._broadcast = publisher(keys["broadcast"])
             entities.append(self._broadcast)
             self._addressed = {
-                other: self._session.declare_publisher(addressed_key(fleet, other), **publish)
+                other: publisher(addressed_key(fleet, other))
                 for other in range(fleet_size)
                 if other != index
             }
@@ -413,7 +418,7 @@ class ZenohTransport:
                 self._ready.wait(remaining)
             return not self._closed and len(self._alive) >= count
 
-    def __enter__(self) -> ZenohTransport:
+    def __enter__(self) -> Self:
         return self
 
     def __exit__(self, *_: object) -> None:

@@ -1,0 +1,370 @@
+"""Conflict-Based Search: optimal sum of costs for a fleet on a grid.
+
+Conflict-Based Search (Sharon, Stern, Felner & Sturtevant, "Conflict-based
+search for optimal multi-agent pathfinding", Artificial Intelligence 219, 2015)
+searches a *constraint tree*. Each node holds a set of constraints per robot
+and one path per robot, each the cheapest path that respects that robot's
+constraints (found by :func:`~mrmp.centralized.space_time_astar.space_time_astar`).
+The high level is best-first on the node's sum of costs:
+
+1. take the node of least sum of costs (ties: fewer conflicts, then the older
+   node, so the search is deterministic);
+2. find its first conflict in time: a *vertex* conflict (two robots in one cell
+   at tick ``t``) or an *edge* conflict (two robots swapping cells at tick
+   ``t``); robots that have arrived stay on their goals, so a robot crossing a
+   parked one is a vertex conflict at a tick after the parked robot's arrival;
+3. no conflict: the node's paths are an optimal plan; otherwise split the node
+   into two children, each forbidding the conflict to one of the two robots
+   (vertex ``(cell, t)`` or edge ``(u, v, t)``), and replan that robot.
+
+The low level breaks ties between paths of equal length by the fewest
+conflicts with the other robots' current paths (the conflict-avoidance table
+of Standley 2010), which keeps the tree small without changing optimality.
+
+**Costs** are the standard MAPF ones (:mod:`mrmp.centralized.plan`): each
+robot's first tick from which it stays at its goal, summed. With
+``heading_aware=True`` one tick is one move forward, one right turn in place or
+a wait (see :mod:`mrmp.centralized.space_time_astar`), and CBS is optimal for
+that time model.
+
+**Limits and statuses.** The search stops at ``max_nodes`` generated
+constraint-tree nodes or after ``time_limit_s`` seconds, whichever comes first,
+with status ``"limit"`` and a message naming the limit. CBS cannot in general
+prove that an instance has no solution before its limits: an unsolvable
+instance normally ends with ``"limit"``. It reports ``"infeasible"`` only when
+it has a proof: a robot's goal is not connected to its start; a connected
+region without cycles is filled with robots of which one is not on its goal
+(no robot there can ever move, for example two robots swapping in a 1x2
+corridor); or the whole constraint tree was exhausted (every low-level search
+is exhaustive, so this proves no plan exists).
+
+``nodes`` in the result counts the constraint-tree nodes generated (the root
+included).
+
+Examples
+--------
+Two robots swapping ends of a corridor with a passing bay:
+
+>>> from mrmp.core.grid import Grid
+>>> from mrmp.sim.referee import check_paths
+>>> grid = Grid.from_rows(["#.#", "..."])
+>>> result = cbs(grid, [(0, 0), (0, 2)], [(0, 2), (0, 0)])
+>>> result.status, result.sum_of_costs(), result.makespan()
+('solved', 7, 4)
+>>> check_paths(grid, dict(zip("AB", result.paths)))
+[]
+>>> cbs(Grid(1, 2), [(0, 0), (0, 1)], [(0, 1), (0, 0)]).status
+'infeasible'
+"""
+
+from __future__ import annotations
+
+import heapq
+import time
+from collections import deque
+from collections.abc import Sequence
+from dataclasses import dataclass
+
+from mrmp.centralized.plan import MapfProblem, PlanningResult, as_problem, pad_headings, pad_paths
+from mrmp.centralized.space_time_astar import Reservations, SpaceTimeResult, space_time_astar
+from mrmp.core.cell import Cell
+from mrmp.core.grid import Grid
+from mrmp.core.heading import Heading
+from mrmp.core.scenario import Scenario
+
+__all__ = ["Conflict", "DEFAULT_MAX_NODES", "DEFAULT_TIME_LIMIT_S", "cbs", "first_conflict", "infeasibility_proof"]
+
+DEFAULT_MAX_NODES = 100_000
+"""Constraint-tree nodes CBS generates at most unless told otherwise."""
+DEFAULT_TIME_LIMIT_S = 60.0
+"""Seconds CBS plans at most unless told otherwise."""
+
+# A constraint: ("v", cell, t) forbids cell at t; ("e", u, v, t) forbids moving u -> v arriving at t.
+_Constraint = tuple
+
+
+@dataclass(frozen=True)
+class Conflict:
+    """A collision between robots ``first`` and ``second`` (indices) at tick ``tick``.
+
+    ``kind`` is ``"vertex"`` (both on ``cells[0]``) or ``"edge"`` (``first``
+    moves ``cells[0] -> cells[1]`` while ``second`` moves back).
+    """
+
+    kind: str
+    first: int
+    second: int
+    cells: tuple[Cell, ...]
+    tick: int
+
+
+def _at(path: Sequence[Cell], tick: int) -> Cell:
+    return path[tick] if tick < len(path) else path[-1]
+
+
+def first_conflict(paths: Sequence[Sequence[Cell]]) -> tuple[Conflict | None, int]:
+    """The earliest conflict among ``paths`` and the number of conflicts in all.
+
+    Robots stay on their last cell after their path ends. At one tick, vertex
+    conflicts come before edge conflicts, and pairs go in robot order.
+
+    Parameters
+    ----------
+    paths:
+        One path per robot, one cell per tick.
+
+    Returns
+    -------
+    tuple
+        The first conflict (``None`` if the paths are conflict-free) and how
+        many conflicting (pair, tick) events the paths hold.
+
+    Examples
+    --------
+    >>> conflict, count = first_conflict([[(0, 0), (0, 1)], [(0, 1), (0, 0)]])
+    >>> conflict.kind, conflict.cells, conflict.tick, count
+    ('edge', ((0, 0), (0, 1)), 1, 1)
+    >>> first_conflict([[(0, 0), (0, 1), (0, 2)], [(0, 2)]])[0].kind
+    'vertex'
+    """
+    length = max((len(path) for path in paths), default=0)
+    first: Conflict | None = None
+    count = 0
+    previous = [_at(path, 0) for path in paths]
+    for tick in range(length):
+        current = [_at(path, tick) for path in paths]
+        occupants: dict[Cell, int] = {}
+        for index, cell in enumerate(current):
+            other = occupants.get(cell)
+            if other is None:
+                occupants[cell] = index
+            else:
+                count += 1
+                if first is None:
+                    first = Conflict("vertex", other, index, (cell,), tick)
+        if tick > 0:
+            moves: dict[tuple[Cell, Cell], int] = {}
+            for index, (source, target) in enumerate(zip(previous, current)):
+                if source != target:
+                    moves[(source, target)] = index
+            for (source, target), index in moves.items():
+                other = moves.get((target, source))
+                if other is not None and other > index:
+                    count += 1
+                    if first is None:
+                        first = Conflict("edge", index, other, (source, target), tick)
+        previous = current
+    return first, count
+
+
+def infeasibility_proof(problem: MapfProblem) -> str | None:
+    """A reason the instance has no solution, when a cheap proof exists; else ``None``.
+
+    Two proofs are tried: a robot whose goal is in another connected region
+    than its start; and a connected region without cycles (a tree of cells)
+    whose every cell holds a robot, one of them not on its goal: no robot
+    there can ever move (4-connected cycles are needed for robots to rotate).
+
+    >>> infeasibility_proof(as_problem(Grid(1, 2), [(0, 0), (0, 1)], [(0, 1), (0, 0)]))
+    'robots fill the cycle-free region of 2 cells around (0, 0) and cannot move'
+    >>> infeasibility_proof(as_problem(Grid(2, 2), [(0, 0), (0, 1)], [(0, 1), (0, 0)])) is None
+    True
+    """
+    grid = problem.grid
+    labels: dict[Cell, int] = {}
+    regions: list[list[Cell]] = []
+    for origin in problem.starts + problem.goals:
+        if origin in labels:
+            continue
+        label = len(regions)
+        region = [origin]
+        labels[origin] = label
+        queue = deque([origin])
+        while queue:
+            cell = queue.popleft()
+            for neighbour in grid.neighbours(cell):
+                if neighbour not in labels:
+                    labels[neighbour] = label
+                    region.append(neighbour)
+                    queue.append(neighbour)
+        regions.append(region)
+    for robot_id, start, goal in zip(problem.ids, problem.starts, problem.goals):
+        if labels[start] != labels[goal]:
+            return f"robot {robot_id} cannot reach its goal {goal} from {start}"
+    robots_in: dict[int, list[int]] = {}
+    for index, start in enumerate(problem.starts):
+        robots_in.setdefault(labels[start], []).append(index)
+    for label, members in robots_in.items():
+        region = regions[label]
+        if len(members) != len(region):
+            continue
+        edges = sum(len(grid.neighbours(cell)) for cell in region) // 2
+        if edges == len(region) - 1 and any(problem.starts[i] != problem.goals[i] for i in members):
+            return f"robots fill the cycle-free region of {len(region)} cells around {region[0]} and cannot move"
+    return None
+
+
+@dataclass
+class _Node:
+    """A constraint-tree node."""
+
+    cost: int
+    conflicts: int
+    serial: int
+    constraints: tuple[tuple[_Constraint, ...], ...]
+    paths: tuple[tuple[Cell, ...], ...]
+    headings: tuple[tuple[Heading, ...] | None, ...]
+    conflict: Conflict | None
+
+    def key(self) -> tuple[int, int, int]:
+        return (self.cost, self.conflicts, self.serial)
+
+
+def _reservations(constraints: Sequence[_Constraint]) -> Reservations:
+    table = Reservations()
+    for constraint in constraints:
+        if constraint[0] == "v":
+            table.forbid_vertex(constraint[1], constraint[2])
+        else:
+            table.forbid_edge(constraint[1], constraint[2], constraint[3])
+    return table
+
+
+def _avoidance(paths: Sequence[Sequence[Cell] | None], skip: int) -> Reservations:
+    table = Reservations()
+    for index, path in enumerate(paths):
+        if index != skip and path:
+            table.reserve_path(path)
+    return table
+
+
+def cbs(
+    problem: Scenario | Grid | MapfProblem,
+    starts: Sequence[Cell] | None = None,
+    goals: Sequence[Cell] | None = None,
+    *,
+    max_nodes: int | None = DEFAULT_MAX_NODES,
+    time_limit_s: float | None = DEFAULT_TIME_LIMIT_S,
+    heading_aware: bool = False,
+) -> PlanningResult:
+    """Plan every robot with Conflict-Based Search (Sharon et al. 2015): least sum of costs.
+
+    Parameters
+    ----------
+    problem:
+        A :class:`~mrmp.core.scenario.Scenario`, or a grid with ``starts``
+        and ``goals`` (see :func:`~mrmp.centralized.plan.as_problem`).
+    starts, goals:
+        With a grid: one cell per robot.
+    max_nodes:
+        Stop after generating this many constraint-tree nodes (``None``: no
+        node limit).
+    time_limit_s:
+        Stop after this many seconds (``None``: no time limit).
+    heading_aware:
+        Plan with the turn model (one tick per move forward or right turn);
+        headings start from the scenario's (NORTH for a bare grid).
+
+    Returns
+    -------
+    PlanningResult
+        ``"solved"`` with optimal paths; ``"limit"`` when a limit was reached
+        (the message names it); ``"infeasible"`` with a proof in the message
+        (see the module docstring). ``nodes`` counts generated nodes.
+
+    Raises
+    ------
+    InputError
+        If the starts or goals are invalid (see :func:`~mrmp.centralized.plan.as_problem`).
+
+    Examples
+    --------
+    >>> from mrmp.core.grid import Grid
+    >>> crowded = Grid.from_rows(["#.#", "..."])
+    >>> r = cbs(crowded, [(0, 0), (0, 1), (0, 2)], [(0, 2), (0, 1), (0, 0)], max_nodes=5)
+    >>> r.status, r.nodes, r.message
+    ('limit', 5, 'node limit of 5 reached')
+    """
+    began = time.perf_counter()
+    instance = as_problem(problem, starts, goals)
+    deadline = None if time_limit_s is None else began + time_limit_s
+
+    def result(status: str, message: str, nodes: int, node: _Node | None = None) -> PlanningResult:
+        elapsed = time.perf_counter() - began
+        paths = headings = None
+        if node is not None:
+            paths = pad_paths(node.paths)
+            if heading_aware:
+                headings = pad_headings([row for row in node.headings if row is not None])
+        return PlanningResult(status, paths, elapsed, "cbs", nodes=nodes, message=message, headings=headings)
+
+    proof = infeasibility_proof(instance)
+    if proof is not None:
+        return result("infeasible", proof, 0)
+
+    grid = instance.grid
+    count = len(instance)
+
+    def replan(index: int, constraints: Sequence[_Constraint], paths: Sequence[Sequence[Cell] | None]) -> SpaceTimeResult:
+        return space_time_astar(
+            grid,
+            instance.starts[index],
+            instance.goals[index],
+            _reservations(constraints),
+            heading_aware=heading_aware,
+            heading=instance.headings[index],
+            avoid=_avoidance(paths, index),
+            deadline=deadline,
+        )
+
+    empty: tuple[_Constraint, ...] = ()
+    root_paths: list[tuple[Cell, ...] | None] = [None] * count
+    root_headings: list[tuple[Heading, ...] | None] = [None] * count
+    for index in range(count):
+        found = replan(index, empty, root_paths)
+        if found.status == "deadline":
+            return result("limit", f"time limit of {time_limit_s:g} s reached while planning the root", 0)
+        if not found.found:  # pragma: no cover - excluded by infeasibility_proof
+            return result("infeasible", f"robot {instance.ids[index]} cannot reach its goal", 0)
+        root_paths[index] = found.path
+        root_headings[index] = found.headings
+    paths = tuple(path for path in root_paths if path is not None)
+    conflict, conflicts = first_conflict(paths)
+    root = _Node(sum(len(p) - 1 for p in paths), conflicts, 0, (empty,) * count, paths, tuple(root_headings), conflict)
+    nodes = 1
+    open_list: list[tuple[tuple[int, int, int], _Node]] = [(root.key(), root)]
+
+    while open_list:
+        _, node = heapq.heappop(open_list)
+        if node.conflict is None:
+            return result("solved", f"optimal sum of costs {node.cost} after {nodes} nodes", nodes, node)
+        if deadline is not None and time.perf_counter() > deadline:
+            return result("limit", f"time limit of {time_limit_s:g} s reached after {nodes} nodes", nodes)
+        conflict = node.conflict
+        if conflict.kind == "vertex":
+            cell = conflict.cells[0]
+            splits = ((conflict.first, ("v", cell, conflict.tick)), (conflict.second, ("v", cell, conflict.tick)))
+        else:
+            source, target = conflict.cells
+            splits = (
+                (conflict.first, ("e", source, target, conflict.tick)),
+                (conflict.second, ("e", target, source, conflict.tick)),
+            )
+        for robot, constraint in splits:
+            if max_nodes is not None and nodes >= max_nodes:
+                return result("limit", f"node limit of {max_nodes} reached", nodes)
+            constraints = node.constraints[robot] + (constraint,)
+            found = replan(robot, constraints, node.paths)
+            if found.status == "deadline":
+                return result("limit", f"time limit of {time_limit_s:g} s reached after {nodes} nodes", nodes)
+            nodes += 1
+            if not found.found or found.path is None:
+                continue
+            child_paths = node.paths[:robot] + (found.path,) + node.paths[robot + 1 :]
+            child_headings = node.headings[:robot] + (found.headings,) + node.headings[robot + 1 :]
+            child_constraints = node.constraints[:robot] + (constraints,) + node.constraints[robot + 1 :]
+            child_conflict, child_conflicts = first_conflict(child_paths)
+            cost = node.cost - (len(node.paths[robot]) - 1) + (len(found.path) - 1)
+            child = _Node(cost, child_conflicts, nodes, child_constraints, child_paths, child_headings, child_conflict)
+            heapq.heappush(open_list, (child.key(), child))
+    return result("infeasible", f"constraint tree exhausted after {nodes} nodes: no plan exists", nodes)

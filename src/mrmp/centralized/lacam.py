@@ -1,0 +1,335 @@
+"""LaCAM: lazy search over configurations, with PIBT as the successor generator.
+
+LaCAM, *Lazy Constraints Addition search for MAPF* (Okumura, "LaCAM:
+Search-Based Algorithm for Quick Multi-Agent Pathfinding", AAAI 2023), is a
+depth-first search whose nodes are *configurations* (one cell per robot):
+
+* A high-level node holds a configuration, a robot priority order and a queue
+  of *low-level nodes*. A low-level node is a set of constraints "robot ``i``
+  moves to cell ``v``", built lazily: expanding one at depth ``d`` creates one
+  child per candidate cell (the robot's neighbours and its own cell) of the
+  ``d``-th robot in the order, so the queue enumerates, breadth first, every
+  combination of moves.
+* Each time a node is visited, one low-level node is taken from its queue and
+  PIBT (:mod:`mrmp.centralized.pibt_step`) completes its constraints into a
+  whole next configuration. A new configuration becomes a new high-level node
+  on top of the stack; a known one is pushed again (it is revisited).
+* A node whose low-level queue is exhausted has generated every successor
+  configuration and is popped.
+
+The first node on top of the stack whose configuration is the goal gives the
+plan (backtracked through parents). Because the low-level queues eventually
+enumerate every successor, the search is *complete*: when the stack empties
+without reaching the goal, no plan exists and the result is ``"infeasible"``.
+
+This module follows the reference implementations of Kei18/lacam
+(``lacam/src/planner.cpp``) and Kei18/lacam3 (``hnode.cpp``, ``planner.cpp``):
+priorities start at ``dist(start, goal)`` scaled below 1, grow by one per step
+for robots away from their goals and drop to their fractional part for robots
+at them (dynamic priorities, as in PIBT); the order of a node sorts robots by
+decreasing priority; candidates of low-level expansions are shuffled with the
+seeded generator.
+
+LaCAM* (Okumura, "Improving LaCAM for Scalable Eventually Optimal Multi-Agent
+Pathfinding", IJCAI 2023), the anytime version that keeps searching after the
+first solution and rewires parents to shorten it, is available with
+``anytime=True`` (off by default); its edge cost counts the robots that are not
+resting at their goals. The swap technique of LaCAM* engineering (Okumura,
+AAMAS 2024) is on by default in the PIBT successor generator (``swap``).
+
+Examples
+--------
+Two robots in a corridor with a bay: robot ``A`` must pass robot ``B``, so
+``B`` steps aside into the bay.
+
+>>> from mrmp.core.grid import Grid
+>>> from mrmp.core.scenario import RobotSpec, Scenario
+>>> from mrmp.sim.referee import check_paths
+>>> grid = Grid.from_rows(["#.##", "...."])
+>>> scenario = Scenario(grid, (RobotSpec("A", (0, 0), (0, 3)), RobotSpec("B", (0, 1), (0, 0))))
+>>> result = lacam(scenario)
+>>> result.status, result.planner, result.sum_of_costs()
+('solved', 'lacam', 6)
+>>> check_paths(grid, dict(zip("AB", result.paths)))
+[]
+
+Two robots that must exchange places in a corridor with no room cannot:
+
+>>> swap = Scenario(Grid(1, 3), (RobotSpec("A", (0, 0), (0, 2)), RobotSpec("B", (0, 2), (0, 0))))
+>>> lacam(swap).status
+'infeasible'
+"""
+
+from __future__ import annotations
+
+import random
+import time
+from collections import deque
+
+from mrmp.centralized.pibt_step import (
+    NO_CELL,
+    PIBT,
+    cell_of,
+    distance_list,
+    flat_neighbours,
+    index_of,
+    tick_grid,
+)
+from mrmp.centralized.plan import PlanningResult
+from mrmp.core.scenario import Scenario
+from mrmp.search.distance import distance_table
+
+__all__ = ["lacam"]
+
+_LowNode = tuple[int, int, int, "_LowNode | None"]
+"""A low-level node: ``(depth, robot, cell, parent)``; the root is ``(0, -1, -1, None)``.
+
+Its constraints are the ``(robot, cell)`` pairs along the chain to the root, so
+a child costs O(1) to create (the reference copies the lists)."""
+
+_LOW_ROOT: _LowNode = (0, -1, -1, None)
+
+
+class _Node:
+    """A high-level node of LaCAM: a configuration and its lazy low-level queue."""
+
+    __slots__ = ("config", "f", "g", "h", "neighbours", "order", "parent", "priorities", "tree")
+
+    def __init__(
+        self,
+        config: tuple[int, ...],
+        parent: _Node | None,
+        priorities: list[float],
+        g: int = 0,
+        h: int = 0,
+    ) -> None:
+        self.config = config
+        self.parent = parent
+        self.priorities = priorities
+        self.order = sorted(range(len(config)), key=lambda robot: -priorities[robot])
+        self.tree: deque[_LowNode] = deque((_LOW_ROOT,))
+        self.g = g
+        self.h = h
+        self.f = g + h
+        self.neighbours: set[_Node] = set()
+
+
+def _result(status: str, start: float, nodes: int, message: str, paths: tuple[tuple[tuple[int, int], ...], ...] | None = None) -> PlanningResult:
+    return PlanningResult(status, paths, time.perf_counter() - start, "lacam", nodes=nodes, message=message)
+
+
+def lacam(
+    scenario: Scenario,
+    *,
+    time_limit_s: float | None = 10.0,
+    max_nodes: int | None = None,
+    seed: int | None = 0,
+    swap: bool = True,
+    anytime: bool = False,
+) -> PlanningResult:
+    """Plan every robot of ``scenario`` with LaCAM (Okumura, AAAI 2023).
+
+    Time is counted in ticks: every robot moves to a neighbouring cell or waits
+    in each tick; entry costs of cells and robot headings are ignored (the
+    result carries no headings).
+
+    Parameters
+    ----------
+    scenario:
+        The grid and the robots' starts and goals.
+    time_limit_s:
+        Wall-clock budget in seconds, distance tables included; ``None`` for
+        none. When it runs out before a solution, the status is ``"limit"``.
+    max_nodes:
+        Largest number of high-level configurations to generate (``None``: no
+        limit); reaching it before a solution gives ``"limit"``.
+    seed:
+        Seed of the random choices (order of low-level candidates, PIBT's
+        tie-breaks between equally distant cells). ``None`` makes no random
+        choice at all: ties keep the grid's neighbour order. Equal seeds give
+        equal plans.
+    swap:
+        Use the swap technique of LaCAM* engineering (Okumura, AAMAS 2024) in
+        PIBT; it helps robots pass each other in corridors.
+    anytime:
+        LaCAM* (Okumura, IJCAI 2023): after the first solution keep searching,
+        rewiring parents to lower the sum of costs, until the time or node limit
+        (the result is then ``"solved"`` with the best plan found) or until the
+        search space is exhausted (the plan is then optimal for LaCAM*'s cost,
+        which counts every robot not resting at its goal in each tick).
+
+    Returns
+    -------
+    PlanningResult
+        ``planner="lacam"``; ``nodes`` is the number of high-level
+        configurations generated (distinct configurations inserted in the
+        search, the start included). When solved, ``paths`` holds one path per
+        robot in scenario order, all of equal length, ending with every robot
+        at its goal. ``"infeasible"`` when the search proved no plan exists
+        (also when a goal cannot be reached from its start).
+
+    Raises
+    ------
+    ValueError
+        If a start or goal is not a free cell, or two robots share a start or
+        a goal.
+
+    Examples
+    --------
+    >>> from mrmp.core.grid import Grid
+    >>> from mrmp.core.scenario import RobotSpec, Scenario
+    >>> rotate = Scenario(Grid(2, 2), (
+    ...     RobotSpec("A", (0, 0), (0, 1)), RobotSpec("B", (0, 1), (1, 1)),
+    ...     RobotSpec("C", (1, 1), (1, 0)),
+    ... ))
+    >>> result = lacam(rotate)
+    >>> result.status, result.makespan(), result.nodes >= 2
+    ('solved', 1, True)
+    >>> lacam(rotate, max_nodes=1).status
+    'limit'
+    """
+    start_time = time.perf_counter()
+    deadline = None if time_limit_s is None else start_time + time_limit_s
+    grid = scenario.grid
+    robots = scenario.robots
+    for kind in ("start", "goal"):
+        seen: dict[tuple[int, int], str] = {}
+        for robot in robots:
+            cell = getattr(robot, kind)
+            if not grid.is_free(cell):
+                raise ValueError(f"robot {robot.id}: {kind} {cell} is not a free cell")
+            if cell in seen:
+                raise ValueError(f"robots {seen[cell]} and {robot.id} share the {kind} {cell}")
+            seen[cell] = robot.id
+    count = len(robots)
+    if count == 0:
+        return _result("solved", start_time, 0, "no robots", ())
+
+    plain = tick_grid(grid)
+    size = grid.x_size * grid.y_size
+    unreachable = size
+    tables = [distance_table(plain, robot.goal) for robot in robots]
+    for robot, table in zip(robots, tables):
+        if not table.reachable(robot.start):
+            return _result("infeasible", start_time, 0, f"robot {robot.id} cannot reach its goal {robot.goal}")
+    distances = [distance_list(table, unreachable) for table in tables]
+    neighbours = flat_neighbours(grid)
+    starts = tuple(index_of(grid, robot.start) for robot in robots)
+    goals = tuple(index_of(grid, robot.goal) for robot in robots)
+    rng = random.Random(seed) if seed is not None else None
+    pibt = PIBT(neighbours, distances, list(goals), swap=swap, rng=rng)
+    candidates = [(*row, cell) for cell, row in enumerate(neighbours)]
+    scale = 1.0 / (unreachable + 1)
+    robot_range = range(count)
+
+    def heuristic(config: tuple[int, ...]) -> int:
+        return sum(distances[robot][config[robot]] for robot in robot_range)
+
+    def edge_cost(before: tuple[int, ...], after: tuple[int, ...]) -> int:
+        return sum(1 for robot in robot_range if not (before[robot] == after[robot] == goals[robot]))
+
+    def make_node(config: tuple[int, ...], parent: _Node | None) -> _Node:
+        if parent is None:
+            priorities = [distances[robot][config[robot]] * scale for robot in robot_range]
+        else:
+            old = parent.priorities
+            priorities = [
+                old[robot] + 1 if config[robot] != goals[robot] else old[robot] - int(old[robot]) for robot in robot_range
+            ]
+        if not anytime:
+            return _Node(config, parent, priorities)
+        g = 0 if parent is None else parent.g + edge_cost(parent.config, config)
+        node = _Node(config, parent, priorities, g, heuristic(config))
+        if parent is not None:
+            node.neighbours.add(parent)
+            parent.neighbours.add(node)
+        return node
+
+    root = make_node(starts, None)
+    stack: deque[_Node] = deque((root,))
+    explored: dict[tuple[int, ...], _Node] = {starts: root}
+    goal_node: _Node | None = None
+    iterations = 0
+    stopped = ""
+
+    def rewrite(origin: _Node, reached: _Node) -> None:
+        """LaCAM*'s Dijkstra-like update of g-values from ``origin`` after it met ``reached``."""
+        origin.neighbours.add(reached)
+        queue = deque((origin,))
+        while queue:
+            node = queue.popleft()
+            for other in node.neighbours:
+                g = node.g + edge_cost(node.config, other.config)
+                if g < other.g:
+                    other.g = g
+                    other.f = g + other.h
+                    other.parent = node
+                    queue.append(other)
+                    if goal_node is not None and other.f < goal_node.f:
+                        stack.appendleft(other)
+
+    while stack:
+        if deadline is not None and time.perf_counter() > deadline:
+            stopped = f"time limit {time_limit_s} s reached"
+            break
+        iterations += 1
+        node = stack[0]
+        if anytime and goal_node is not None and node.f >= goal_node.f:
+            stack.popleft()
+            continue
+        if goal_node is None and node.config == goals:
+            goal_node = node
+            if not anytime:
+                break
+            continue
+        if not node.tree:
+            stack.popleft()
+            continue
+        low = node.tree.popleft()
+        depth = low[0]
+        if depth < count:
+            robot = node.order[depth]
+            options = list(candidates[node.config[robot]])
+            if rng is not None:
+                rng.shuffle(options)
+            node.tree.extend((depth + 1, robot, cell, low) for cell in options)
+        target = [NO_CELL] * count
+        constraint: _LowNode | None = low
+        while constraint is not None and constraint[0] > 0:
+            target[constraint[1]] = constraint[2]
+            constraint = constraint[3]
+        if not pibt.generate(node.config, target, node.order):
+            continue
+        config = tuple(target)
+        known = explored.get(config)
+        if known is not None:
+            if anytime:
+                rewrite(node, known)
+            stack.appendleft(known)
+            continue
+        if max_nodes is not None and len(explored) >= max_nodes:
+            stopped = f"node limit {max_nodes} reached"
+            break
+        new = make_node(config, node)
+        explored[config] = new
+        stack.appendleft(new)
+
+    nodes = len(explored)
+    if goal_node is None:
+        if stopped:
+            return _result("limit", start_time, nodes, f"{stopped} after {iterations} iterations, no solution")
+        return _result("infeasible", start_time, nodes, f"search space exhausted after {iterations} iterations")
+    configs: list[tuple[int, ...]] = []
+    cursor: _Node | None = goal_node
+    while cursor is not None:
+        configs.append(cursor.config)
+        cursor = cursor.parent
+    configs.reverse()
+    paths = tuple(tuple(cell_of(grid, config[robot]) for config in configs) for robot in robot_range)
+    if not anytime:
+        message = f"first solution after {iterations} iterations"
+    elif stopped:
+        message = f"best solution when the {stopped} (LaCAM*, cost {goal_node.g})"
+    else:
+        message = f"optimal for LaCAM*'s cost {goal_node.g} (search space exhausted)"
+    return _result("solved", start_time, nodes, message, paths)

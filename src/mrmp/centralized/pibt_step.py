@@ -1,0 +1,573 @@
+"""PIBT as a configuration generator: one collision-free step for every robot at once.
+
+PIBT, *Priority Inheritance with Backtracking* (Okumura, Machida, Défago and
+Tamura, "Priority Inheritance with Backtracking for Iterative Multi-agent Path
+Finding", IJCAI 2019; extended in Artificial Intelligence 310, 2022), decides
+the next cell of every robot from the current configuration:
+
+* robots are served in priority order; a robot tries its candidate cells (its
+  free neighbours and its own cell) from nearest to farthest from its goal;
+* a robot never takes a cell another robot has already reserved for the next
+  step, nor the cell of a robot that is moving into its own cell (no swap);
+* when a robot ``i`` reserves the cell of a robot ``j`` that has not decided
+  yet, ``j`` *inherits* ``i``'s priority and decides at once, and must leave
+  that cell; when ``j`` cannot move anywhere it stays, and ``i`` *backtracks*
+  to its next candidate.
+
+LaCAM (Okumura, "LaCAM: Search-Based Algorithm for Quick Multi-Agent
+Pathfinding", AAAI 2023) uses PIBT as its successor generator *under
+constraints*: some robots' next cells are fixed in advance and PIBT plans the
+others around them, or reports that it cannot (:meth:`PIBT.generate`).
+
+**Swap.** PIBT alone cannot make two robots exchange places in a corridor
+(each wants the other's cell, and swaps are forbidden). The *swap* technique
+of LaCAM* engineering (Okumura, "Engineering LaCAM*: Towards Real-Time,
+Large-Scale, and Near-Optimal Multi-Agent Pathfinding", AAMAS 2024) detects
+such a head-on situation, makes the robot walk backwards (its candidates are
+tried in reverse order) and *pulls* the other robot behind it, until the pair
+reaches a cell of degree three or more where they can pass each other. It is
+off by default here and turned on with ``swap=True``; it follows
+``lacam3/src/pibt.cpp`` of Kei18/lacam3 (``is_swap_required``,
+``is_swap_possible``, the pull after a first-choice move).
+
+The inner loop works on flat cell indices (``x * y_size + y``, the indexing of
+:mod:`mrmp.search.distance`), neighbour tuples precomputed once per grid and
+integer distance lists per robot. Priority inheritance is run with an explicit
+stack, so chains of any length need no deep Python recursion.
+
+Examples
+--------
+Two robots in a corridor with a bay above its middle cell: robot 0 must
+pass robot 1, so robot 1 steps into the bay (priority inheritance pushes it
+there, since it may neither stay nor swap):
+
+>>> from mrmp.core.grid import Grid
+>>> grid = Grid.from_rows(["#.#", "..."])
+>>> pibt_step(grid, [(0, 0), (0, 1)], [(0, 2), (0, 0)])
+[(0, 1), (1, 1)]
+
+A robot whose next cell is fixed gets exactly that cell:
+
+>>> pibt_step(grid, [(0, 0), (0, 1)], [(0, 2), (0, 0)], constraints={1: (0, 2)})
+[(0, 1), (0, 2)]
+
+Constraints that cannot be met (here: a swap) give ``None``:
+
+>>> pibt_step(grid, [(0, 0), (0, 1)], [(0, 2), (0, 0)], constraints={0: (0, 1), 1: (0, 0)}) is None
+True
+"""
+
+from __future__ import annotations
+
+import math
+import random
+from collections.abc import Mapping, Sequence
+
+import numpy as np
+
+from mrmp.core.cell import Cell
+from mrmp.core.grid import Grid
+from mrmp.search.distance import DistanceTable, distance_table
+
+__all__ = [
+    "NO_AGENT",
+    "NO_CELL",
+    "PIBT",
+    "cell_of",
+    "distance_list",
+    "flat_neighbours",
+    "index_of",
+    "pibt_step",
+    "tick_grid",
+]
+
+NO_AGENT = -1
+"""Marks a cell that no robot occupies (or reserves)."""
+NO_CELL = -1
+"""Marks a robot whose next cell is not decided yet."""
+
+
+def index_of(grid: Grid, cell: Cell) -> int:
+    """The flat index ``x * y_size + y`` of ``cell``.
+
+    >>> index_of(Grid(3, 4), (2, 1))
+    9
+    """
+    return cell[0] * grid.y_size + cell[1]
+
+
+def cell_of(grid: Grid, index: int) -> Cell:
+    """The cell of flat index ``index`` (inverse of :func:`index_of`).
+
+    >>> cell_of(Grid(3, 4), 9)
+    (2, 1)
+    """
+    return divmod(index, grid.y_size)
+
+
+def flat_neighbours(grid: Grid) -> list[tuple[int, ...]]:
+    """For every flat index, the flat indices of its free 4-neighbours (NORTH, EAST, SOUTH, WEST).
+
+    Blocked cells get an empty tuple.
+
+    >>> flat_neighbours(Grid.from_rows(["..", ".#"]))
+    [(2,), (), (3, 0), (2,)]
+    """
+    y_size = grid.y_size
+    result: list[tuple[int, ...]] = []
+    for x in range(grid.x_size):
+        for y in range(y_size):
+            if grid.is_free((x, y)):
+                result.append(tuple(nx * y_size + ny for nx, ny in grid.neighbours((x, y))))
+            else:
+                result.append(())
+    return result
+
+
+def tick_grid(grid: Grid) -> Grid:
+    """``grid`` itself when every cell costs 1 to enter, else a copy without costs.
+
+    Planners that count time in ticks (one move or wait per tick) rank cells by
+    the number of moves to the goal, whatever the entry costs.
+
+    >>> grid = Grid(2, 2, costs={(1, 1): 5.0})
+    >>> tick_grid(grid).has_costs, tick_grid(Grid(2, 2)) is not None
+    (False, True)
+    """
+    if not grid.has_costs:
+        return grid
+    return Grid(grid.x_size, grid.y_size, grid.blocked_cells(), name=grid.name)
+
+
+def distance_list(table: DistanceTable, unreachable: int) -> list[int]:
+    """A distance table as a flat list of ints, ``unreachable`` where it is infinite.
+
+    >>> distance_list(distance_table(Grid.from_rows([".#."]), (0, 0)), 99)
+    [0, 99, 99]
+    """
+    values = table.array.ravel()
+    return np.where(np.isfinite(values), values, unreachable).astype(np.int64).tolist()
+
+
+class PIBT:
+    """A reusable PIBT configuration generator on flat cell indices.
+
+    Parameters
+    ----------
+    neighbours:
+        For every flat cell index, the indices of the cells one move away
+        (see :func:`flat_neighbours`).
+    distances:
+        For every robot, the distance (number of moves) from every flat cell to
+        its goal, a large number where the goal cannot be reached (see
+        :func:`distance_list`).
+    goals:
+        Every robot's goal, as a flat index.
+    swap:
+        Whether to use the swap technique of LaCAM* engineering (Okumura,
+        AAMAS 2024); see the module docstring.
+    rng:
+        Breaks ties between equally distant candidate cells at random when
+        given; otherwise ties keep the neighbour order (NORTH, EAST, SOUTH,
+        WEST, then staying), so results are deterministic.
+
+    Notes
+    -----
+    :meth:`generate` follows ``PIBT::set_new_config`` and ``funcPIBT`` of the
+    reference implementations (Kei18/pypibt, Kei18/lacam, Kei18/lacam3): the
+    candidates of robot ``i`` at ``v`` are ``v`` and its neighbours sorted by
+    distance to ``i``'s goal; a candidate is skipped when reserved, or when its
+    occupant already moves into ``v``; after reserving a cell whose occupant
+    has not decided, that occupant is planned at once (priority inheritance)
+    and on its failure the next candidate is tried (backtracking). A robot with
+    no candidate left stays where it is and reports failure.
+
+    Examples
+    --------
+    A 1x3 corridor, flat indices 0, 1, 2. Robot 0 at 0 heads for 2; robot 1
+    is at home on 1. Robot 0 (served first) asks for cell 1, robot 1 inherits
+    its priority and, unable to stay or to swap, steps on to 2:
+
+    >>> neighbours = [(1,), (2, 0), (1,)]
+    >>> pibt = PIBT(neighbours, [[2, 1, 0], [1, 0, 1]], [2, 1])
+    >>> pibt.step([0, 1], order=[0, 1])
+    [1, 2]
+
+    When robot 1 is constrained to stay, robot 0 waits:
+
+    >>> pibt.step([0, 1], order=[0, 1], constraints={1: 1})
+    [0, 1]
+    """
+
+    __slots__ = ("_candidates", "_distances", "_goals", "_neighbours", "_occ_next", "_occ_now", "_random", "swap")
+
+    def __init__(
+        self,
+        neighbours: Sequence[tuple[int, ...]],
+        distances: Sequence[Sequence[int]],
+        goals: Sequence[int],
+        *,
+        swap: bool = False,
+        rng: random.Random | None = None,
+    ) -> None:
+        if len(distances) != len(goals):
+            raise ValueError(f"{len(distances)} distance lists for {len(goals)} goals")
+        self._neighbours = list(neighbours)
+        self._candidates = [(*row, index) for index, row in enumerate(self._neighbours)]
+        self._distances = list(distances)
+        self._goals = list(goals)
+        self._occ_now = [NO_AGENT] * len(self._neighbours)
+        self._occ_next = [NO_AGENT] * len(self._neighbours)
+        self._random = rng.random if rng is not None else None
+        self.swap = swap
+
+    @property
+    def clean(self) -> bool:
+        """Whether no cell is marked occupied (true between calls; for tests).
+
+        >>> PIBT([(1,), (0,)], [[1, 0]], [1]).clean
+        True
+        """
+        return all(a == NO_AGENT for a in self._occ_now) and all(a == NO_AGENT for a in self._occ_next)
+
+    def step(
+        self,
+        current: Sequence[int],
+        order: Sequence[int],
+        constraints: Mapping[int, int] | None = None,
+    ) -> list[int] | None:
+        """The next configuration, or ``None`` when PIBT fails under ``constraints``.
+
+        Parameters
+        ----------
+        current:
+            Every robot's flat cell.
+        order:
+            Robot indices, highest priority first; every robot must appear.
+        constraints:
+            Robots whose next cell is fixed: ``{robot: flat cell}``.
+
+        Returns
+        -------
+        list of int or None
+            Every robot's next flat cell (collision-free, constrained robots on
+            their constrained cells), or ``None``.
+
+        Examples
+        --------
+        >>> PIBT([(1,), (0,)], [[1, 0]], [1]).step([0], [0])
+        [1]
+        """
+        target = [NO_CELL] * len(current)
+        for robot, cell in (constraints or {}).items():
+            target[robot] = cell
+        return target if self.generate(current, target, order) else None
+
+    def generate(self, current: Sequence[int], target: list[int], order: Sequence[int]) -> bool:
+        """Fill ``target`` (``NO_CELL`` where free, a flat cell where constrained) in place.
+
+        This is ``set_new_config`` of LaCAM: check that the constrained cells
+        are free of vertex and swap collisions among themselves, then run PIBT
+        for every unconstrained robot in ``order``.
+
+        Parameters
+        ----------
+        current:
+            Every robot's flat cell; cells must be distinct.
+        target:
+            One entry per robot: its constrained next cell (which must be
+            ``current`` or a neighbour of it), or :data:`NO_CELL`. Filled in.
+        order:
+            Robot indices, highest priority first.
+
+        Returns
+        -------
+        bool
+            Whether ``target`` now holds a valid next configuration. On
+            ``False`` its content is unspecified.
+
+        Examples
+        --------
+        >>> pibt = PIBT([(1,), (0, 2), (1,)], [[2, 1, 0], [0, 1, 2]], [2, 0])
+        >>> target = [NO_CELL, 2]
+        >>> pibt.generate([0, 1], target, [0, 1]), target
+        (True, [1, 2])
+        >>> target = [1, 0]
+        >>> pibt.generate([0, 1], target, [0, 1])
+        False
+        """
+        occ_now, occ_next = self._occ_now, self._occ_next
+        count = len(current)
+        success = True
+        for robot in range(count):
+            occ_now[current[robot]] = robot
+        for robot in range(count):
+            cell = target[robot]
+            if cell == NO_CELL:
+                continue
+            if occ_next[cell] != NO_AGENT:
+                success = False
+                break
+            other = occ_now[cell]
+            if other != NO_AGENT and other != robot and target[other] == current[robot]:
+                success = False
+                break
+            occ_next[cell] = robot
+        if success:
+            for robot in order:
+                if target[robot] == NO_CELL and not self._plan(robot, current, target):
+                    success = False
+                    break
+        for robot in range(count):
+            occ_now[current[robot]] = NO_AGENT
+            cell = target[robot]
+            if cell != NO_CELL:
+                occ_next[cell] = NO_AGENT
+        return success
+
+    # -- PIBT proper ------------------------------------------------------------
+
+    def _sorted_candidates(self, robot: int, current: Sequence[int], target: list[int]) -> tuple[list[int], int]:
+        """Robot's candidate cells, best first, and the robot to pull (or ``NO_AGENT``)."""
+        candidates = list(self._candidates[current[robot]])
+        dist = self._distances[robot]
+        noise = self._random
+        if noise is None:
+            candidates.sort(key=dist.__getitem__)
+        else:
+            candidates.sort(key=lambda cell: dist[cell] + noise())
+        pulled = NO_AGENT
+        if self.swap:
+            pulled = self._swap_agent(robot, candidates, current, target)
+            if pulled != NO_AGENT:
+                candidates.reverse()
+        return candidates, pulled
+
+    def _plan(self, root: int, current: Sequence[int], target: list[int]) -> bool:
+        """``funcPIBT`` for ``root``, priority inheritance on an explicit stack."""
+        occ_now, occ_next = self._occ_now, self._occ_next
+        stack: list[tuple[int, list[int], int, int]] = []
+        robot = root
+        candidates, pulled = self._sorted_candidates(robot, current, target)
+        k = 0
+        while True:
+            here = current[robot]
+            child = NO_AGENT
+            success = False
+            size = len(candidates)
+            while k < size:
+                cell = candidates[k]
+                if occ_next[cell] != NO_AGENT:
+                    k += 1
+                    continue
+                occupant = occ_now[cell]
+                if occupant != NO_AGENT and target[occupant] == here:
+                    k += 1  # the occupant moves into our cell: taking its cell would swap
+                    continue
+                occ_next[cell] = robot
+                target[robot] = cell
+                if occupant != NO_AGENT and occupant != robot and target[occupant] == NO_CELL:
+                    child = occupant  # priority inheritance
+                else:
+                    success = True
+                break
+            if child != NO_AGENT:
+                stack.append((robot, candidates, k, pulled))
+                robot = child
+                candidates, pulled = self._sorted_candidates(robot, current, target)
+                k = 0
+                continue
+            if not success:  # no candidate left: stay
+                occ_next[here] = robot
+                target[robot] = here
+            while True:  # return ``success`` to the robots that pushed this one
+                if success and k == 0 and pulled != NO_AGENT:
+                    self._pull(robot, pulled, current, target)
+                if not stack:
+                    return success
+                robot, candidates, k, pulled = stack.pop()
+                if not success:
+                    k += 1  # backtrack: the pushed robot could not leave
+                    break
+
+    # -- swap (LaCAM* engineering, Okumura AAMAS 2024) -----------------------------
+
+    def _pull(self, robot: int, pulled: int, current: Sequence[int], target: list[int]) -> None:
+        """Move ``pulled`` into the cell ``robot`` leaves, if both are still possible."""
+        here = current[robot]
+        if target[pulled] == NO_CELL and self._occ_next[here] == NO_AGENT:
+            self._occ_next[here] = pulled
+            target[pulled] = here
+
+    def _swap_agent(self, robot: int, candidates: list[int], current: Sequence[int], target: list[int]) -> int:
+        """``is_swap_required_and_possible``: the robot to pull behind ``robot``, or ``NO_AGENT``."""
+        occ_now = self._occ_now
+        best = candidates[0]
+        here = current[robot]
+        other = occ_now[best]
+        if (
+            other != NO_AGENT
+            and other != robot
+            and target[other] == NO_CELL
+            and self._swap_required(robot, other, here, current[other])
+            and self._swap_possible(current[other], here)
+        ):
+            return other
+        if best != here:  # "clear" operation, as in push and swap
+            for cell in self._neighbours[here]:
+                other = occ_now[cell]
+                if (
+                    other != NO_AGENT
+                    and best != current[other]
+                    and self._swap_required(other, robot, here, best)
+                    and self._swap_possible(best, here)
+                ):
+                    return other
+        return NO_AGENT
+
+    def _open_neighbours(self, cell: int, behind: int) -> tuple[int, int]:
+        """How many ways lead on from ``cell`` (not back to ``behind``, not into a settled dead end), and one of them."""
+        neighbours, occ_now, goals = self._neighbours, self._occ_now, self._goals
+        row = neighbours[cell]
+        count = len(row)
+        onward = NO_CELL
+        for next_cell in row:
+            occupant = occ_now[next_cell]
+            if next_cell == behind or (
+                len(neighbours[next_cell]) == 1 and occupant != NO_AGENT and goals[occupant] == next_cell
+            ):
+                count -= 1
+            else:
+                onward = next_cell
+        return count, onward
+
+    def _swap_required(self, pusher: int, puller: int, pusher_cell: int, puller_cell: int) -> bool:
+        """Whether ``pusher`` and ``puller`` are head-on in a corridor and must pass each other."""
+        dist = self._distances[pusher]
+        for _ in range(len(self._neighbours)):
+            if not dist[puller_cell] < dist[pusher_cell]:
+                break
+            count, onward = self._open_neighbours(puller_cell, pusher_cell)
+            if count >= 2:
+                return False  # they can pass at puller_cell
+            if count <= 0:
+                break
+            pusher_cell, puller_cell = puller_cell, onward
+        back = self._distances[puller]
+        return back[pusher_cell] < back[puller_cell] and (
+            dist[pusher_cell] == 0 or dist[puller_cell] < dist[pusher_cell]
+        )
+
+    def _swap_possible(self, pusher_origin: int, puller_origin: int) -> bool:
+        """Whether walking back from ``puller_origin`` (away from ``pusher_origin``) reaches a passing place."""
+        pusher_cell, puller_cell = pusher_origin, puller_origin
+        for _ in range(len(self._neighbours)):
+            if puller_cell == pusher_origin:
+                return False  # went round a loop
+            count, onward = self._open_neighbours(puller_cell, pusher_cell)
+            if count >= 2:
+                return True
+            if count <= 0:
+                return False
+            pusher_cell, puller_cell = puller_cell, onward
+        return False
+
+
+def pibt_step(
+    grid: Grid,
+    config: Sequence[Cell],
+    goals: Sequence[Cell],
+    *,
+    priorities: Sequence[float] | None = None,
+    constraints: Mapping[int, Cell] | None = None,
+    tables: Sequence[DistanceTable] | None = None,
+    swap: bool = False,
+    seed: int | None = None,
+) -> list[Cell] | None:
+    """One PIBT step on cells: every robot's next cell, or ``None`` if PIBT fails.
+
+    A convenience wrapper around :class:`PIBT` (Okumura et al., IJCAI 2019 /
+    AIJ 2022); planners that step many times should build a :class:`PIBT`
+    once and work on flat indices.
+
+    Parameters
+    ----------
+    grid:
+        The map; entry costs are ignored (distances count moves).
+    config:
+        Every robot's cell; cells must be free and distinct.
+    goals:
+        Every robot's goal.
+    priorities:
+        Higher moves first; ties go to the lower index. By default, robots
+        farther from their goals come first (LaCAM's initial priorities).
+    constraints:
+        Robots whose next cell is fixed, ``{robot index: cell}``; each cell must
+        be the robot's own cell or a neighbour of it.
+    tables:
+        Every robot's distance table to its goal (computed when not given).
+    swap:
+        Use the swap technique of LaCAM* engineering (Okumura, AAMAS 2024).
+    seed:
+        Seed of a random tie-break between equally distant cells; ``None``
+        breaks ties by neighbour order.
+
+    Returns
+    -------
+    list of Cell or None
+        The next configuration (no vertex or swap collision, constrained robots
+        on their cells), or ``None`` when the constraints collide or a robot
+        cannot make way for them.
+
+    Raises
+    ------
+    ValueError
+        If the sizes disagree, a cell is not free, two robots share a cell, or
+        a constrained cell is not reachable in one move.
+
+    Examples
+    --------
+    >>> from mrmp.core.grid import Grid
+    >>> pibt_step(Grid(1, 4), [(0, 0), (0, 1)], [(0, 1), (0, 3)])
+    [(0, 1), (0, 2)]
+    >>> pibt_step(Grid(1, 2), [(0, 0), (0, 1)], [(0, 1), (0, 0)])  # no room to swap: both wait
+    [(0, 0), (0, 1)]
+    """
+    if len(config) != len(goals):
+        raise ValueError(f"{len(config)} cells for {len(goals)} goals")
+    for cell in (*config, *goals):
+        if not grid.is_free(cell):
+            raise ValueError(f"cell {cell} is not a free cell of the grid")
+    if len(set(config)) != len(config):
+        raise ValueError("two robots share a cell")
+    plain = tick_grid(grid)
+    if tables is None:
+        tables = [distance_table(plain, goal) for goal in goals]
+    elif len(tables) != len(goals):
+        raise ValueError(f"{len(tables)} distance tables for {len(goals)} goals")
+    unreachable = grid.x_size * grid.y_size
+    neighbours = flat_neighbours(grid)
+    current = [index_of(grid, cell) for cell in config]
+    fixed: dict[int, int] = {}
+    for robot, cell in (constraints or {}).items():
+        index = index_of(grid, cell)
+        if not 0 <= robot < len(config):
+            raise ValueError(f"constraint on robot {robot}, which does not exist")
+        if index != current[robot] and index not in neighbours[current[robot]]:
+            raise ValueError(f"robot {robot} cannot reach {cell} from {config[robot]} in one move")
+        fixed[robot] = index
+    if priorities is None:
+        priorities = [table.distance(cell) if math.isfinite(table.distance(cell)) else unreachable
+                      for table, cell in zip(tables, config)]
+    elif len(priorities) != len(config):
+        raise ValueError(f"{len(priorities)} priorities for {len(config)} robots")
+    order = sorted(range(len(config)), key=lambda robot: -priorities[robot])
+    pibt = PIBT(
+        neighbours,
+        [distance_list(table, unreachable) for table in tables],
+        [index_of(grid, goal) for goal in goals],
+        swap=swap,
+        rng=random.Random(seed) if seed is not None else None,
+    )
+    result = pibt.step(current, order, fixed)
+    return None if result is None else [cell_of(grid, index) for index in result]

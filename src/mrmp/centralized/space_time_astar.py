@@ -1,0 +1,485 @@
+"""Space-time A*: plan one robot through time around reservations and constraints.
+
+Space-time A* (Silver 2005, "Cooperative Pathfinding", AIIDE) searches states
+``(cell, t)``: each tick a robot waits or moves to a free 4-neighbour, and a
+:class:`Reservations` table says which states and moves other robots (or a
+constraint-tree node of CBS) forbid:
+
+* a *vertex* entry ``(cell, t)``: the robot must not be on ``cell`` at tick
+  ``t``;
+* an *edge* entry ``(u, v, t)``: the robot must not move from ``u`` (tick
+  ``t - 1``) to ``v`` (tick ``t``); prioritized planning stores the reverse of
+  every move of an earlier robot here, which forbids swaps;
+* a *parking* entry ``cell -> T``: ``cell`` is occupied at every tick from
+  ``T`` on (a robot that has arrived at its goal and stays there).
+
+A path ends when the robot reaches its goal and may stay there forever: its
+arrival tick must come after every vertex entry on its goal (someone passing
+its goal later), and no one may be parked on its goal. Prioritized planning
+(Silver 2005; Erdmann & Lozano-Perez 1987, "On multiple moving objects",
+Algorithmica) passes the paths of the robots planned before; Conflict-Based
+Search (Sharon et al. 2015) passes its negative constraints.
+
+**Search.** A* (Hart, Nilsson & Raphael 1968) on ``f = max(t + h, T_goal)``,
+where ``h`` is the exact distance in ticks to the goal on the static grid
+(:func:`mrmp.search.distance.distance_table` on the grid without cell costs:
+the planners count ticks, not entry costs) and ``T_goal`` is the earliest tick
+at which the robot may settle on its goal. Both parts are consistent, so the
+first goal state popped is a path of least arrival tick. After the last tick
+``T_last`` mentioned by any entry the world is static, so all states of one
+cell with ``t > T_last`` are merged: the search is finite even without a
+horizon, and an exhausted search proves that no path exists. Ties on ``f`` go
+to fewer hits of an optional ``avoid`` table (CBS's conflict-avoidance table,
+Standley 2010), then to smaller ``h``, then to generation order: the result is
+deterministic.
+
+**Heading-aware mode** (``heading_aware=True``): states are
+``(cell, heading, t)`` and each tick the robot does one of: wait, turn right in
+place (heading ``h`` becomes ``h + 1`` mod 4, thesis section 3.3), or move one
+cell forward into the cell ahead. So one tick is one move *or* one right turn,
+and a robot changes direction only after spending ticks turning in place. The
+heuristic is the exact static distance over ``(cell, heading)`` states
+(:func:`heading_distance_table`). Reservations still speak of cells: a robot
+turning in place occupies its cell like a waiting one.
+
+Examples
+--------
+>>> from mrmp.core.grid import Grid
+>>> grid = Grid.from_rows(["...", "...", "..."])
+>>> reservations = Reservations()
+>>> reservations.forbid_vertex((0, 1), 1)
+>>> result = space_time_astar(grid, (0, 0), (0, 2), reservations)
+>>> result.status, result.path
+('found', ((0, 0), (0, 0), (0, 1), (0, 2)))
+>>> blocked = Reservations()
+>>> blocked.park((0, 1), 0)
+>>> space_time_astar(Grid.from_rows(["..."]), (0, 0), (0, 2), blocked).status
+'unreachable'
+"""
+
+from __future__ import annotations
+
+import heapq
+import math
+import time
+from collections import deque
+from collections.abc import Iterable, Sequence
+from dataclasses import dataclass
+from functools import lru_cache
+
+from mrmp.core.cell import Cell
+from mrmp.core.grid import Grid
+from mrmp.core.heading import HEADINGS, Heading
+from mrmp.search.distance import DistanceTable, distance_table
+
+__all__ = [
+    "SEARCH_STATUSES",
+    "Reservations",
+    "SpaceTimeResult",
+    "heading_distance_table",
+    "hop_distance_table",
+    "space_time_astar",
+]
+
+SEARCH_STATUSES = ("found", "unreachable", "horizon", "deadline", "expansions")
+"""How a space-time search ends: a path was ``found``; the goal is
+``unreachable`` under the reservations (proved: the search was exhausted);
+the ``horizon`` ``max_time`` cut the search before a path was found; the
+``deadline`` passed; the ``expansions`` limit was reached."""
+
+_DEADLINE_CHECK_EVERY = 512
+"""Expansions between two reads of the clock."""
+
+
+class Reservations:
+    """Forbidden states and moves for one robot: vertex, edge and parking entries.
+
+    See the module docstring for the meaning of each kind of entry.
+
+    Examples
+    --------
+    >>> table = Reservations()
+    >>> table.reserve_path([(0, 0), (0, 1), (0, 2)])
+    >>> table.blocks((0, 1), 1), table.blocks((0, 2), 7), table.blocks((0, 2), 1)
+    (True, True, False)
+    >>> table.forbids_move((0, 2), (0, 1), 2)   # a swap with the reserved robot
+    True
+    >>> table.last_time, table.last_vertex_time((0, 1))
+    (2, 1)
+    """
+
+    __slots__ = ("vertex", "edge", "parked", "_last_vertex", "last_time")
+
+    def __init__(self) -> None:
+        self.vertex: set[tuple[Cell, int]] = set()
+        self.edge: set[tuple[Cell, Cell, int]] = set()
+        self.parked: dict[Cell, int] = {}
+        self._last_vertex: dict[Cell, int] = {}
+        self.last_time = -1
+        """The largest tick any entry mentions (-1 when empty)."""
+
+    @classmethod
+    def from_entries(
+        cls,
+        vertex: Iterable[tuple[Cell, int]] = (),
+        edge: Iterable[tuple[Cell, Cell, int]] = (),
+        parked: Iterable[tuple[Cell, int]] = (),
+    ) -> Reservations:
+        """A table holding the given entries.
+
+        >>> Reservations.from_entries(vertex=[((1, 1), 3)]).blocks((1, 1), 3)
+        True
+        """
+        table = cls()
+        for cell, tick in vertex:
+            table.forbid_vertex(cell, tick)
+        for source, target, tick in edge:
+            table.forbid_edge(source, target, tick)
+        for cell, tick in parked:
+            table.park(cell, tick)
+        return table
+
+    def forbid_vertex(self, cell: Cell, tick: int) -> None:
+        """Forbid standing on ``cell`` at ``tick``."""
+        self.vertex.add((cell, tick))
+        if tick > self._last_vertex.get(cell, -1):
+            self._last_vertex[cell] = tick
+        if tick > self.last_time:
+            self.last_time = tick
+
+    def forbid_edge(self, source: Cell, target: Cell, tick: int) -> None:
+        """Forbid moving from ``source`` at ``tick - 1`` to ``target`` at ``tick``."""
+        self.edge.add((source, target, tick))
+        if tick > self.last_time:
+            self.last_time = tick
+
+    def park(self, cell: Cell, tick: int) -> None:
+        """Mark ``cell`` occupied at every tick from ``tick`` on (keeps the earliest)."""
+        if tick < self.parked.get(cell, math.inf):
+            self.parked[cell] = tick
+        if tick > self.last_time:
+            self.last_time = tick
+
+    def reserve_path(self, path: Sequence[Cell]) -> None:
+        """Reserve a whole path of another robot, which then stays on its last cell forever.
+
+        Adds a vertex entry per tick, an edge entry for the reverse of every
+        move (forbidding swaps) and a parking entry on the last cell from the
+        tick the path ends.
+        """
+        last = len(path) - 1
+        for tick in range(last):
+            self.forbid_vertex(path[tick], tick)
+        for tick in range(1, last + 1):
+            if path[tick] != path[tick - 1]:
+                self.forbid_edge(path[tick], path[tick - 1], tick)
+        if last >= 0:
+            self.park(path[last], last)
+
+    def blocks(self, cell: Cell, tick: int) -> bool:
+        """Whether standing on ``cell`` at ``tick`` is forbidden."""
+        return (cell, tick) in self.vertex or self.parked.get(cell, math.inf) <= tick
+
+    def forbids_move(self, source: Cell, target: Cell, tick: int) -> bool:
+        """Whether the move ``source -> target`` arriving at ``tick`` is forbidden (edge entries only)."""
+        return (source, target, tick) in self.edge
+
+    def last_vertex_time(self, cell: Cell) -> int:
+        """The last tick at which a vertex entry forbids ``cell`` (-1 if none)."""
+        return self._last_vertex.get(cell, -1)
+
+    def __len__(self) -> int:
+        return len(self.vertex) + len(self.edge) + len(self.parked)
+
+    def __repr__(self) -> str:
+        return f"<Reservations {len(self.vertex)} vertex, {len(self.edge)} edge, {len(self.parked)} parked>"
+
+
+@dataclass(frozen=True)
+class SpaceTimeResult:
+    """The outcome of one space-time search.
+
+    Attributes
+    ----------
+    status:
+        One of :data:`SEARCH_STATUSES`.
+    path:
+        When found: one cell per tick from the start (tick 0) to the tick the
+        robot settles on its goal; ``None`` otherwise.
+    headings:
+        In heading-aware mode, the heading at each tick of ``path``.
+    expansions:
+        States taken from the open list and expanded.
+    """
+
+    status: str
+    path: tuple[Cell, ...] | None
+    headings: tuple[Heading, ...] | None
+    expansions: int
+
+    @property
+    def found(self) -> bool:
+        """Whether a path was found."""
+        return self.status == "found"
+
+    @property
+    def cost(self) -> int:
+        """The arrival tick (path length minus one).
+
+        Raises
+        ------
+        ValueError
+            If no path was found.
+        """
+        if self.path is None:
+            raise ValueError(f"no path ({self.status})")
+        return len(self.path) - 1
+
+
+def _plain_grid(grid: Grid) -> Grid:
+    """The same grid with every entry cost 1 (planners count ticks)."""
+    if not grid.has_costs:
+        return grid
+    return Grid(grid.x_size, grid.y_size, grid.blocked_cells(), name=grid.name)
+
+
+def hop_distance_table(grid: Grid, goal: Cell) -> DistanceTable:
+    """The number of moves from every cell to ``goal``, ignoring entry costs.
+
+    >>> hop_distance_table(Grid(2, 2, costs={(0, 1): 9.0}), (0, 1)).distance((1, 0))
+    2.0
+    """
+    return distance_table(_plain_grid(grid), goal)
+
+
+@lru_cache(maxsize=64)
+def heading_distance_table(grid: Grid, goal: Cell) -> dict[tuple[Cell, Heading], int]:
+    """Ticks from every ``(cell, heading)`` to ``goal`` under the turn model, on the static grid.
+
+    One tick moves one cell ahead or turns right once; the goal may be reached
+    facing any heading. Computed by a breadth-first search backwards from the
+    four goal states (Moore 1959). States that cannot reach the goal are left
+    out. Cached per grid and goal.
+
+    >>> table = heading_distance_table(Grid(1, 3), (0, 2))
+    >>> table[((0, 0), Heading.EAST)], table[((0, 0), Heading.NORTH)], table[((0, 0), Heading.SOUTH)]
+    (2, 3, 5)
+    """
+    distances: dict[tuple[Cell, Heading], int] = {}
+    queue: deque[tuple[Cell, Heading]] = deque()
+    for heading in HEADINGS:
+        distances[(goal, heading)] = 0
+        queue.append((goal, heading))
+    while queue:
+        state = queue.popleft()
+        cell, heading = state
+        d = distances[state] + 1
+        dx, dy = heading.delta
+        behind = (cell[0] - dx, cell[1] - dy)
+        predecessors = [(Heading((int(heading) - 2) % 4 + 1), cell)]  # turned right into `heading`
+        if grid.is_free(behind):
+            predecessors.append((heading, behind))
+        for previous_heading, previous_cell in predecessors:
+            key = (previous_cell, previous_heading)
+            if key not in distances:
+                distances[key] = d
+                queue.append(key)
+    return distances
+
+
+def space_time_astar(
+    grid: Grid,
+    start: Cell,
+    goal: Cell,
+    reservations: Reservations | None = None,
+    *,
+    heading_aware: bool = False,
+    heading: Heading = Heading.NORTH,
+    max_time: int | None = None,
+    avoid: Reservations | None = None,
+    deadline: float | None = None,
+    max_expansions: int | None = None,
+) -> SpaceTimeResult:
+    """Plan one robot from ``start`` to ``goal`` through time, respecting ``reservations``.
+
+    Space-time A* (Silver 2005, "Cooperative Pathfinding"); see the module
+    docstring for the state space, the goal condition and the search.
+
+    Parameters
+    ----------
+    grid:
+        The map; only its free cells matter (entry costs are ignored, one move
+        or one wait takes one tick).
+    start, goal:
+        Free cells.
+    reservations:
+        What the robot must avoid; ``None`` for nothing.
+    heading_aware:
+        Plan states ``(cell, heading, t)``, where one tick is one move forward,
+        one right turn in place, or a wait.
+    heading:
+        The robot's heading at tick 0 (heading-aware mode only).
+    max_time:
+        The horizon: no state later than this tick is searched; ``None`` for
+        no horizon (the search is still finite, see the module docstring).
+    avoid:
+        Soft reservations: among states of equal ``f``, fewer hits of these
+        entries go first (a conflict-avoidance table). Never changes the
+        arrival tick.
+    deadline:
+        A :func:`time.perf_counter` value after which the search gives up.
+    max_expansions:
+        Give up after this many expansions.
+
+    Returns
+    -------
+    SpaceTimeResult
+        ``status == "found"`` with the path of least arrival tick, or why not.
+
+    Raises
+    ------
+    ValueError
+        If ``start`` or ``goal`` is not a free cell.
+
+    Examples
+    --------
+    A robot whose goal another robot crosses at tick 3 cannot settle there earlier:
+
+    >>> grid = Grid.from_rows([".....", "....."])
+    >>> crossing = Reservations.from_entries(vertex=[((0, 2), 3)])
+    >>> result = space_time_astar(grid, (0, 0), (0, 2), crossing)
+    >>> result.cost, result.path[3] != (0, 2), result.path[-1]
+    (4, True, (0, 2))
+
+    A horizon too short for any path:
+
+    >>> space_time_astar(grid, (0, 0), (0, 4), max_time=3).status
+    'horizon'
+
+    Heading-aware: facing NORTH, going EAST costs one right turn first:
+
+    >>> result = space_time_astar(grid, (0, 0), (0, 2), heading_aware=True)
+    >>> result.path
+    ((0, 0), (0, 0), (0, 1), (0, 2))
+    >>> [h.name for h in result.headings]
+    ['NORTH', 'EAST', 'EAST', 'EAST']
+    """
+    if not grid.is_free(start):
+        raise ValueError(f"start {start} is not a free cell")
+    if not grid.is_free(goal):
+        raise ValueError(f"goal {goal} is not a free cell")
+    if reservations is None:
+        reservations = Reservations()
+    if heading_aware:
+        heading_table = heading_distance_table(_plain_grid(grid), goal)
+
+        def estimate(cell: Cell, facing: int) -> float:
+            return heading_table.get((cell, Heading(facing)), math.inf)
+
+        start_facing = int(heading)
+    else:
+        hop_table = hop_distance_table(grid, goal)
+        hop = hop_table.distance
+
+        def estimate(cell: Cell, facing: int) -> float:
+            return hop(cell)
+
+        start_facing = 0
+
+    if goal in reservations.parked or reservations.blocks(start, 0) or estimate(start, start_facing) == math.inf:
+        return SpaceTimeResult("unreachable", None, None, 0)
+
+    earliest_final = reservations.last_vertex_time(goal) + 1
+    static_from = max(reservations.last_time, avoid.last_time if avoid is not None else -1) + 1
+
+    vertex, edge, parked = reservations.vertex, reservations.edge, reservations.parked
+    if avoid is not None:
+        avoid_vertex, avoid_edge, avoid_parked = avoid.vertex, avoid.edge, avoid.parked
+    neighbours = grid.neighbours
+    inf = math.inf
+
+    # state records: cell, facing, tick, parent index
+    cells: list[Cell] = [start]
+    facings: list[int] = [start_facing]
+    ticks: list[int] = [0]
+    parents: list[int] = [-1]
+    h0 = estimate(start, start_facing)
+    open_list: list[tuple[float, int, float, int]] = [(max(h0, earliest_final), 0, h0, 0)]
+    best: dict[tuple[Cell, int, int], tuple[int, int]] = {(start, start_facing, 0): (0, 0)}
+    closed: set[tuple[Cell, int, int]] = set()
+    expansions = 0
+    cut_by_horizon = False
+    pop, push = heapq.heappop, heapq.heappush
+
+    while open_list:
+        _, conflicts, _, index = pop(open_list)
+        cell, facing, tick = cells[index], facings[index], ticks[index]
+        key = (cell, facing, tick if tick < static_from else static_from)
+        if key in closed:
+            continue
+        closed.add(key)
+        expansions += 1
+        if cell == goal and tick >= earliest_final:
+            return _finish(cells, facings, parents, index, heading_aware, expansions)
+        if max_expansions is not None and expansions >= max_expansions:
+            return SpaceTimeResult("expansions", None, None, expansions)
+        if deadline is not None and expansions % _DEADLINE_CHECK_EVERY == 0 and time.perf_counter() > deadline:
+            return SpaceTimeResult("deadline", None, None, expansions)
+        next_tick = tick + 1
+        if max_time is not None and next_tick > max_time:
+            cut_by_horizon = True
+            continue
+        if heading_aware:
+            ahead = Heading(facing).ahead(cell)
+            moves = [(cell, facing), (cell, facing % 4 + 1)]
+            if grid.is_free(ahead):
+                moves.append((ahead, facing))
+        else:
+            moves = [(cell, 0)]
+            moves.extend((n, 0) for n in neighbours(cell))
+        next_key_tick = next_tick if next_tick < static_from else static_from
+        for next_cell, next_facing in moves:
+            if (next_cell, next_tick) in vertex or parked.get(next_cell, inf) <= next_tick:
+                continue
+            if next_cell != cell and (cell, next_cell, next_tick) in edge:
+                continue
+            next_key = (next_cell, next_facing, next_key_tick)
+            if next_key in closed:
+                continue
+            h = estimate(next_cell, next_facing)
+            if h == inf:
+                continue
+            next_conflicts = conflicts
+            if avoid is not None:
+                if (next_cell, next_tick) in avoid_vertex or avoid_parked.get(next_cell, inf) <= next_tick:
+                    next_conflicts += 1
+                if next_cell != cell and (cell, next_cell, next_tick) in avoid_edge:
+                    next_conflicts += 1
+            rank = (next_tick, next_conflicts)
+            previous = best.get(next_key)
+            if previous is not None and previous <= rank:
+                continue
+            best[next_key] = rank
+            cells.append(next_cell)
+            facings.append(next_facing)
+            ticks.append(next_tick)
+            parents.append(index)
+            f = next_tick + h
+            push(open_list, (f if f > earliest_final else earliest_final, next_conflicts, h, len(cells) - 1))
+    return SpaceTimeResult("horizon" if cut_by_horizon else "unreachable", None, None, expansions)
+
+
+def _finish(
+    cells: list[Cell], facings: list[int], parents: list[int], index: int, heading_aware: bool, expansions: int
+) -> SpaceTimeResult:
+    """Follow parent links back from state ``index`` to the start."""
+    path: list[Cell] = []
+    faced: list[int] = []
+    while index >= 0:
+        path.append(cells[index])
+        faced.append(facings[index])
+        index = parents[index]
+    path.reverse()
+    faced.reverse()
+    headings = tuple(Heading(value) for value in faced) if heading_aware else None
+    return SpaceTimeResult("found", tuple(path), headings, expansions)
