@@ -335,12 +335,13 @@ def compare(
     except InputError as error:
         raise _fail(error.problems) from None
     table = Table(title=f"{scenario.name}: {len(scenario.robots)} robots, lower bound {rows[0].lower_bound if rows else 0}")
-    for column in ("method", "kind", "success", "makespan", "SoC / LB", "planning s", "run s", "messages", "plan bytes"):
+    table.caption = "robots: decentralized policy; central: planner + execution. plan s: planning wall time; plan B: plan to distribute"
+    for column in ("method", "kind", "ok", "makespan", "SoC/LB", "plan s", "run s", "msgs", "plan B"):
         table.add_column(column, justify="left" if column in ("method", "kind") else "right")
     for row in rows:
         table.add_row(
             row.method,
-            row.kind,
+            "central" if row.kind == "centralized" else "robots",
             "yes" if row.success else f"[red]no[/red] ({row.status})",
             str(row.makespan) if row.makespan is not None else "-",
             f"{row.cost_ratio:.3f}" if row.cost_ratio is not None else "-",

@@ -142,3 +142,19 @@ def test_forged_replayed_and_garbage_packets_change_nothing():
     assert report.rejected["oversized"] == sent["oversized"]
     assert report.rejected["magic"] == sent["magic"]
     assert report.safety["claims"] > 0 and report.safety["granted"] == 0
+
+
+def test_lacam_plan_for_sixteen_robots_with_delays_and_loss(tmp_path):
+    """A central LaCAM plan executed live over UDP with random delays and 20% message loss."""
+    from mrmp.centralized.registry import plan_with
+    from mrmp.io import load_movingai_scenario
+
+    maps = Path(__file__).resolve().parents[2] / "maps"
+    scenario = load_movingai_scenario(maps / "random-32-32-20.map", maps / "random-32-32-20-random-1.scen", 16)
+    plan = plan_with("lacam", scenario, time_limit_s=30)
+    assert plan.solved
+    faults = LiveFaults(loss=0.2, delay_min=0.0, delay_max=0.05)
+    result = live(scenario, tmp_path, time_scale=40, faults=faults, jitter=0.3, plan=plan, seed=5)
+    assert result.collisions == [] and result.success, result.stop_reason
+    assert result.policy == "lacam" and result.planning_time_s == plan.planning_time_s
+    assert result.network["injected_lost"] > 0

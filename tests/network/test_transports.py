@@ -7,6 +7,7 @@ import subprocess
 import sys
 import threading
 import time
+import types
 
 import pytest
 
@@ -290,3 +291,14 @@ def test_zenoh_transport_module_imports_without_zenoh_and_says_what_to_install()
     result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=30, check=False)
     assert result.returncode == 0, result.stderr
     assert result.stdout.strip() == "the zenoh transport needs the eclipse-zenoh package: pip install eclipse-zenoh"
+
+
+def test_zenoh_transport_refuses_a_zenoh_without_liveliness(monkeypatch):
+    from mrmp.live.zenoh_transport import ZenohTransport
+
+    class OldSession:  # eclipse-zenoh 1.0's Python Session has no liveliness()
+        pass
+
+    monkeypatch.setitem(sys.modules, "zenoh", types.SimpleNamespace(Session=OldSession))
+    with pytest.raises(RuntimeError, match="1.1 or later"):
+        ZenohTransport(0, "mrmp", "tcp/127.0.0.1:1", [], 1)

@@ -65,6 +65,7 @@ from __future__ import annotations
 import random
 import time
 from collections import deque
+from collections.abc import Sequence
 
 from mrmp.centralized.pibt_step import (
     NO_CELL,
@@ -75,7 +76,9 @@ from mrmp.centralized.pibt_step import (
     index_of,
     tick_grid,
 )
-from mrmp.centralized.plan import PlanningResult
+from mrmp.centralized.plan import MapfProblem, PlanningResult, as_problem
+from mrmp.core.cell import Cell
+from mrmp.core.grid import Grid
 from mrmp.core.scenario import Scenario
 from mrmp.search.distance import distance_table
 
@@ -114,12 +117,21 @@ class _Node:
         self.neighbours: set[_Node] = set()
 
 
-def _result(status: str, start: float, nodes: int, message: str, paths: tuple[tuple[tuple[int, int], ...], ...] | None = None) -> PlanningResult:
+def _result(
+    status: str,
+    start: float,
+    nodes: int,
+    message: str,
+    paths: tuple[tuple[tuple[int, int], ...], ...] | None = None,
+) -> PlanningResult:
+    """A :class:`PlanningResult` of LaCAM, timed from ``start``."""
     return PlanningResult(status, paths, time.perf_counter() - start, "lacam", nodes=nodes, message=message)
 
 
 def lacam(
-    scenario: Scenario,
+    problem: Scenario | Grid | MapfProblem,
+    starts: Sequence[Cell] | None = None,
+    goals: Sequence[Cell] | None = None,
     *,
     time_limit_s: float | None = 10.0,
     max_nodes: int | None = None,
@@ -127,16 +139,19 @@ def lacam(
     swap: bool = True,
     anytime: bool = False,
 ) -> PlanningResult:
-    """Plan every robot of ``scenario`` with LaCAM (Okumura, AAAI 2023).
+    """Plan every robot with LaCAM (Okumura, AAAI 2023): quick, complete, suboptimal.
 
     Time is counted in ticks: every robot moves to a neighbouring cell or waits
-    in each tick; entry costs of cells and robot headings are ignored (the
-    result carries no headings).
+    in each tick; entry costs of cells and robot headings are ignored (LaCAM
+    has no turn model; the result carries no headings).
 
     Parameters
     ----------
-    scenario:
-        The grid and the robots' starts and goals.
+    problem:
+        A :class:`~mrmp.core.scenario.Scenario`, or a grid with ``starts``
+        and ``goals`` (see :func:`~mrmp.centralized.plan.as_problem`).
+    starts, goals:
+        With a grid: one cell per robot.
     time_limit_s:
         Wall-clock budget in seconds, distance tables included; ``None`` for
         none. When it runs out before a solution, the status is ``"limit"``.
@@ -150,13 +165,15 @@ def lacam(
         equal plans.
     swap:
         Use the swap technique of LaCAM* engineering (Okumura, AAMAS 2024) in
-        PIBT; it helps robots pass each other in corridors.
+        PIBT; it lets robots pass each other in corridors without a long
+        search (see :mod:`mrmp.centralized.pibt_step`).
     anytime:
         LaCAM* (Okumura, IJCAI 2023): after the first solution keep searching,
-        rewiring parents to lower the sum of costs, until the time or node limit
-        (the result is then ``"solved"`` with the best plan found) or until the
-        search space is exhausted (the plan is then optimal for LaCAM*'s cost,
-        which counts every robot not resting at its goal in each tick).
+        rewiring parents to lower the cost, until the time or node limit (the
+        result is then ``"solved"`` with the best plan found) or until the
+        search space is exhausted (the plan is then optimal for LaCAM*'s
+        cost, which counts in each tick every robot not resting at its goal).
+        Off by default: the first solution is returned.
 
     Returns
     -------
@@ -164,60 +181,49 @@ def lacam(
         ``planner="lacam"``; ``nodes`` is the number of high-level
         configurations generated (distinct configurations inserted in the
         search, the start included). When solved, ``paths`` holds one path per
-        robot in scenario order, all of equal length, ending with every robot
-        at its goal. ``"infeasible"`` when the search proved no plan exists
-        (also when a goal cannot be reached from its start).
+        robot in robot order, all of equal length, ending with every robot
+        at its goal. ``"infeasible"`` when the search proved that no plan
+        exists (at once when a goal cannot be reached from its start);
+        ``"limit"`` when ``time_limit_s`` or ``max_nodes`` ran out first.
 
     Raises
     ------
-    ValueError
-        If a start or goal is not a free cell, or two robots share a start or
-        a goal.
+    InputError
+        If the starts or goals are invalid (see :func:`~mrmp.centralized.plan.as_problem`).
 
     Examples
     --------
+    Three robots rotate in a 2x2 grid, which takes one tick:
+
     >>> from mrmp.core.grid import Grid
-    >>> from mrmp.core.scenario import RobotSpec, Scenario
-    >>> rotate = Scenario(Grid(2, 2), (
-    ...     RobotSpec("A", (0, 0), (0, 1)), RobotSpec("B", (0, 1), (1, 1)),
-    ...     RobotSpec("C", (1, 1), (1, 0)),
-    ... ))
-    >>> result = lacam(rotate)
-    >>> result.status, result.makespan(), result.nodes >= 2
-    ('solved', 1, True)
-    >>> lacam(rotate, max_nodes=1).status
+    >>> cells = [(0, 0), (0, 1), (1, 1), (1, 0)]
+    >>> result = lacam(Grid(2, 2), cells[:3], cells[1:])
+    >>> result.status, result.makespan(), result.nodes
+    ('solved', 1, 2)
+    >>> lacam(Grid(2, 2), cells[:3], cells[1:], max_nodes=1).status
     'limit'
     """
     start_time = time.perf_counter()
     deadline = None if time_limit_s is None else start_time + time_limit_s
-    grid = scenario.grid
-    robots = scenario.robots
-    for kind in ("start", "goal"):
-        seen: dict[tuple[int, int], str] = {}
-        for robot in robots:
-            cell = getattr(robot, kind)
-            if not grid.is_free(cell):
-                raise ValueError(f"robot {robot.id}: {kind} {cell} is not a free cell")
-            if cell in seen:
-                raise ValueError(f"robots {seen[cell]} and {robot.id} share the {kind} {cell}")
-            seen[cell] = robot.id
-    count = len(robots)
+    instance = as_problem(problem, starts, goals)
+    grid = instance.grid
+    count = len(instance)
     if count == 0:
         return _result("solved", start_time, 0, "no robots", ())
 
     plain = tick_grid(grid)
     size = grid.x_size * grid.y_size
     unreachable = size
-    tables = [distance_table(plain, robot.goal) for robot in robots]
-    for robot, table in zip(robots, tables):
-        if not table.reachable(robot.start):
-            return _result("infeasible", start_time, 0, f"robot {robot.id} cannot reach its goal {robot.goal}")
+    tables = [distance_table(plain, goal) for goal in instance.goals]
+    for robot_id, start, goal, table in zip(instance.ids, instance.starts, instance.goals, tables):
+        if not table.reachable(start):
+            return _result("infeasible", start_time, 0, f"robot {robot_id} cannot reach its goal {goal} from {start}")
     distances = [distance_list(table, unreachable) for table in tables]
     neighbours = flat_neighbours(grid)
-    starts = tuple(index_of(grid, robot.start) for robot in robots)
-    goals = tuple(index_of(grid, robot.goal) for robot in robots)
+    start_config = tuple(index_of(grid, cell) for cell in instance.starts)
+    goal_config = tuple(index_of(grid, cell) for cell in instance.goals)
     rng = random.Random(seed) if seed is not None else None
-    pibt = PIBT(neighbours, distances, list(goals), swap=swap, rng=rng)
+    pibt = PIBT(neighbours, distances, list(goal_config), swap=swap, rng=rng)
     candidates = [(*row, cell) for cell, row in enumerate(neighbours)]
     scale = 1.0 / (unreachable + 1)
     robot_range = range(count)
@@ -226,7 +232,7 @@ def lacam(
         return sum(distances[robot][config[robot]] for robot in robot_range)
 
     def edge_cost(before: tuple[int, ...], after: tuple[int, ...]) -> int:
-        return sum(1 for robot in robot_range if not (before[robot] == after[robot] == goals[robot]))
+        return sum(1 for robot in robot_range if not (before[robot] == after[robot] == goal_config[robot]))
 
     def make_node(config: tuple[int, ...], parent: _Node | None) -> _Node:
         if parent is None:
@@ -234,7 +240,8 @@ def lacam(
         else:
             old = parent.priorities
             priorities = [
-                old[robot] + 1 if config[robot] != goals[robot] else old[robot] - int(old[robot]) for robot in robot_range
+                old[robot] + 1 if config[robot] != goal_config[robot] else old[robot] - int(old[robot])
+                for robot in robot_range
             ]
         if not anytime:
             return _Node(config, parent, priorities)
@@ -245,9 +252,9 @@ def lacam(
             parent.neighbours.add(node)
         return node
 
-    root = make_node(starts, None)
+    root = make_node(start_config, None)
     stack: deque[_Node] = deque((root,))
-    explored: dict[tuple[int, ...], _Node] = {starts: root}
+    explored: dict[tuple[int, ...], _Node] = {start_config: root}
     goal_node: _Node | None = None
     iterations = 0
     stopped = ""
@@ -277,7 +284,7 @@ def lacam(
         if anytime and goal_node is not None and node.f >= goal_node.f:
             stack.popleft()
             continue
-        if goal_node is None and node.config == goals:
+        if goal_node is None and node.config == goal_config:
             goal_node = node
             if not anytime:
                 break
@@ -288,11 +295,11 @@ def lacam(
         low = node.tree.popleft()
         depth = low[0]
         if depth < count:
-            robot = node.order[depth]
-            options = list(candidates[node.config[robot]])
+            chosen = node.order[depth]
+            options = list(candidates[node.config[chosen]])
             if rng is not None:
                 rng.shuffle(options)
-            node.tree.extend((depth + 1, robot, cell, low) for cell in options)
+            node.tree.extend((depth + 1, chosen, cell, low) for cell in options)
         target = [NO_CELL] * count
         constraint: _LowNode | None = low
         while constraint is not None and constraint[0] > 0:

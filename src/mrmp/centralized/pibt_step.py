@@ -59,7 +59,6 @@ True
 
 from __future__ import annotations
 
-import math
 import random
 from collections.abc import Mapping, Sequence
 
@@ -146,7 +145,8 @@ def distance_list(table: DistanceTable, unreachable: int) -> list[int]:
     [0, 99, 99]
     """
     values = table.array.ravel()
-    return np.where(np.isfinite(values), values, unreachable).astype(np.int64).tolist()
+    result: list[int] = np.where(np.isfinite(values), values, unreachable).astype(np.int64).tolist()
+    return result
 
 
 class PIBT:
@@ -557,8 +557,7 @@ def pibt_step(
             raise ValueError(f"robot {robot} cannot reach {cell} from {config[robot]} in one move")
         fixed[robot] = index
     if priorities is None:
-        priorities = [table.distance(cell) if math.isfinite(table.distance(cell)) else unreachable
-                      for table, cell in zip(tables, config)]
+        priorities = [min(table.distance(cell), unreachable) for table, cell in zip(tables, config)]
     elif len(priorities) != len(config):
         raise ValueError(f"{len(priorities)} priorities for {len(config)} robots")
     order = sorted(range(len(config)), key=lambda robot: -priorities[robot])

@@ -1,9 +1,10 @@
 """Zenoh transport: a live robot's datagrams as Zenoh publications between peers.
 
 :class:`ZenohTransport` implements :class:`mrmp.live.transport.Transport` on
-top of `Zenoh <https://zenoh.io>`_ (the ``eclipse-zenoh`` package, version
-1.x), imported lazily: this module imports without Zenoh installed, and the
-constructor raises a clear :class:`RuntimeError` if it is missing.
+top of `Zenoh <https://zenoh.io>`_: the ``eclipse-zenoh`` package, 1.1 or
+later in 1.x (tested with 1.1.0, 1.2.0, 1.3.0, 1.5.0, 1.7.0 and 1.10.2).
+Zenoh is imported lazily: this module imports without it, and the constructor
+raises a clear :class:`RuntimeError` if it is missing (or too old).
 
 Key expressions
 ---------------
@@ -18,13 +19,13 @@ https://zenoh.io/docs/manual/abstractions/). Robot ``i`` uses:
 It subscribes to ``{fleet}/robot/*`` (``*`` is exactly one chunk, so this is
 every robot's broadcast key; its own is ignored) and to ``{fleet}/to/{i}``,
 both restricted to remote publications (``allowed_origin=Locality.REMOTE``
-where the installed Zenoh has it, 1.1 and later),
+where the installed Zenoh has it: 1.5 and later),
 and to the liveliness of ``{fleet}/alive/*`` to know which peers are up.
 
 Configuration, and why
 ----------------------
 The options are documented in Zenoh's reference configuration,
-``DEFAULT_CONFIG.json5`` (https://github.com/eclipse-zenoh/zenoh/blob/main/DEFAULT_CONFIG.json5),
+``DEFAULT_CONFIG.json5`` (e.g. https://github.com/eclipse-zenoh/zenoh/blob/1.9.0/DEFAULT_CONFIG.json5),
 and in the deployment guide (https://zenoh.io/docs/getting-started/deployment/):
 
 * ``mode: "peer"``: robots talk to each other directly, with no router
@@ -39,7 +40,8 @@ and in the deployment guide (https://zenoh.io/docs/getting-started/deployment/):
 * ``connect/timeout_ms: -1`` and ``connect/exit_on_failure: false`` (the
   documented defaults for peers, written out so the behaviour does not depend
   on them): opening a session does not fail when a peer is not up yet; Zenoh
-  keeps retrying the endpoints it could not reach in the background.
+  keeps retrying the endpoints it could not reach in the background. (With
+  ``timeout_ms: 0`` it would try once and never again: checked with 1.10.)
 * ``connect/retry``: ``period_init_ms: 100``, ``period_increase_factor: 1.5``,
   ``period_max_ms: 500`` instead of the default 1000/2/4000 ms: a robot
   started before its peers reaches them at most half a second after they come
@@ -93,6 +95,9 @@ if TYPE_CHECKING:  # pragma: no cover - typing only
 
 MISSING_ZENOH = "the zenoh transport needs the eclipse-zenoh package: pip install eclipse-zenoh"
 """The message of the :class:`RuntimeError` raised when Zenoh is not installed."""
+
+TOO_OLD_ZENOH = "the zenoh transport needs eclipse-zenoh 1.1 or later: pip install -U eclipse-zenoh"
+"""The message of the :class:`RuntimeError` raised when the installed Zenoh has no liveliness API."""
 
 DEFAULT_QUEUE_LIMIT = 10_000
 """How many received datagrams are kept waiting for :meth:`ZenohTransport.receive` at most."""
@@ -213,7 +218,7 @@ class ZenohTransport:
     Raises
     ------
     RuntimeError
-        If the ``eclipse-zenoh`` package is not installed.
+        If the ``eclipse-zenoh`` package is not installed, or older than 1.1.
     ValueError
         If ``index`` is not in ``range(fleet_size)`` or ``fleet`` is not a Zenoh key.
     zenoh.ZError
@@ -251,6 +256,8 @@ class ZenohTransport:
             import zenoh
         except ImportError as error:
             raise RuntimeError(MISSING_ZENOH) from error
+        if not hasattr(zenoh.Session, "liveliness"):
+            raise RuntimeError(TOO_OLD_ZENOH)
         if not 0 <= index < fleet_size:
             raise ValueError(f"robot index {index} is not in 0..{fleet_size - 1}")
         if queue_limit < 1:
@@ -278,7 +285,8 @@ class ZenohTransport:
         self._session: zenoh.Session = zenoh.open(config)
         entities: list[Any] = []
         try:
-            # Only remote publications (zenoh >= 1.1; the own-key check in _on_sample covers 1.0).
+            # Only remote publications where Zenoh can say so (1.5 and later); the own-key check in
+            # _on_sample covers older versions.
             origin = {"allowed_origin": zenoh.Locality.REMOTE} if hasattr(zenoh, "Locality") else {}
             for key in (keys["broadcasts"], keys["inbox"]):
                 entities.append(self._session.declare_subscriber(key, self._on_sample, **origin))

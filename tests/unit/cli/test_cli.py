@@ -132,3 +132,35 @@ def test_animations(tmp_path):
         result = invoke("run", EXAMPLES / "thesis-swap.yaml", "--animate", target)
         assert result.exit_code == 0, result.output
         assert target.stat().st_size > 1000
+
+
+@pytest.mark.parametrize("planner", ["cbs", "pp", "lacam"])
+def test_run_with_a_central_planner(planner, tmp_path):
+    out = tmp_path / "plan.json"
+    result = invoke("run", EXAMPLES / "thesis-cross.yaml", "--planner", planner, "--json", out)
+    assert result.exit_code == 0, result.output
+    assert f"{planner}: planned in" in result.output
+    data = json.loads(out.read_text())
+    assert data["success"] is True and data["planning_time_s"] >= 0 and data["plan_bytes"] > 0
+    assert data["policy"] == planner
+
+
+def test_unknown_planner_and_unsolvable_plan(tmp_path):
+    result = invoke("run", EXAMPLES / "thesis-swap.yaml", "--planner", "magic")
+    assert result.exit_code == 2 and "unknown planner 'magic'" in result.output
+    corridor = tmp_path / "corridor.yaml"
+    corridor.write_text("map: {rows: ['..']}\nrobots:\n  - {id: A, start: [0, 0], goal: [0, 1]}\n  - {id: B, start: [0, 1], goal: [0, 0]}\n")
+    result = invoke("run", corridor, "--planner", "lacam", "--time-limit", "2")
+    assert result.exit_code == 1 and "lacam: no plan" in result.output and "infeasible" in result.output
+
+
+def test_compare_prints_every_method(tmp_path):
+    out = tmp_path / "rows.json"
+    result = invoke("compare", EXAMPLES / "thesis-cross.yaml", "--json", out)
+    assert result.exit_code == 0, result.output
+    rows = json.loads(out.read_text())
+    assert [row["method"] for row in rows] == ["thesis", "astar", "cbs", "pp", "lacam"]
+    assert all(row["success"] for row in rows)
+    cbs = next(row for row in rows if row["method"] == "cbs")
+    assert cbs["sum_of_costs"] == 16 == cbs["lower_bound"]  # optimal: the lower bound is reached
+    assert cbs["plan_bytes"] > 0 and cbs["planning_time_s"] >= 0
