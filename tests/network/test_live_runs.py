@@ -15,7 +15,7 @@ from mrmp.live.body import SimulatedBody
 from mrmp.live.launcher import LiveOptions, run_live
 from mrmp.live.transport import LiveFaults, UdpTransport
 from mrmp.protocol.auth import Opener, Sealer
-from mrmp.protocol.messages import ClaimMessage, ReplyMessage, StateMessage
+from mrmp.protocol.messages import ReplyMessage, StateMessage
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 

@@ -146,7 +146,6 @@ def test_udp_send_to_an_unreachable_peer_is_a_lost_datagram():
     transport.close()
 
 
-@pytest.mark.xfail(strict=True, reason="UdpTransport.close does not wake a receive blocked in another thread")
 def test_udp_close_wakes_a_blocked_receive():
     transport = UdpTransport((LOOPBACK, 0), {})
     outcome = {}

@@ -72,7 +72,17 @@ from mrmp.core.grid import Grid
 from mrmp.core.heading import Heading
 from mrmp.core.scenario import Scenario
 
-__all__ = ["Conflict", "DEFAULT_MAX_NODES", "DEFAULT_TIME_LIMIT_S", "cbs", "first_conflict", "infeasibility_proof"]
+__all__ = [
+    "DEFAULT_MAX_NODES",
+    "DEFAULT_TIME_LIMIT_S",
+    "Conflict",
+    "all_conflicts",
+    "cbs",
+    "first_conflict",
+    "infeasibility_proof",
+    "mdd_layers",
+    "min_vertex_cover_size",
+]
 
 DEFAULT_MAX_NODES = 100_000
 """Constraint-tree nodes CBS generates at most unless told otherwise."""
@@ -98,15 +108,12 @@ class Conflict:
     tick: int
 
 
-def _at(path: Sequence[Cell], tick: int) -> Cell:
-    return path[tick] if tick < len(path) else path[-1]
-
-
-def first_conflict(paths: Sequence[Sequence[Cell]]) -> tuple[Conflict | None, int]:
-    """The earliest conflict among ``paths`` and the number of conflicts in all.
+def all_conflicts(paths: Sequence[Sequence[Cell]]) -> list[Conflict]:
+    """Every conflict among ``paths``, in tick order.
 
     Robots stay on their last cell after their path ends. At one tick, vertex
-    conflicts come before edge conflicts, and pairs go in robot order.
+    conflicts come before edge conflicts, and pairs go in robot order. Three
+    robots in one cell give two vertex conflicts, each with the first of them.
 
     Parameters
     ----------
@@ -115,33 +122,28 @@ def first_conflict(paths: Sequence[Sequence[Cell]]) -> tuple[Conflict | None, in
 
     Returns
     -------
-    tuple
-        The first conflict (``None`` if the paths are conflict-free) and how
-        many conflicting (pair, tick) events the paths hold.
+    list of Conflict
+        Empty when the paths are a valid plan.
 
     Examples
     --------
-    >>> conflict, count = first_conflict([[(0, 0), (0, 1)], [(0, 1), (0, 0)]])
-    >>> conflict.kind, conflict.cells, conflict.tick, count
-    ('edge', ((0, 0), (0, 1)), 1, 1)
-    >>> first_conflict([[(0, 0), (0, 1), (0, 2)], [(0, 2)]])[0].kind
+    >>> [(c.kind, c.first, c.second, c.tick) for c in all_conflicts([[(0, 0), (0, 1)], [(0, 1), (0, 0)]])]
+    [('edge', 0, 1, 1)]
+    >>> all_conflicts([[(0, 0), (0, 1), (0, 2)], [(0, 2)]])[0].kind
     'vertex'
     """
     length = max((len(path) for path in paths), default=0)
-    first: Conflict | None = None
-    count = 0
-    previous = [_at(path, 0) for path in paths]
+    found: list[Conflict] = []
+    previous: list[Cell] = []
     for tick in range(length):
-        current = [_at(path, tick) for path in paths]
+        current = [path[tick] if tick < len(path) else path[-1] for path in paths]
         occupants: dict[Cell, int] = {}
         for index, cell in enumerate(current):
             other = occupants.get(cell)
             if other is None:
                 occupants[cell] = index
             else:
-                count += 1
-                if first is None:
-                    first = Conflict("vertex", other, index, (cell,), tick)
+                found.append(Conflict("vertex", other, index, (cell,), tick))
         if tick > 0:
             moves: dict[tuple[Cell, Cell], int] = {}
             for index, (source, target) in enumerate(zip(previous, current)):
@@ -150,11 +152,24 @@ def first_conflict(paths: Sequence[Sequence[Cell]]) -> tuple[Conflict | None, in
             for (source, target), index in moves.items():
                 other = moves.get((target, source))
                 if other is not None and other > index:
-                    count += 1
-                    if first is None:
-                        first = Conflict("edge", index, other, (source, target), tick)
+                    found.append(Conflict("edge", index, other, (source, target), tick))
         previous = current
-    return first, count
+    return found
+
+
+def first_conflict(paths: Sequence[Sequence[Cell]]) -> tuple[Conflict | None, int]:
+    """The earliest conflict among ``paths`` (see :func:`all_conflicts`) and how many there are.
+
+    Examples
+    --------
+    >>> conflict, count = first_conflict([[(0, 0), (0, 1)], [(0, 1), (0, 0)]])
+    >>> conflict.kind, conflict.cells, conflict.tick, count
+    ('edge', ((0, 0), (0, 1)), 1, 1)
+    >>> first_conflict([[(0, 0), (0, 1)], [(0, 1), (0, 2)]])   # following is allowed
+    (None, 0)
+    """
+    found = all_conflicts(paths)
+    return (found[0] if found else None), len(found)
 
 
 def infeasibility_proof(problem: MapfProblem) -> str | None:
@@ -204,20 +219,66 @@ def infeasibility_proof(problem: MapfProblem) -> str | None:
     return None
 
 
+def min_vertex_cover_size(edges: Sequence[tuple[int, int]], exact_up_to: int = 8) -> int:
+    """The size of a smallest vertex cover of a graph given by its edges (a lower bound if large).
+
+    Exact by iterative deepening on the cover size (two branches per uncovered
+    edge) while the size is at most ``exact_up_to``; beyond that, the size of a
+    greedy maximal matching, which never exceeds the true value.
+
+    >>> min_vertex_cover_size([(0, 1), (1, 2), (2, 0)])
+    2
+    >>> min_vertex_cover_size([(0, 1), (0, 2), (0, 3)])
+    1
+    >>> min_vertex_cover_size([])
+    0
+    """
+    unique = sorted({(min(u, v), max(u, v)) for u, v in edges})
+    matched: set[int] = set()
+    matching = 0
+    for u, v in unique:
+        if u not in matched and v not in matched:
+            matched.update((u, v))
+            matching += 1
+
+    def coverable(remaining: list[tuple[int, int]], budget: int) -> bool:
+        if not remaining:
+            return True
+        if budget == 0:
+            return False
+        u, v = remaining[0]
+        return coverable([e for e in remaining if u not in e], budget - 1) or coverable(
+            [e for e in remaining if v not in e], budget - 1
+        )
+
+    size = matching
+    while size <= exact_up_to:
+        if coverable(unique, size):
+            return size
+        size += 1
+    return matching
+
+
+_Layers = tuple[frozenset[Cell], ...]
+
+
 @dataclass
 class _Node:
-    """A constraint-tree node."""
+    """A constraint-tree node: constraints, paths, and the bound ``f`` on its subtree's costs."""
 
     cost: int
-    conflicts: int
+    f: int
+    conflicts: list[Conflict]
     serial: int
     constraints: tuple[tuple[_Constraint, ...], ...]
     paths: tuple[tuple[Cell, ...], ...]
     headings: tuple[tuple[Heading, ...] | None, ...]
-    conflict: Conflict | None
+    mdds: list[_Layers | None]
+    evaluated: bool = False
+    chosen: Conflict | None = None
 
     def key(self) -> tuple[int, int, int]:
-        return (self.cost, self.conflicts, self.serial)
+        return (self.f, len(self.conflicts), self.serial)
 
 
 def _reservations(constraints: Sequence[_Constraint]) -> Reservations:
@@ -238,6 +299,84 @@ def _avoidance(paths: Sequence[Sequence[Cell] | None], skip: int) -> Reservation
     return table
 
 
+def mdd_layers(
+    grid: Grid,
+    start: Cell,
+    goal: Cell,
+    cost: int,
+    reservations: Reservations,
+    *,
+    heading_aware: bool = False,
+    heading: Heading = Heading.NORTH,
+) -> tuple[frozenset[Cell], ...]:
+    """The cells of every path of exactly ``cost`` ticks from ``start`` to ``goal``, tick by tick.
+
+    A multi-valued decision diagram (Sharon et al., "The increasing cost tree
+    search for optimal multi-agent pathfinding", AIJ 2013), projected on
+    cells: layer ``t`` holds the cells some path respecting ``reservations``
+    (vertex and edge entries) visits at tick ``t`` while reaching ``goal`` at
+    tick ``cost``. A layer with one cell means every such path is there then:
+    forbidding it raises the robot's cost (a *cardinal* conflict, Boyarski et
+    al. 2015). ``cost`` must be the least arrival tick under the reservations.
+
+    >>> from mrmp.core.grid import Grid
+    >>> [sorted(layer) for layer in mdd_layers(Grid(2, 2), (0, 0), (1, 1), 2, Reservations())]
+    [[(0, 0)], [(0, 1), (1, 0)], [(1, 1)]]
+    """
+    from mrmp.centralized.space_time_astar import heading_distance_table, hop_distance_table
+
+    if heading_aware:
+        table = heading_distance_table(grid if not grid.has_costs else Grid(grid.x_size, grid.y_size, grid.blocked_cells()), goal)
+
+        def estimate(state: tuple[Cell, int]) -> float:
+            return table.get((state[0], Heading(state[1])), float("inf"))
+
+        def successors(state: tuple[Cell, int]) -> list[tuple[Cell, int]]:
+            cell, facing = state
+            moves = [(cell, facing), (cell, facing % 4 + 1)]
+            ahead = Heading(facing).ahead(cell)
+            if grid.is_free(ahead):
+                moves.append((ahead, facing))
+            return moves
+
+        first: tuple[Cell, int] = (start, int(heading))
+    else:
+        hop = hop_distance_table(grid, goal).distance
+
+        def estimate(state: tuple[Cell, int]) -> float:
+            return hop(state[0])
+
+        def successors(state: tuple[Cell, int]) -> list[tuple[Cell, int]]:
+            cell = state[0]
+            return [(cell, 0)] + [(n, 0) for n in grid.neighbours(cell)]
+
+        first = (start, 0)
+    vertex, edge = reservations.vertex, reservations.edge
+    layers: list[set[tuple[Cell, int]]] = [{first}]
+    for tick in range(1, cost + 1):
+        layer: set[tuple[Cell, int]] = set()
+        for state in layers[-1]:
+            for nxt in successors(state):
+                if (nxt[0], tick) in vertex or (nxt[0] != state[0] and (state[0], nxt[0], tick) in edge):
+                    continue
+                if tick + estimate(nxt) <= cost:
+                    layer.add(nxt)
+        layers.append(layer)
+    kept: list[set[tuple[Cell, int]]] = [set() for _ in layers]
+    kept[cost] = {state for state in layers[cost] if state[0] == goal}
+    for tick in range(cost - 1, -1, -1):
+        after = kept[tick + 1]
+        kept[tick] = {
+            state
+            for state in layers[tick]
+            if any(
+                nxt in after and not (nxt[0] != state[0] and (state[0], nxt[0], tick + 1) in edge)
+                for nxt in successors(state)
+            )
+        }
+    return tuple(frozenset(state[0] for state in layer) for layer in kept)
+
+
 def cbs(
     problem: Scenario | Grid | MapfProblem,
     starts: Sequence[Cell] | None = None,
@@ -246,6 +385,7 @@ def cbs(
     max_nodes: int | None = DEFAULT_MAX_NODES,
     time_limit_s: float | None = DEFAULT_TIME_LIMIT_S,
     heading_aware: bool = False,
+    improved: bool = True,
 ) -> PlanningResult:
     """Plan every robot with Conflict-Based Search (Sharon et al. 2015): least sum of costs.
 
@@ -264,6 +404,10 @@ def cbs(
     heading_aware:
         Plan with the turn model (one tick per move forward or right turn);
         headings start from the scenario's (NORTH for a bare grid).
+    improved:
+        Use the optimality-preserving improvements (cardinal conflicts first,
+        the conflict-graph heuristic, bypass; see the module docstring).
+        ``False`` runs the original CBS: split the first conflict in time.
 
     Returns
     -------
@@ -298,6 +442,9 @@ def cbs(
                 headings = pad_headings([row for row in node.headings if row is not None])
         return PlanningResult(status, paths, elapsed, "cbs", nodes=nodes, message=message, headings=headings)
 
+    def out_of_time(nodes: int) -> PlanningResult:
+        return result("limit", f"time limit of {time_limit_s:g} s reached after {nodes} nodes", nodes)
+
     proof = infeasibility_proof(instance)
     if proof is not None:
         return result("infeasible", proof, 0)
@@ -317,6 +464,58 @@ def cbs(
             deadline=deadline,
         )
 
+    def mdd(node: _Node, robot: int) -> _Layers:
+        layers = node.mdds[robot]
+        if layers is None:
+            layers = mdd_layers(
+                grid,
+                instance.starts[robot],
+                instance.goals[robot],
+                len(node.paths[robot]) - 1,
+                _reservations(node.constraints[robot]),
+                heading_aware=heading_aware,
+                heading=instance.headings[robot],
+            )
+            node.mdds[robot] = layers
+        return layers
+
+    def forced(node: _Node, robot: int, conflict: Conflict) -> bool:
+        """Whether every cheapest path of ``robot`` has the conflict (splitting raises its cost)."""
+        tick = conflict.tick
+        cost = len(node.paths[robot]) - 1
+        if conflict.kind == "vertex":
+            if tick >= cost:
+                return True  # settled on its goal: it must leave and come back later
+            layer = mdd(node, robot)[tick]
+            return len(layer) == 1
+        layers = mdd(node, robot)
+        return len(layers[tick - 1]) == 1 and len(layers[tick]) == 1
+
+    def evaluate(node: _Node) -> None:
+        """Choose the conflict to split (cardinal, then semi-cardinal, then the earliest) and bound ``f``."""
+        node.evaluated = True
+        if not improved:
+            node.chosen = node.conflicts[0]
+            return
+        best: tuple[int, int] | None = None
+        cardinal_pairs: set[tuple[int, int]] = set()
+        classified: set[tuple[int, int]] = set()
+        for position, conflict in enumerate(node.conflicts):
+            pair = (conflict.first, conflict.second)
+            if pair in cardinal_pairs:
+                continue
+            if pair in classified and best is not None and best[0] == 0:
+                continue
+            kind = 2 - forced(node, conflict.first, conflict) - forced(node, conflict.second, conflict)
+            classified.add(pair)
+            if kind == 0:
+                cardinal_pairs.add(pair)
+            if best is None or kind < best[0]:
+                best = (kind, position)
+        node.chosen = node.conflicts[best[1] if best is not None else 0]
+        if cardinal_pairs:
+            node.f = max(node.f, node.cost + min_vertex_cover_size(sorted(cardinal_pairs)))
+
     empty: tuple[_Constraint, ...] = ()
     root_paths: list[tuple[Cell, ...] | None] = [None] * count
     root_headings: list[tuple[Heading, ...] | None] = [None] * count
@@ -329,18 +528,25 @@ def cbs(
         root_paths[index] = found.path
         root_headings[index] = found.headings
     paths = tuple(path for path in root_paths if path is not None)
-    conflict, conflicts = first_conflict(paths)
-    root = _Node(sum(len(p) - 1 for p in paths), conflicts, 0, (empty,) * count, paths, tuple(root_headings), conflict)
+    cost = sum(len(path) - 1 for path in paths)
+    root = _Node(cost, cost, all_conflicts(paths), 0, (empty,) * count, paths, tuple(root_headings), [None] * count)
     nodes = 1
     open_list: list[tuple[tuple[int, int, int], _Node]] = [(root.key(), root)]
 
     while open_list:
         _, node = heapq.heappop(open_list)
-        if node.conflict is None:
+        if not node.conflicts:
             return result("solved", f"optimal sum of costs {node.cost} after {nodes} nodes", nodes, node)
         if deadline is not None and time.perf_counter() > deadline:
-            return result("limit", f"time limit of {time_limit_s:g} s reached after {nodes} nodes", nodes)
-        conflict = node.conflict
+            return out_of_time(nodes)
+        if not node.evaluated:
+            bound = node.f
+            evaluate(node)
+            if node.f > bound:
+                heapq.heappush(open_list, (node.key(), node))
+                continue
+        conflict = node.chosen
+        assert conflict is not None
         if conflict.kind == "vertex":
             cell = conflict.cells[0]
             splits = ((conflict.first, ("v", cell, conflict.tick)), (conflict.second, ("v", cell, conflict.tick)))
@@ -350,21 +556,38 @@ def cbs(
                 (conflict.first, ("e", source, target, conflict.tick)),
                 (conflict.second, ("e", target, source, conflict.tick)),
             )
+        children: list[_Node] = []
+        bypassed = False
         for robot, constraint in splits:
             if max_nodes is not None and nodes >= max_nodes:
                 return result("limit", f"node limit of {max_nodes} reached", nodes)
             constraints = node.constraints[robot] + (constraint,)
             found = replan(robot, constraints, node.paths)
             if found.status == "deadline":
-                return result("limit", f"time limit of {time_limit_s:g} s reached after {nodes} nodes", nodes)
+                return out_of_time(nodes)
             nodes += 1
             if not found.found or found.path is None:
                 continue
             child_paths = node.paths[:robot] + (found.path,) + node.paths[robot + 1 :]
             child_headings = node.headings[:robot] + (found.headings,) + node.headings[robot + 1 :]
-            child_constraints = node.constraints[:robot] + (constraints,) + node.constraints[robot + 1 :]
-            child_conflict, child_conflicts = first_conflict(child_paths)
+            child_conflicts = all_conflicts(child_paths)
             cost = node.cost - (len(node.paths[robot]) - 1) + (len(found.path) - 1)
-            child = _Node(cost, child_conflicts, nodes, child_constraints, child_paths, child_headings, child_conflict)
+            if improved and cost == node.cost and len(child_conflicts) < len(node.conflicts):
+                # bypass (Boyarski et al. 2015): the new path is as cheap and also respects the
+                # node's own constraints; adopt it instead of splitting
+                node.paths, node.headings, node.conflicts = child_paths, child_headings, child_conflicts
+                node.evaluated, node.chosen = False, None
+                bypassed = True
+                break
+            child_constraints = node.constraints[:robot] + (constraints,) + node.constraints[robot + 1 :]
+            mdds = list(node.mdds)
+            mdds[robot] = None
+            children.append(
+                _Node(cost, max(cost, node.f), child_conflicts, nodes, child_constraints, child_paths, child_headings, mdds)
+            )
+        if bypassed:
+            heapq.heappush(open_list, (node.key(), node))
+            continue
+        for child in children:
             heapq.heappush(open_list, (child.key(), child))
     return result("infeasible", f"constraint tree exhausted after {nodes} nodes: no plan exists", nodes)

@@ -92,11 +92,15 @@ class _UdpSocket:
             data, _ = self._socket.recvfrom(MAX_DATAGRAM_BYTES + 1)
         except (TimeoutError, OSError):
             return None
-        return data
+        return None if self._closed else data
 
     def close(self) -> None:
-        """Close the socket; ``receive`` returns None from now on."""
+        """Close the socket, waking a ``receive`` blocked in another thread; ``receive`` returns None from now on."""
         self._closed = True
+        try:
+            self._socket.shutdown(socket.SHUT_RDWR)  # wakes a blocked recvfrom on Linux
+        except OSError:
+            pass
         self._socket.close()
 
 
