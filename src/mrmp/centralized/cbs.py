@@ -499,15 +499,11 @@ def cbs(
             return
         best: tuple[int, int] | None = None
         cardinal_pairs: set[tuple[int, int]] = set()
-        classified: set[tuple[int, int]] = set()
         for position, conflict in enumerate(node.conflicts):
             pair = (conflict.first, conflict.second)
             if pair in cardinal_pairs:
                 continue
-            if pair in classified and best is not None and best[0] == 0:
-                continue
             kind = 2 - forced(node, conflict.first, conflict) - forced(node, conflict.second, conflict)
-            classified.add(pair)
             if kind == 0:
                 cardinal_pairs.add(pair)
             if best is None or kind < best[0]:
