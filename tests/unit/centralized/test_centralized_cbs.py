@@ -69,7 +69,7 @@ def corridor_instances(draw: st.DrawFn) -> tuple[Grid, list, list]:
 def test_cbs_sum_of_costs_equals_brute_force(instance: tuple[Grid, list, list]) -> None:
     grid, starts, goals = instance
     optimum = brute_force_sum_of_costs(grid, starts, goals)
-    result = cbs(grid, starts, goals, max_nodes=3000 if optimum is not None else 300, time_limit_s=5.0)
+    result = cbs(grid, starts, goals, max_nodes=30_000 if optimum is not None else 300, time_limit_s=10.0)
     if optimum is None:
         assert result.status in ("infeasible", "limit")
         assert result.paths is None
