@@ -12,9 +12,12 @@ collision-free plan (a :class:`PlanningResult`) before anything moves:
   (Silver 2005), with vertex, edge and parking reservations and an optional
   heading-aware (right-turn) time model.
 
-:data:`PLANNERS` maps the names ``"cbs"`` and ``"pp"`` to the planners; each is
-called as ``planner(scenario)`` or ``planner(grid, starts, goals)`` with
-keyword options.
+:func:`lacam` -- LaCAM (Okumura, AAAI 2023): complete, quick, suboptimal.
+
+:data:`~mrmp.centralized.registry.PLANNERS` maps the names ``"cbs"``, ``"pp"``
+and ``"lacam"`` to the planners; each is called as ``planner(scenario)`` or
+``planner(grid, starts, goals)`` with keyword options. Plans are executed by the
+fleet through :mod:`mrmp.centralized.execution`.
 
 Examples
 --------
@@ -24,14 +27,18 @@ Examples
 >>> starts, goals = [(0, 0), (2, 3)], [(2, 3), (0, 0)]
 >>> results = {name: planner(grid, starts, goals) for name, planner in PLANNERS.items()}
 >>> {name: (r.status, r.sum_of_costs()) for name, r in results.items()}
-{'cbs': ('solved', 10), 'pp': ('solved', 10)}
+{'cbs': ('solved', 10), 'pp': ('solved', 10), 'lacam': ('solved', 14)}
 >>> all(check_paths(grid, dict(zip("AB", r.paths))) == [] for r in results.values())
 True
 """
 
-from collections.abc import Callable
-
-from mrmp.centralized.cbs import cbs, first_conflict, infeasibility_proof
+from mrmp.centralized.cbs import (
+    Conflict,
+    all_conflicts,
+    cbs,
+    first_conflict,
+    infeasibility_proof,
+)
 from mrmp.centralized.plan import (
     STATUSES,
     MapfProblem,
@@ -42,7 +49,9 @@ from mrmp.centralized.plan import (
     path_cost,
     plan_size_bytes,
 )
+from mrmp.centralized.lacam import lacam
 from mrmp.centralized.prioritized import prioritized, priority_order
+from mrmp.centralized.registry import PLANNER_NAMES, PLANNERS, plan_with
 from mrmp.centralized.space_time_astar import (
     Reservations,
     SpaceTimeResult,
@@ -50,28 +59,27 @@ from mrmp.centralized.space_time_astar import (
     space_time_astar,
 )
 
-PLANNERS: dict[str, Callable[..., PlanningResult]] = {
-    "cbs": cbs,
-    "pp": prioritized,
-}
-"""Centralized planners by name."""
-
 __all__ = [
     "PLANNERS",
+    "PLANNER_NAMES",
     "STATUSES",
+    "Conflict",
     "MapfProblem",
     "PlanningResult",
     "Reservations",
     "SpaceTimeResult",
+    "all_conflicts",
     "as_problem",
     "cbs",
     "first_conflict",
     "heading_distance_table",
     "infeasibility_proof",
+    "lacam",
     "pad_headings",
     "pad_paths",
     "path_cost",
     "plan_size_bytes",
+    "plan_with",
     "prioritized",
     "priority_order",
     "space_time_astar",

@@ -5,11 +5,12 @@ search for optimal multi-agent pathfinding", Artificial Intelligence 219, 2015)
 searches a *constraint tree*. Each node holds a set of constraints per robot
 and one path per robot, each the cheapest path that respects that robot's
 constraints (found by :func:`~mrmp.centralized.space_time_astar.space_time_astar`).
-The high level is best-first on the node's sum of costs:
+The high level is best-first on the node's sum of costs (a lower bound ``f``
+on it, with the improvements below):
 
-1. take the node of least sum of costs (ties: fewer conflicts, then the older
-   node, so the search is deterministic);
-2. find its first conflict in time: a *vertex* conflict (two robots in one cell
+1. take the node of least ``f`` (ties: fewer conflicts, then the older node,
+   so the search is deterministic);
+2. pick a conflict (the first in time, or see the improvements): a *vertex* conflict (two robots in one cell
    at tick ``t``) or an *edge* conflict (two robots swapping cells at tick
    ``t``); robots that have arrived stay on their goals, so a robot crossing a
    parked one is a vertex conflict at a tick after the parked robot's arrival;
@@ -19,7 +20,30 @@ The high level is best-first on the node's sum of costs:
 
 The low level breaks ties between paths of equal length by the fewest
 conflicts with the other robots' current paths (the conflict-avoidance table
-of Standley 2010), which keeps the tree small without changing optimality.
+of Standley 2010).
+
+**Improvements** (``improved=True``, the default; all keep optimality):
+
+* *conflict prioritization* (ICBS: Boyarski, Felner, Stern, Sharon, Tolpin,
+  Betzalel & Shimony, "ICBS: Improved Conflict-Based Search Algorithm for
+  Multi-Agent Pathfinding", IJCAI 2015): split a *cardinal* conflict (every
+  cheapest path of both robots has it, read off their multi-valued decision
+  diagrams, :func:`mdd_layers`) before a semi-cardinal one, before the rest;
+* the *conflict-graph heuristic* (Felner, Li, Boyarski, Ma, Cohen, Kumar &
+  Koenig, "Adding Heuristics to Conflict-Based Search for Multi-Agent Path
+  Finding", ICAPS 2018): robots joined by a cardinal conflict form a graph, and
+  each edge costs at least one more tick, so the size of a minimum vertex
+  cover (:func:`min_vertex_cover_size`) is added to the node's bound;
+  computed lazily when a node is first taken from the open list, and a child
+  inherits its parent's bound;
+* *bypass* (Boyarski, Felner, Sharon & Stern, "Don't Split, Try To Work It
+  Out: Bypassing Conflicts in Multi-Agent Pathfinding", ICAPS 2015): a child
+  path as cheap as the parent's and with fewer conflicts replaces the parent's
+  path instead of splitting.
+
+``improved=False`` runs CBS exactly as published in 2015. Robots crossing in
+corridors remain exponential for both (symmetry reasoning, Li et al. 2020, is
+not implemented): there the limits apply.
 
 **Costs** are the standard MAPF ones (:mod:`mrmp.centralized.plan`): each
 robot's first tick from which it stays at its goal, summed. With
@@ -65,8 +89,18 @@ from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass
 
-from mrmp.centralized.plan import MapfProblem, PlanningResult, as_problem, pad_headings, pad_paths
-from mrmp.centralized.space_time_astar import Reservations, SpaceTimeResult, space_time_astar
+from mrmp.centralized.plan import (
+    MapfProblem,
+    PlanningResult,
+    as_problem,
+    pad_headings,
+    pad_paths,
+)
+from mrmp.centralized.space_time_astar import (
+    Reservations,
+    SpaceTimeResult,
+    space_time_astar,
+)
 from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
 from mrmp.core.heading import Heading
@@ -89,8 +123,9 @@ DEFAULT_MAX_NODES = 100_000
 DEFAULT_TIME_LIMIT_S = 60.0
 """Seconds CBS plans at most unless told otherwise."""
 
-# A constraint: ("v", cell, t) forbids cell at t; ("e", u, v, t) forbids moving u -> v arriving at t.
-_Constraint = tuple
+_Constraint = tuple[str, Cell, int] | tuple[str, Cell, Cell, int]
+"""A CBS constraint: ``("v", cell, t)`` forbids ``cell`` at tick ``t``; ``("e", u, v, t)``
+forbids moving ``u -> v`` arriving at tick ``t``."""
 
 
 @dataclass(frozen=True)
@@ -284,10 +319,12 @@ class _Node:
 def _reservations(constraints: Sequence[_Constraint]) -> Reservations:
     table = Reservations()
     for constraint in constraints:
-        if constraint[0] == "v":
-            table.forbid_vertex(constraint[1], constraint[2])
+        if len(constraint) == 3:
+            _, cell, tick = constraint
+            table.forbid_vertex(cell, tick)
         else:
-            table.forbid_edge(constraint[1], constraint[2], constraint[3])
+            _, source, target, tick = constraint
+            table.forbid_edge(source, target, tick)
     return table
 
 
@@ -323,7 +360,10 @@ def mdd_layers(
     >>> [sorted(layer) for layer in mdd_layers(Grid(2, 2), (0, 0), (1, 1), 2, Reservations())]
     [[(0, 0)], [(0, 1), (1, 0)], [(1, 1)]]
     """
-    from mrmp.centralized.space_time_astar import heading_distance_table, hop_distance_table
+    from mrmp.centralized.space_time_astar import (
+        heading_distance_table,
+        hop_distance_table,
+    )
 
     if heading_aware:
         table = heading_distance_table(grid if not grid.has_costs else Grid(grid.x_size, grid.y_size, grid.blocked_cells()), goal)
@@ -543,6 +583,7 @@ def cbs(
                 continue
         conflict = node.chosen
         assert conflict is not None
+        splits: tuple[tuple[int, _Constraint], ...]
         if conflict.kind == "vertex":
             cell = conflict.cells[0]
             splits = ((conflict.first, ("v", cell, conflict.tick)), (conflict.second, ("v", cell, conflict.tick)))

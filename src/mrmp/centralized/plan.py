@@ -45,10 +45,10 @@ from mrmp.core.scenario import Scenario
 __all__ = [
     "BYTES_PER_CELL",
     "BYTES_PER_HEADING",
-    "MapfProblem",
-    "as_problem",
     "STATUSES",
+    "MapfProblem",
     "PlanningResult",
+    "as_problem",
     "pad_headings",
     "pad_paths",
     "path_cost",
@@ -328,8 +328,8 @@ def as_problem(
         grid = problem
         if starts is None or goals is None:
             raise InputError("a grid needs starts and goals")
-    starts = [tuple(cell) for cell in starts]  # type: ignore[misc]
-    goals = [tuple(cell) for cell in goals]  # type: ignore[misc]
+    starts = [(int(cell[0]), int(cell[1])) for cell in starts]
+    goals = [(int(cell[0]), int(cell[1])) for cell in goals]
     problems: list[Problem] = []
     if len(starts) != len(goals):
         problems.append(Problem("goals", f"{len(goals)} goals for {len(starts)} starts"))
@@ -356,8 +356,8 @@ def as_problem(
         raise InputError(problems)
     return MapfProblem(
         grid=grid,
-        starts=tuple(starts),  # type: ignore[arg-type]
-        goals=tuple(goals),  # type: ignore[arg-type]
+        starts=tuple(starts),
+        goals=tuple(goals),
         ids=tuple(str(robot_id) for robot_id in ids),
         headings=tuple(Heading.parse(h) if not isinstance(h, Heading) else h for h in headings),
     )

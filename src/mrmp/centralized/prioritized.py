@@ -42,15 +42,26 @@ from __future__ import annotations
 import time
 from collections.abc import Sequence
 
-from mrmp.centralized.plan import MapfProblem, PlanningResult, as_problem, pad_headings, pad_paths
-from mrmp.centralized.space_time_astar import Reservations, hop_distance_table, space_time_astar
+from mrmp.centralized.cbs import infeasibility_proof
+from mrmp.centralized.plan import (
+    MapfProblem,
+    PlanningResult,
+    as_problem,
+    pad_headings,
+    pad_paths,
+)
+from mrmp.centralized.space_time_astar import (
+    Reservations,
+    hop_distance_table,
+    space_time_astar,
+)
 from mrmp.core.cell import Cell
 from mrmp.core.errors import InputError
 from mrmp.core.grid import Grid
 from mrmp.core.heading import Heading
 from mrmp.core.scenario import Scenario
 
-__all__ = ["ORDERS", "priority_order", "prioritized"]
+__all__ = ["ORDERS", "prioritized", "priority_order"]
 
 ORDERS = ("scenario", "longest_first")
 """The named priority orders."""
@@ -128,7 +139,10 @@ def prioritized(
     PlanningResult
         ``"solved"``; ``"failed"`` with ``failed_robot`` when a robot could not
         be planned around those before it; ``"limit"`` when the time limit was
-        reached. ``nodes`` counts low-level expansions.
+        reached; ``"infeasible"`` when a cheap proof shows that no plan exists
+        (:func:`~mrmp.centralized.cbs.infeasibility_proof`: a goal cut off from
+        its start, or robots filling a cycle-free region). ``nodes`` counts
+        low-level expansions.
 
     Raises
     ------
@@ -145,12 +159,25 @@ def prioritized(
     began = time.perf_counter()
     instance = as_problem(problem, starts, goals)
     deadline = None if time_limit_s is None else began + time_limit_s
+    proof = infeasibility_proof(instance)
+    if proof is not None:
+        return PlanningResult("infeasible", None, time.perf_counter() - began, "pp", message=proof)
     ranking = priority_order(instance, order)
     reservations = Reservations()
     paths: list[tuple[Cell, ...] | None] = [None] * len(instance)
     headings: list[tuple[Heading, ...] | None] = [None] * len(instance)
     expansions = 0
     for rank, index in enumerate(ranking):
+        robot_id = instance.ids[index]
+        if deadline is not None and time.perf_counter() > deadline:
+            return PlanningResult(
+                "limit",
+                None,
+                time.perf_counter() - began,
+                "pp",
+                nodes=expansions,
+                message=f"time limit of {time_limit_s:g} s reached before planning robot {robot_id}",
+            )
         found = space_time_astar(
             instance.grid,
             instance.starts[index],
@@ -162,7 +189,6 @@ def prioritized(
             deadline=deadline,
         )
         expansions += found.expansions
-        robot_id = instance.ids[index]
         if found.status == "deadline":
             return PlanningResult(
                 "limit",

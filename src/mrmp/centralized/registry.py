@@ -20,9 +20,12 @@ from mrmp.centralized.plan import PlanningResult
 from mrmp.centralized.prioritized import prioritized
 from mrmp.core.scenario import Scenario
 
-_HEADING_AWARE: dict[str, Callable[..., PlanningResult]] = {"cbs": cbs, "pp": prioritized}
-PLANNER_NAMES: tuple[str, ...] = ("cbs", "pp", "lacam")
-"""Every name ``--planner`` accepts: Conflict-Based Search, prioritized planning, LaCAM."""
+PLANNERS: dict[str, Callable[..., PlanningResult]] = {"cbs": cbs, "pp": prioritized, "lacam": lacam}
+"""Central planners by name: Conflict-Based Search, prioritized planning, LaCAM. Each is called as
+``planner(scenario)`` or ``planner(grid, starts, goals)`` with keyword options."""
+PLANNER_NAMES: tuple[str, ...] = tuple(PLANNERS)
+"""Every name ``--planner`` accepts."""
+_HEADING_AWARE = ("cbs", "pp")
 
 
 def plan_with(name: str, scenario: Scenario, time_limit_s: float) -> PlanningResult:
@@ -33,6 +36,7 @@ def plan_with(name: str, scenario: Scenario, time_limit_s: float) -> PlanningRes
     KeyError
         If ``name`` is not in :data:`PLANNER_NAMES`.
     """
-    if name == "lacam":
-        return lacam(scenario, time_limit_s=time_limit_s, seed=scenario.seed)
-    return _HEADING_AWARE[name](scenario, time_limit_s=time_limit_s, heading_aware=scenario.policy.heading_aware)
+    planner = PLANNERS[name]
+    if name in _HEADING_AWARE:
+        return planner(scenario, time_limit_s=time_limit_s, heading_aware=scenario.policy.heading_aware)
+    return planner(scenario, time_limit_s=time_limit_s, seed=scenario.seed)

@@ -108,7 +108,7 @@ class Reservations:
     (2, 1)
     """
 
-    __slots__ = ("vertex", "edge", "parked", "_last_vertex", "last_time")
+    __slots__ = ("_last_vertex", "edge", "last_time", "parked", "vertex")
 
     def __init__(self) -> None:
         self.vertex: set[tuple[Cell, int]] = set()
@@ -144,21 +144,18 @@ class Reservations:
         self.vertex.add((cell, tick))
         if tick > self._last_vertex.get(cell, -1):
             self._last_vertex[cell] = tick
-        if tick > self.last_time:
-            self.last_time = tick
+        self.last_time = max(self.last_time, tick)
 
     def forbid_edge(self, source: Cell, target: Cell, tick: int) -> None:
         """Forbid moving from ``source`` at ``tick - 1`` to ``target`` at ``tick``."""
         self.edge.add((source, target, tick))
-        if tick > self.last_time:
-            self.last_time = tick
+        self.last_time = max(self.last_time, tick)
 
     def park(self, cell: Cell, tick: int) -> None:
         """Mark ``cell`` occupied at every tick from ``tick`` on (keeps the earliest)."""
         if tick < self.parked.get(cell, math.inf):
             self.parked[cell] = tick
-        if tick > self.last_time:
-            self.last_time = tick
+        self.last_time = max(self.last_time, tick)
 
     def reserve_path(self, path: Sequence[Cell]) -> None:
         """Reserve a whole path of another robot, which then stays on its last cell forever.
@@ -259,7 +256,7 @@ def heading_distance_table(grid: Grid, goal: Cell) -> dict[tuple[Cell, Heading],
     One tick moves one cell ahead or turns right once; the goal may be reached
     facing any heading. Computed by a breadth-first search backwards from the
     four goal states (Moore 1959). States that cannot reach the goal are left
-    out. Cached per grid and goal.
+    out. Entry costs are ignored. Cached per grid and goal.
 
     >>> table = heading_distance_table(Grid(1, 3), (0, 2))
     >>> table[((0, 0), Heading.EAST)], table[((0, 0), Heading.NORTH)], table[((0, 0), Heading.SOUTH)]
@@ -371,7 +368,7 @@ def space_time_astar(
     if reservations is None:
         reservations = Reservations()
     if heading_aware:
-        heading_table = heading_distance_table(_plain_grid(grid), goal)
+        heading_table = heading_distance_table(grid, goal)
 
         def estimate(cell: Cell, facing: int) -> float:
             return heading_table.get((cell, Heading(facing)), math.inf)
@@ -414,7 +411,7 @@ def space_time_astar(
     while open_list:
         _, conflicts, _, index = pop(open_list)
         cell, facing, tick = cells[index], facings[index], ticks[index]
-        key = (cell, facing, tick if tick < static_from else static_from)
+        key = (cell, facing, min(static_from, tick))
         if key in closed:
             continue
         closed.add(key)
@@ -437,7 +434,7 @@ def space_time_astar(
         else:
             moves = [(cell, 0)]
             moves.extend((n, 0) for n in neighbours(cell))
-        next_key_tick = next_tick if next_tick < static_from else static_from
+        next_key_tick = min(static_from, next_tick)
         for next_cell, next_facing in moves:
             if (next_cell, next_tick) in vertex or parked.get(next_cell, inf) <= next_tick:
                 continue
@@ -465,7 +462,7 @@ def space_time_astar(
             ticks.append(next_tick)
             parents.append(index)
             f = next_tick + h
-            push(open_list, (f if f > earliest_final else earliest_final, next_conflicts, h, len(cells) - 1))
+            push(open_list, (max(earliest_final, f), next_conflicts, h, len(cells) - 1))
     return SpaceTimeResult("horizon" if cut_by_horizon else "unreachable", None, None, expansions)
 
 

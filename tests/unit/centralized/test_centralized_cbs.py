@@ -7,10 +7,16 @@ import time
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from test_centralized_support import assert_valid_plan, brute_force_sum_of_costs, replay_headings
+from test_centralized_support import (
+    assert_valid_plan,
+    brute_force_sum_of_costs,
+    replay_headings,
+)
 
 from mrmp.centralized import PLANNERS, cbs, first_conflict, infeasibility_proof
+from mrmp.centralized.cbs import all_conflicts, mdd_layers, min_vertex_cover_size
 from mrmp.centralized.plan import as_problem
+from mrmp.centralized.space_time_astar import Reservations
 from mrmp.core.errors import InputError
 from mrmp.core.grid import Grid
 from mrmp.core.heading import Heading
@@ -29,8 +35,7 @@ def instances(draw: st.DrawFn, max_side: int = 4, max_robots: int = 3) -> tuple[
     if len(free) > 9:
         robots = min(robots, 2)  # keeps the brute force fast
     robots = min(robots, len(free))
-    if robots < 1:
-        robots = 1
+    robots = max(robots, 1)
     if not free:
         free = [cells[0]]
         blocked.discard(cells[0])
@@ -44,14 +49,16 @@ def corridor_instances(draw: st.DrawFn) -> tuple[Grid, list, list]:
     """A corridor (the south row) with passing bays to its north; robots start in the corridor.
 
     Most of these need waits, detours into a bay, or are impossible (robots
-    cannot pass each other without a bay).
+    cannot pass each other without a bay). Two robots only: three robots
+    crossing in a corridor is the textbook exponential case of CBS (Li et al.,
+    ICAPS 2020), tested separately against the node limit.
     """
     length = draw(st.integers(3, 5))
     bays = draw(st.sets(st.integers(0, length - 1), min_size=1, max_size=2))
     blocked = [(1, y) for y in range(length) if y not in bays]
     corridor = [(0, y) for y in range(length)]
     free = corridor + [(1, y) for y in sorted(bays)]
-    robots = draw(st.integers(2, 3))
+    robots = 2
     starts = draw(st.lists(st.sampled_from(corridor), min_size=robots, max_size=robots, unique=True))
     goals = draw(st.lists(st.sampled_from(free), min_size=robots, max_size=robots, unique=True))
     if draw(st.booleans()):  # make the robots cross: westmost start gets the eastmost goal, and so on
@@ -69,10 +76,24 @@ def corridor_instances(draw: st.DrawFn) -> tuple[Grid, list, list]:
 def test_cbs_sum_of_costs_equals_brute_force(instance: tuple[Grid, list, list]) -> None:
     grid, starts, goals = instance
     optimum = brute_force_sum_of_costs(grid, starts, goals)
-    result = cbs(grid, starts, goals, max_nodes=30_000 if optimum is not None else 300, time_limit_s=10.0)
+    result = cbs(grid, starts, goals, max_nodes=5000 if optimum is not None else 300, time_limit_s=10.0)
     if optimum is None:
         assert result.status in ("infeasible", "limit")
         assert result.paths is None
+    else:
+        assert_valid_plan(grid, result, starts, goals)
+        assert result.sum_of_costs() == optimum
+
+
+@settings(max_examples=60, derandomize=True, deadline=None)
+@given(st.one_of(instances(max_side=3), corridor_instances()))
+def test_original_cbs_is_optimal_too(instance: tuple[Grid, list, list]) -> None:
+    # improved=False: split the first conflict, no heuristic, no bypass (Sharon et al. 2015 as published)
+    grid, starts, goals = instance
+    optimum = brute_force_sum_of_costs(grid, starts, goals)
+    result = cbs(grid, starts, goals, max_nodes=5000 if optimum is not None else 200, improved=False)
+    if optimum is None:
+        assert not result.solved
     else:
         assert_valid_plan(grid, result, starts, goals)
         assert result.sum_of_costs() == optimum
@@ -246,3 +267,25 @@ def test_infeasibility_proof_allows_rotation_on_cycles() -> None:
 def test_planners_registry() -> None:
     assert PLANNERS["cbs"] is cbs
     assert "pp" in PLANNERS
+
+
+def test_all_conflicts_lists_every_pair_and_tick() -> None:
+    paths = [[(0, 0), (0, 1), (0, 2)], [(0, 2), (0, 1), (0, 0)], [(1, 1), (0, 1), (1, 1)]]
+    found = all_conflicts(paths)
+    assert [(c.kind, c.first, c.second, c.tick) for c in found] == [("vertex", 0, 1, 1), ("vertex", 0, 2, 1)]
+
+
+def test_mdd_layers_of_a_constrained_robot() -> None:
+    # forbidding (0, 1) at tick 1 on a 1x3 corridor: the only 3-tick paths wait first or step back
+    grid = Grid(1, 3)
+    layers = mdd_layers(grid, (0, 0), (0, 2), 3, Reservations.from_entries(vertex=[((0, 1), 1)]))
+    assert [sorted(layer) for layer in layers] == [[(0, 0)], [(0, 0)], [(0, 1)], [(0, 2)]]
+
+
+def test_min_vertex_cover_on_a_path_and_a_star() -> None:
+    assert min_vertex_cover_size([(0, 1), (1, 2), (2, 3), (3, 4)]) == 2
+    assert min_vertex_cover_size([(0, i) for i in range(1, 9)]) == 1
+    clique = [(i, j) for i in range(5) for j in range(i + 1, 5)]
+    assert min_vertex_cover_size(clique) == 4
+    # beyond the exact size a matching bound is returned, never more than the truth
+    assert min_vertex_cover_size(clique, exact_up_to=1) == 2

@@ -16,7 +16,7 @@ from __future__ import annotations
 
 import heapq
 from collections.abc import Sequence
-from itertools import product
+from itertools import pairwise, product
 
 from mrmp.centralized import PlanningResult
 from mrmp.core.grid import Grid
@@ -75,7 +75,7 @@ def brute_force_sum_of_costs(
         for i in range(count):
             if not finished >> i & 1 and cells[i] == goals[i]:
                 successors.append((cost, (cells, facings, finished | 1 << i)))
-        step = count - bin(finished).count("1")
+        step = count - finished.bit_count()
         choices = [
             [(cells[i], facings[i])] if finished >> i & 1 else _options(grid, cells[i], facings[i], heading_aware)
             for i in range(count)
@@ -112,7 +112,7 @@ def assert_valid_plan(grid: Grid, result: PlanningResult, starts: Sequence[Cell]
     for path, start, goal in zip(result.paths, starts, goals):
         assert path[0] == start
         assert path[-1] == goal
-        for before, after in zip(path, path[1:]):
+        for before, after in pairwise(path):
             assert abs(before[0] - after[0]) + abs(before[1] - after[1]) <= 1
             assert grid.is_free(after)
 
