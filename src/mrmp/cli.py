@@ -39,17 +39,22 @@ def _fail(problems: list[Problem] | tuple[Problem, ...]) -> typer.Exit:
     return typer.Exit(2)
 
 
-def parse_delay(text: str) -> tuple[int, int]:
-    """Read ``--delay``: ``N`` or ``A..B`` ticks.
+def parse_range(text: str, option: str, unit: str = "ticks", whole: bool = True) -> tuple[float, float]:
+    """Read ``N`` or ``A..B`` (whole numbers when ``whole``), with ``0 <= A <= B``.
 
-    >>> parse_delay("0..3"), parse_delay("2")
+    >>> parse_range("0..3", "--delay"), parse_range("2", "--delay")
     ((0, 3), (2, 2))
+    >>> parse_range("20..80", "--delay-ms", "milliseconds", whole=False)
+    (20.0, 80.0)
     """
     low, separator, high = text.partition("..")
+    number = int if whole else float
     try:
-        bounds = (int(low), int(high)) if separator else (int(low), int(low))
+        bounds = (number(low), number(high)) if separator else (number(low), number(low))
     except ValueError:
-        raise InputError(Problem("--delay", f"expected N or A..B ticks, got {text!r}")) from None
+        raise InputError(Problem(option, f"expected N or A..B {unit}, got {text!r}")) from None
+    if not 0 <= bounds[0] <= bounds[1]:
+        raise InputError(Problem(option, f"expected 0 <= A <= B {unit}, got {text!r}"))
     return bounds
 
 
@@ -77,7 +82,7 @@ def _apply_options(scenario: Scenario, **options: object) -> Scenario:
         key: options[key] for key in ("loss", "duplicate", "reorder") if options.get(key) is not None
     }
     if options.get("delay") is not None:
-        network_changes["delay_min"], network_changes["delay_max"] = parse_delay(str(options["delay"]))
+        network_changes["delay_min"], network_changes["delay_max"] = parse_range(str(options["delay"]), "--delay")
     if network_changes:
         network = NetworkFaults(**{**network.__dict__, **network_changes})
     changes: dict[str, object] = {"policy": policy, "network": network}
@@ -106,19 +111,13 @@ def _fraction(value: float, option: str) -> float:
 
 
 def parse_range_ms(text: str, option: str) -> tuple[float, float]:
-    """Read ``N`` or ``A..B`` milliseconds as seconds.
+    """Read ``N`` or ``A..B`` milliseconds, as seconds.
 
     >>> parse_range_ms("20..80", "--delay-ms")
     (0.02, 0.08)
     """
-    low, separator, high = text.partition("..")
-    try:
-        bounds = (float(low), float(high)) if separator else (float(low), float(low))
-    except ValueError:
-        raise InputError(Problem(option, f"expected N or A..B milliseconds, got {text!r}")) from None
-    if not 0 <= bounds[0] <= bounds[1]:
-        raise InputError(Problem(option, f"expected 0 <= A <= B, got {text!r}"))
-    return bounds[0] / 1000.0, bounds[1] / 1000.0
+    low, high = parse_range(text, option, "milliseconds", whole=False)
+    return low / 1000.0, high / 1000.0
 
 
 def parse_kills(items: list[str]) -> dict[str, float]:
@@ -432,6 +431,9 @@ def agent(
                 peers[ids.index(name)] = parse_address(address)
             except ValueError as error:
                 raise InputError(Problem("--peer", str(error))) from None
+        missing = [ids[other] for other in range(len(ids)) if other != index and other not in peers]
+        if transport == "udp" and missing:
+            raise InputError(Problem("--peer", f"no address for {', '.join(missing)}: give --peer ID=HOST:PORT for every other robot"))
         try:
             spec = TransportSpec(
                 transport,

@@ -121,6 +121,24 @@ class Scenario:
         """A copy with some fields replaced (a frozen dataclass ``replace``)."""
         return replace(self, **changes)  # type: ignore[arg-type]
 
+    def worst_faults(self) -> NetworkFaults:
+        """The worst loss, delay, duplication and reordering over the network and all its links.
+
+        >>> from mrmp.core.grid import Grid
+        >>> scenario = Scenario(Grid(2, 2), (), network=NetworkFaults(loss=0.1),
+        ...                     links=(LinkFaults("A", "B", NetworkFaults(delay_max=3)),))
+        >>> scenario.worst_faults()
+        NetworkFaults(loss=0.1, delay_min=0, delay_max=3, duplicate=0.0, reorder=0.0)
+        """
+        every = [self.network, *(link.faults for link in self.links)]
+        return NetworkFaults(
+            loss=max(faults.loss for faults in every),
+            delay_min=min(faults.delay_min for faults in every),
+            delay_max=max(faults.delay_max for faults in every),
+            duplicate=max(faults.duplicate for faults in every),
+            reorder=max(faults.reorder for faults in every),
+        )
+
     def robot(self, robot_id: str) -> RobotSpec:
         """The robot named ``robot_id``.
 

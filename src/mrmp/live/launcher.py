@@ -60,14 +60,23 @@ class LiveOptions:
 
 
 def free_ports(count: int) -> list[int]:
-    """``count`` distinct free TCP/UDP ports on loopback (bound and released together)."""
-    sockets = []
+    """``count`` distinct ports free for both UDP and TCP on loopback (bound and released together)."""
+    sockets: list[socket.socket] = []
+    ports: list[int] = []
     try:
-        for _ in range(count):
+        while len(ports) < count:
+            tcp = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
+            tcp.bind(("127.0.0.1", 0))
+            sockets.append(tcp)
+            port = tcp.getsockname()[1]
             udp = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-            udp.bind(("127.0.0.1", 0))
             sockets.append(udp)
-        return [sock.getsockname()[1] for sock in sockets]
+            try:
+                udp.bind(("127.0.0.1", port))
+            except OSError:
+                continue  # taken for UDP: keep the TCP socket bound so it is not offered again, try another
+            ports.append(port)
+        return ports
     finally:
         for sock in sockets:
             sock.close()

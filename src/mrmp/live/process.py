@@ -135,49 +135,52 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
     """Run one robot until it is done, writing ``agent-<i>.json`` and ``trace-<i>.jsonl`` in ``options.results``."""
     index = options.index
     options.results.mkdir(parents=True, exist_ok=True)
-    transport: Transport = open_transport(options.transport, index, len(scenario.robots))
-    if not options.faults.is_perfect:
-        transport = FaultyTransport(transport, options.faults, seed=options.seed * 7919 + index)
-    trace = TraceWriter(options.results / f"trace-{index}.jsonl", index)
-    spec = scenario.robots[index]
-    body = SimulatedBody(
-        spec.start,
-        spec.heading,
-        scenario.grid,
-        scenario.timing,
-        time_scale=options.time_scale,
-        jitter=options.jitter,
-        miss_line=options.miss_line,
-        rng=random.Random(options.seed * 104_729 + index),
-        recorder=OccupancyRecorder(trace.write),
-    )
     policy = None
     if options.plan is not None:
         plan = read_plan(options.plan, [robot.id for robot in scenario.robots])
         policy = plan_policies(plan)[index]
-    agent = Agent(
-        scenario,
-        index,
-        transport,
-        body,
-        Sealer(options.key, options.session),
-        Opener(options.key, options.session, fleet_size=len(scenario.robots)),
-        timing=options.timing,
-        guarded=options.guarded,
-        seed=options.seed,
-        policy=policy,
-    )
+    spec = scenario.robots[index]
     report_path = options.results / f"agent-{index}.json"
-    _on_stop_signals(agent.stop_requested.set)
-    wait_for_peers = getattr(transport, "wait_for_peers", None) or getattr(getattr(transport, "inner", None), "wait_for_peers", None)
-    if wait_for_peers is not None:
-        wait_for_peers(len(scenario.robots) - 1, timeout=10.0)
+    trace = TraceWriter(options.results / f"trace-{index}.jsonl", index)
+    transport: Transport | None = None
     try:
+        transport = open_transport(options.transport, index, len(scenario.robots))
+        if not options.faults.is_perfect:
+            transport = FaultyTransport(transport, options.faults, seed=options.seed * 7919 + index)
+        body = SimulatedBody(
+            spec.start,
+            spec.heading,
+            scenario.grid,
+            scenario.timing,
+            time_scale=options.time_scale,
+            jitter=options.jitter,
+            miss_line=options.miss_line,
+            rng=random.Random(options.seed * 104_729 + index),
+            recorder=OccupancyRecorder(trace.write),
+        )
+        agent = Agent(
+            scenario,
+            index,
+            transport,
+            body,
+            Sealer(options.key, options.session),
+            Opener(options.key, options.session, fleet_size=len(scenario.robots)),
+            timing=options.timing,
+            guarded=options.guarded,
+            seed=options.seed,
+            policy=policy,
+        )
+        _on_stop_signals(agent.stop_requested.set)
+        inner = getattr(transport, "inner", transport)
+        wait_for_peers = getattr(inner, "wait_for_peers", None)
+        if wait_for_peers is not None:
+            wait_for_peers(len(scenario.robots) - 1, timeout=10.0)
         report = agent.run(on_progress=lambda report: write_json(report_path, report.as_dict()))
     finally:
-        transport.close()
+        if transport is not None:
+            transport.close()
         trace.close()
-    write_json(report_path, agent.report.as_dict())
+    write_json(report_path, report.as_dict())
     return report
 
 

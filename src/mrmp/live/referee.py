@@ -79,14 +79,6 @@ class IntervalReferee:
             if interval is not None:
                 interval.end = t
 
-    def cells_at(self, t: float) -> list[list[Cell]]:
-        """For each robot, the cells it covers at time ``t``."""
-        covered: list[list[Cell]] = [[] for _ in self.robot_ids]
-        for interval in self.intervals:
-            if interval.start <= t < interval.end:
-                covered[interval.robot].append(interval.cell)
-        return covered
-
     def _tick(self, t: float) -> int:
         return int(round((t - self.start_time) * 1000))
 
@@ -101,7 +93,7 @@ class IntervalReferee:
                 found.append((interval.start, Collision("off_grid", self._tick(interval.start), (ids[interval.robot],), (interval.cell,))))
             elif self.grid.is_blocked(interval.cell):
                 found.append((interval.start, Collision("obstacle", self._tick(interval.start), (ids[interval.robot],), (interval.cell,))))
-        overlaps: dict[tuple[int, int], list[tuple[float, Cell]]] = {}
+        overlaps: dict[tuple[int, int], list[tuple[float, float, Interval, Interval]]] = {}
         for cell, intervals in by_cell.items():
             intervals.sort(key=lambda interval: interval.start)
             for i, first in enumerate(intervals):
@@ -109,22 +101,48 @@ class IntervalReferee:
                     if second.start >= first.end:
                         break
                     if first.robot != second.robot:
-                        pair = tuple(sorted((first.robot, second.robot)))
-                        overlaps.setdefault(pair, []).append((max(first.start, second.start), cell))  # type: ignore[arg-type]
-        for (a, b), cells in overlaps.items():
-            cells.sort()
-            distinct = sorted({cell for _, cell in cells})
-            t = cells[0][0]
-            kind = "swap" if len(distinct) == 2 and self._exchanged(a, b, distinct) else "vertex"
-            shown = tuple(distinct) if kind == "swap" else (cells[0][1],)
-            found.append((t, Collision(kind, self._tick(t), (ids[a], ids[b]), shown)))
+                        a, b = sorted((first, second), key=lambda interval: interval.robot)
+                        start, end = max(a.start, b.start), min(a.end, b.end)
+                        overlaps.setdefault((a.robot, b.robot), []).append((start, end, a, b))
+        for (a, b), spans in overlaps.items():
+            for episode in _episodes(spans):
+                t = episode[0][0]
+                cells = sorted({span[2].cell for span in episode})
+                kind = "swap" if _exchanged(episode) else "vertex"
+                shown = tuple(cells) if kind == "swap" else (episode[0][2].cell,)
+                found.append((t, Collision(kind, self._tick(t), (ids[a], ids[b]), shown)))
         found.sort(key=lambda item: item[0])
         return [collision for _, collision in found]
 
-    def _exchanged(self, a: int, b: int, cells: list[Cell]) -> bool:
-        """Whether robots ``a`` and ``b`` each moved from one of ``cells`` into the other."""
-        first: dict[int, list[Cell]] = {a: [], b: []}
-        for interval in sorted(self.intervals, key=lambda interval: interval.start):
-            if interval.robot in first and interval.cell in cells:
-                first[interval.robot].append(interval.cell)
-        return all(len(order) >= 2 and order[-2] != order[-1] for order in first.values()) and first[a][-1] != first[b][-1]
+
+Span = tuple[float, float, Interval, Interval]
+
+
+def _episodes(spans: list[Span]) -> list[list[Span]]:
+    """Group one pair's overlaps into episodes: overlaps that touch in time belong together."""
+    episodes: list[list[Span]] = []
+    end = -math.inf
+    for span in sorted(spans, key=lambda span: span[0]):
+        if span[0] > end or not episodes:
+            episodes.append([span])
+            end = span[1]
+        else:
+            episodes[-1].append(span)
+            end = max(end, span[1])
+    return episodes
+
+
+def _exchanged(episode: list[Span]) -> bool:
+    """Whether, in this episode, each robot moved into the cell the other was leaving (a swap)."""
+    cells = {span[2].cell for span in episode}
+    if len(cells) != 2:
+        return False
+    first: dict[int, dict[Cell, float]] = {}
+    for _, _, a, b in episode:
+        for interval in (a, b):
+            first.setdefault(interval.robot, {})[interval.cell] = interval.start
+    if len(first) != 2 or any(len(entered) != 2 for entered in first.values()):
+        return False
+    (robot_a, cells_a), (robot_b, cells_b) = first.items()
+    x, y = sorted(cells)
+    return (cells_a[x] < cells_a[y]) == (cells_b[y] < cells_b[x])

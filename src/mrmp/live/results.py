@@ -89,8 +89,10 @@ def live_result(
             result.messages_sent = int(report.get("messages_sent", 0))
             result.bytes_sent = int(report.get("bytes_sent", 0))
             arrival = report.get("arrival_time")
-            if arrival is not None:
+            if arrival is not None and result.arrived:
                 result.time_s = float(report["started_at"]) + float(arrival) - fleet_start
+            else:  # not settled at its goal (by ground truth): it counts the whole run, as in the simulator
+                result.time_s = float(report["ended_at"]) - fleet_start
             network["messages_sent"] += int(report.get("messages_sent", 0))
             network["datagrams_sent"] += int(report.get("datagrams_sent", 0))
             network["messages_received"] += int(report.get("messages_received", 0))

@@ -123,7 +123,11 @@ class UdpTransport(_UdpSocket):
         self._closed = False
 
     def send(self, data: bytes, recipient: int | None = None) -> None:
-        targets = self.peers.values() if recipient is None else [self.peers[recipient]]
+        if recipient is None:
+            targets = list(self.peers.values())
+        else:
+            address = self.peers.get(recipient)
+            targets = [address] if address is not None else []  # no address: lost, as on any network
         for address in targets:
             try:
                 self._socket.sendto(data, address)

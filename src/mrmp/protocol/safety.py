@@ -15,7 +15,9 @@ robot registers a cell to at most one owner at a time, so two robots can never
 both hold a majority for one cell at once. A registration is only dropped on
 evidence from its owner itself: a state message sent *after* the claim (a larger
 sequence number) that shows the owner neither covering the cell nor still
-claiming it. Until then the granting robot keeps the cell for its owner, even if
+claiming it. A registration only ever moves forward (to a newer claim of the
+same owner, never back to an older one), and a claim older than one already
+seen from its sender is ignored. Until then the granting robot keeps the cell for its owner, even if
 the owner is silent for ever (a crashed robot is an obstacle at its last cells),
 so lost, late, duplicated or reordered messages can only delay a robot, never
 let two robots into one cell. The full argument, and what it costs in messages,
@@ -119,6 +121,7 @@ class SafetyLayer:
         self._claim_numbers = 0
         self._grants: dict[Cell, _Grant] = {}
         self._newest_state: dict[int, tuple[int, int]] = {}
+        self._highest_claim: dict[int, int] = {}
         for owner, cell in enumerate(starts):
             if owner != index:
                 self._grants[cell] = _Grant(owner, 0, 0, cell)
@@ -135,10 +138,6 @@ class SafetyLayer:
             return self.index
         grant = self._grants.get(cell)
         return grant.owner if grant is not None else None
-
-    def registered_to_others(self) -> dict[Cell, int]:
-        """Every cell registered to a peer, with its owner (for planning around them)."""
-        return {cell: grant.owner for cell, grant in self._grants.items()}
 
     # -- this robot's claims ----------------------------------------------------------
 
@@ -194,11 +193,11 @@ class SafetyLayer:
             return None
         if pending.refused:
             self.stats.refused += 1
-            self.pending = None
+            self.cancel_claim()
             return None
         if now - pending.started_at >= self.claim_timeout:
             self.stats.timed_out += 1
-            self.pending = None
+            self.cancel_claim()
             return None
         if now - pending.sent_at >= self.retry_interval and 1 + len(pending.votes) < self.quorum:
             pending.sent_at = now
@@ -222,6 +221,7 @@ class SafetyLayer:
         if message.seq <= self._newest_state.get(sender, (-1, 0))[0]:
             return
         self._newest_state[sender] = (message.seq, message.claim)
+        self._highest_claim[sender] = max(self._highest_claim.get(sender, 0), message.claim)
         occupied = message.occupied
         for cell in [cell for cell, grant in self._grants.items() if grant.owner == sender]:
             grant = self._grants[cell]
@@ -243,13 +243,18 @@ class SafetyLayer:
         newest_seq, newest_claim = self._newest_state.get(sender, (-1, 0))
         if message.seq < newest_seq and newest_claim != message.claim:
             return None  # a newer state of its sender shows it gave this claim up
+        if message.claim < self._highest_claim.get(sender, 0):
+            return None  # its sender has made a newer claim since: this one is over
+        self._highest_claim[sender] = message.claim
         owner = self.owner_of(cell)
         if owner == self.index and self.pending is not None and self.pending.cell == cell and cell != self.present:
             if self.target != cell and claimant_outranks and self.granted_claim is None:
                 self.pending = None
                 owner = self.owner_of(cell)
         if owner is None or owner == sender:
-            self._grants[cell] = _Grant(sender, message.claim, message.seq, cell)
+            previous = self._grants.get(cell)
+            claim_seq = message.seq if previous is None else max(previous.claim_seq, message.seq)
+            self._grants[cell] = _Grant(sender, message.claim, claim_seq, cell)  # records only move forward
             self.stats.grants_given += 1
             return ReplyMessage(self.index, 0, sender, message.claim, cell, True)
         self.stats.refusals_given += 1

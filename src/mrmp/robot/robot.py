@@ -139,14 +139,7 @@ class Robot:
                 }
         return Situation(self.index, self.present, self.heading, self.goal, self.grid, peers)
 
-    def silent_peers(self) -> list[int]:
-        """Indices of peers not heard from within the silence timeout (never heard counts as silent)."""
-        if self.silence_timeout is None:
-            return []
-        horizon = self.now - self.silence_timeout
-        known = self.belief.peers
-        return [index for index in range(self.safety.fleet_size) if index != self.index
-                and (index not in known or known[index].heard_at < horizon)]
+
 
     def _stamp(self, message: Message) -> Message:
         self.seq += 1
@@ -169,9 +162,13 @@ class Robot:
     # -- the step -------------------------------------------------------------------
 
     def announce(self, now: float) -> list[Outgoing]:
-        """Compute the intended Next (unless moving) and return the state message announcing it."""
+        """Compute the intended Next and return the state message announcing it.
+
+        While the robot is moving, or has chosen a cell and is claiming it, its
+        Next stays what it announced (a heartbeat repeats it).
+        """
         self.now = now
-        if not self.moving:
+        if not self.moving and self.wanted is None and self.safety.pending is None:
             self.intended = self.policy.intend(self.situation())
         return [Outgoing(self.state_message())]
 

@@ -47,8 +47,23 @@ def default_max_ticks(scenario: Scenario, lengths: Sequence[int]) -> int:
     """
     longest = max(lengths, default=0)
     ticks = max(64, 4 * longest + 2 * len(scenario.robots))
-    network = scenario.network
-    if scenario.safety and not network.is_perfect:
-        delivered = max(1.0 - network.loss, 0.05) ** 2
-        ticks = int(ticks * (2 * network.delay_max + 1) / delivered)
+    if scenario.safety:
+        ticks = int(ticks * network_slowdown(scenario))
     return ticks
+
+
+def network_slowdown(scenario: Scenario) -> float:
+    """How many times longer a guarded exchange takes over the scenario's worst faults than over a perfect network.
+
+    A claim's round trip takes up to ``2 * delay_max + 1`` ticks, and a claim and
+    its answer both get through with probability ``(1 - loss)^2``.
+
+    >>> from mrmp.core import Grid, NetworkFaults, Scenario
+    >>> network_slowdown(Scenario(Grid(2, 2), (), network=NetworkFaults(loss=0.5, delay_max=1)))
+    12.0
+    """
+    worst = scenario.worst_faults()
+    if worst.is_perfect:
+        return 1.0
+    delivered = max(1.0 - worst.loss, 0.05) ** 2
+    return (2 * worst.delay_max + 1) / delivered

@@ -107,8 +107,3 @@ class SimulatedNetwork:
             self.stats.bytes_delivered += len(payload)
         self.stats.delivered += len(out)
         return out
-
-    @property
-    def in_flight(self) -> int:
-        """Datagrams sent but not yet delivered."""
-        return len(self._queue)

@@ -42,13 +42,14 @@ from mrmp.policies.registry import make_policy
 from mrmp.protocol.codec import DecodeError, decode, encode
 from mrmp.protocol.messages import Message
 from mrmp.robot.robot import Outgoing, Robot
-from mrmp.sim.metrics import default_max_ticks, shortest_steps
+from mrmp.sim.metrics import default_max_ticks, network_slowdown, shortest_steps
 from mrmp.sim.network import SimulatedNetwork
 from mrmp.sim.referee import Referee
 
 RECURRENCE_LIMIT = 10
 """How often one configuration may recur before the run is declared stuck (plus
-twice the claim timeout, so that robots waiting for late answers are not)."""
+twice the claim timeout, so that robots waiting for late answers are not, and
+times the expected tries of a claim under loss)."""
 
 
 def safety_timers(delay_max: int) -> tuple[int, int]:
@@ -85,8 +86,7 @@ class LockstepSimulator:
         self.scenario = scenario
         grid = scenario.grid
         starts = [spec.start for spec in scenario.robots]
-        delay_max = max([scenario.network.delay_max, *(link.faults.delay_max for link in scenario.links)])
-        retry, timeout = safety_timers(delay_max)
+        retry, timeout = safety_timers(scenario.worst_faults().delay_max)
         self.robots = [
             Robot(
                 spec,
@@ -100,7 +100,8 @@ class LockstepSimulator:
             )
             for index, spec in enumerate(scenario.robots)
         ]
-        self.recurrence_limit = RECURRENCE_LIMIT + 2 * timeout
+        slowdown = network_slowdown(scenario) if scenario.safety else 1.0
+        self.recurrence_limit = int((RECURRENCE_LIMIT + 2 * timeout) * max(1.0, slowdown / (2 * scenario.worst_faults().delay_max + 1)))
         index_of = {spec.id: index for index, spec in enumerate(scenario.robots)}
         links = {(index_of[link.sender], index_of[link.recipient]): link.faults for link in scenario.links}
         self.network = SimulatedNetwork(scenario.network, seed=scenario.seed, links=links)

@@ -102,3 +102,31 @@ def test_line_counting_body_turns_right_before_driving():
         t += 0.001
         driver.advance(t)
     assert body.heading is Heading.EAST and body.turns == 1 and t > 0.5
+
+
+def test_interval_referee_counts_each_episode_and_tells_swaps_from_vertex_collisions():
+    from mrmp.live.referee import IntervalReferee
+
+    referee = IntervalReferee(Grid(1, 4), ["A", "B"], starts=[(0, 0), (0, 1)], start_time=0.0)
+    referee.feed(0, "enter", (0, 1), 1.0)  # A drives into B's cell while B drives into A's: a swap
+    referee.feed(1, "enter", (0, 0), 1.0)
+    referee.feed(0, "leave", (0, 0), 2.0)
+    referee.feed(1, "leave", (0, 1), 2.0)
+    referee.feed(0, "enter", (0, 2), 3.0)  # apart again ...
+    referee.feed(0, "leave", (0, 1), 4.0)
+    referee.feed(1, "enter", (0, 1), 5.0)
+    referee.feed(1, "leave", (0, 0), 6.0)
+    referee.feed(1, "enter", (0, 2), 7.0)  # ... then B runs into A: a second, vertex, collision
+    found = [(c.kind, c.tick, c.cells) for c in referee.collisions()]
+    assert found == [("swap", 1000, ((0, 0), (0, 1))), ("vertex", 7000, ((0, 2),))]
+
+
+def test_interval_referee_finds_nothing_when_robots_follow():
+    from mrmp.live.referee import IntervalReferee
+
+    referee = IntervalReferee(Grid(1, 4), ["A", "B"], starts=[(0, 0), (0, 1)], start_time=0.0)
+    referee.feed(1, "enter", (0, 2), 1.0)
+    referee.feed(1, "leave", (0, 1), 2.0)
+    referee.feed(0, "enter", (0, 1), 2.0)  # enters exactly when B has left
+    referee.feed(0, "leave", (0, 0), 3.0)
+    assert referee.collisions() == []
