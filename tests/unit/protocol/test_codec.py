@@ -61,6 +61,27 @@ def test_garbage_raises_only_decode_error(data):
         assert encode(message) == data  # anything accepted is exactly a valid encoding
 
 
+@settings(max_examples=500, derandomize=True)
+@given(messages, st.data())
+def test_mutations_of_valid_messages_decode_to_valid_messages_or_raise(message, data):
+    """Flip, cut or extend a valid encoding: the result is a typed error or a message that encodes back exactly."""
+    encoded = bytearray(encode(message))
+    how = data.draw(st.sampled_from(["flip", "cut", "extend"]))
+    if how == "flip":
+        position = data.draw(st.integers(0, len(encoded) - 1))
+        encoded[position] ^= data.draw(st.integers(1, 255))
+    elif how == "cut":
+        encoded = encoded[: data.draw(st.integers(0, len(encoded) - 1))]
+    else:
+        encoded += data.draw(st.binary(min_size=1, max_size=8))
+    try:
+        decoded = decode(bytes(encoded))
+    except DecodeError as error:
+        assert error.reason in ("oversized", "truncated", "version", "type", "malformed")
+    else:
+        assert encode(decoded) == bytes(encoded)
+
+
 def _valid():
     return encode(StateMessage(3, 9, (1, 2), (2, 2), Heading.EAST, True))
 
