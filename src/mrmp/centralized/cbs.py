@@ -69,7 +69,7 @@ Examples
 --------
 Two robots swapping ends of a corridor with a passing bay:
 
->>> from mrmp.core.grid import Grid
+>>> from mrmp.core.grid import Grid, connected_regions
 >>> from mrmp.sim.referee import check_paths
 >>> grid = Grid.from_rows(["#.#", "..."])
 >>> result = cbs(grid, [(0, 0), (0, 2)], [(0, 2), (0, 0)])
@@ -85,7 +85,6 @@ from __future__ import annotations
 
 import heapq
 import time
-from collections import deque
 from collections.abc import Sequence
 from dataclasses import dataclass
 
@@ -221,23 +220,7 @@ def infeasibility_proof(problem: MapfProblem) -> str | None:
     True
     """
     grid = problem.grid
-    labels: dict[Cell, int] = {}
-    regions: list[list[Cell]] = []
-    for origin in problem.starts + problem.goals:
-        if origin in labels:
-            continue
-        label = len(regions)
-        region = [origin]
-        labels[origin] = label
-        queue = deque([origin])
-        while queue:
-            cell = queue.popleft()
-            for neighbour in grid.neighbours(cell):
-                if neighbour not in labels:
-                    labels[neighbour] = label
-                    region.append(neighbour)
-                    queue.append(neighbour)
-        regions.append(region)
+    labels, regions = connected_regions(grid, problem.starts + problem.goals)
     for robot_id, start, goal in zip(problem.ids, problem.starts, problem.goals):
         if labels[start] != labels[goal]:
             return f"robot {robot_id} cannot reach its goal {goal} from {start}"

@@ -32,6 +32,7 @@ Examples
 
 from __future__ import annotations
 
+from collections import deque
 from collections.abc import Iterable, Mapping, Sequence
 
 from mrmp.core.cell import Cell
@@ -62,6 +63,37 @@ def movingai_from_cell(cell: Cell, height: int) -> tuple[int, int]:
     (0, 0)
     """
     return (cell[1], height - 1 - cell[0])
+
+
+def connected_regions(grid: Grid, origins: Iterable[Cell]) -> tuple[dict[Cell, int], list[list[Cell]]]:
+    """Label the 4-connected free regions that contain ``origins``, by breadth-first search.
+
+    Returns the label of every cell in those regions and each region's cells
+    (its first origin first, then in breadth-first order).
+
+    >>> grid = Grid.from_rows(["..@.."])
+    >>> labels, regions = connected_regions(grid, [(0, 0), (0, 4), (0, 1)])
+    >>> labels[(0, 1)] == labels[(0, 0)] != labels[(0, 4)], regions
+    (True, [[(0, 0), (0, 1)], [(0, 4), (0, 3)]])
+    """
+    labels: dict[Cell, int] = {}
+    regions: list[list[Cell]] = []
+    for origin in origins:
+        if origin in labels:
+            continue
+        label = len(regions)
+        region = [origin]
+        labels[origin] = label
+        queue = deque([origin])
+        while queue:
+            cell = queue.popleft()
+            for neighbour in grid.neighbours(cell):
+                if neighbour not in labels:
+                    labels[neighbour] = label
+                    region.append(neighbour)
+                    queue.append(neighbour)
+        regions.append(region)
+    return labels, regions
 
 
 class Grid:

@@ -7,7 +7,7 @@ problem by its field path, which the I/O layer turns into a file and line.
 
 Examples
 --------
->>> from mrmp.core.grid import Grid
+>>> from mrmp.core.grid import Grid, connected_regions
 >>> swap = Scenario(Grid(5, 5), (RobotSpec("A", (0, 2), (4, 2)), RobotSpec("B", (4, 2), (0, 2))))
 >>> [robot.heading.name for robot in swap.robots]
 ['NORTH', 'NORTH']
@@ -21,11 +21,10 @@ Examples
 from __future__ import annotations
 
 from dataclasses import dataclass, field, replace
-from collections import deque
 
 from mrmp.core.cell import Cell
 from mrmp.core.errors import Problem
-from mrmp.core.grid import Grid
+from mrmp.core.grid import Grid, connected_regions
 from mrmp.core.heading import Heading
 
 RESOLUTIONS = ("divert", "wait")
@@ -124,7 +123,7 @@ class Scenario:
     def worst_faults(self) -> NetworkFaults:
         """The worst loss, delay, duplication and reordering over the network and all its links.
 
-        >>> from mrmp.core.grid import Grid
+        >>> from mrmp.core.grid import Grid, connected_regions
         >>> scenario = Scenario(Grid(2, 2), (), network=NetworkFaults(loss=0.1),
         ...                     links=(LinkFaults("A", "B", NetworkFaults(delay_max=3)),))
         >>> scenario.worst_faults()
@@ -151,24 +150,6 @@ class Scenario:
             if robot.id == robot_id:
                 return robot
         raise KeyError(robot_id)
-
-
-def _component_labels(grid: Grid) -> dict[Cell, int]:
-    """Label each free cell with its 4-connected component."""
-    labels: dict[Cell, int] = {}
-    for origin in grid.free_cells():
-        if origin in labels:
-            continue
-        label = len(labels)
-        labels[origin] = label
-        queue = deque([origin])
-        while queue:
-            cell = queue.popleft()
-            for neighbour in grid.neighbours(cell):
-                if neighbour not in labels:
-                    labels[neighbour] = label
-                    queue.append(neighbour)
-    return labels
 
 
 def _fault_problems(faults: NetworkFaults, where: str) -> list[Problem]:
@@ -220,7 +201,7 @@ def scenario_problems(scenario: Scenario) -> list[Problem]:
                 seen[cell] = index
         if endpoints_ok:
             if labels is None:
-                labels = _component_labels(grid)
+                labels = connected_regions(grid, grid.free_cells())[0]
             if labels[robot.start] != labels[robot.goal]:
                 problems.append(Problem(f"{where}.goal", f"cell {robot.goal} cannot be reached from start {robot.start}"))
     timing = scenario.timing
