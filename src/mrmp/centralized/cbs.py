@@ -69,7 +69,7 @@ Examples
 --------
 Two robots swapping ends of a corridor with a passing bay:
 
->>> from mrmp.core.grid import Grid, connected_regions
+>>> from mrmp.core.grid import Grid
 >>> from mrmp.sim.referee import check_paths
 >>> grid = Grid.from_rows(["#.#", "..."])
 >>> result = cbs(grid, [(0, 0), (0, 2)], [(0, 2), (0, 0)])
@@ -101,7 +101,7 @@ from mrmp.centralized.space_time_astar import (
     space_time_astar,
 )
 from mrmp.core.cell import Cell
-from mrmp.core.grid import Grid
+from mrmp.core.grid import Grid, connected_regions
 from mrmp.core.heading import Heading
 from mrmp.core.scenario import Scenario
 
