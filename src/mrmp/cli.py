@@ -403,7 +403,7 @@ def agent(
     reorder: Annotated[float, typer.Option(help="Inject: probability that a sent message is held back.")] = 0.0,
     listen_time: Annotated[float, typer.Option(help="Seconds between announcing Next and deciding.")] = 0.05,
     unsafe: Annotated[bool, typer.Option("--unsafe", help="No safety layer: the policy as written.")] = False,
-    plan: Annotated[Optional[Path], typer.Option(help="Follow this robot's share of a central plan (plan.json).")] = None,
+    plan: Annotated[Optional[Path], typer.Option(help="Follow this robot's share of a central plan (plan-<index>.json).")] = None,
     seed: Annotated[int, typer.Option(help="Seed of the body's and the fault injector's randomness.")] = 0,
     timeout: Annotated[float, typer.Option(help="Give up after this many seconds.")] = 600.0,
 ) -> None:
@@ -469,9 +469,9 @@ def agent(
             plan=plan,
         )
         if plan is not None:
-            from mrmp.io.plans import read_plan
+            from mrmp.io.plans import read_share
 
-            read_plan(plan, ids)  # a bad plan file is bad input: report it before any socket opens
+            read_share(plan, robot)  # a bad share is bad input: report it before any socket opens
     except InputError as error:
         raise _fail(error.problems) from None
     report = run_agent(scenario, options)

@@ -7,7 +7,8 @@ runs in the lockstep simulator (guarded by the safety layer); each central
 planner plans, and the fleet then executes its plan through the plan's action
 dependencies in the same simulator. Each row gives success, makespan, sum of
 costs over the lower bound, planning wall time, execution wall time, messages
-sent and, for central planners, the size of the plan to distribute.
+sent and, for central planners, the size of the plan to distribute (every
+robot's share: its moves and the dependencies it waits for).
 """
 
 from __future__ import annotations

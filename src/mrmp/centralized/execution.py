@@ -19,10 +19,11 @@ Examples
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import replace
 
 from mrmp.centralized.dependencies import action_dependencies
-from mrmp.centralized.plan import PlanningResult, plan_size_bytes
+from mrmp.centralized.plan import PlanningResult
 from mrmp.core.errors import MrmpError
 from mrmp.core.result import RunResult
 from mrmp.core.scenario import Scenario
@@ -44,7 +45,21 @@ def plan_policies(plan: PlanningResult) -> list[PlanFollowingPolicy]:
     return [PlanFollowingPolicy(robot_moves, needs) for robot_moves, needs in zip(moves, dependencies)]
 
 
+def distributed_bytes(policies: Sequence[PlanFollowingPolicy]) -> int:
+    """What the fleet receives: per robot, 8 bytes per move (two 32-bit coordinates) and
+    12 per dependency (move, robot, progress as 32-bit integers).
+
+    >>> distributed_bytes([PlanFollowingPolicy([(0, 1), (0, 2)], {1: [(1, 1)]})])
+    28
+    """
+    return sum(
+        8 * len(policy.moves) + 12 * sum(len(needs) for needs in policy.dependencies.values()) for policy in policies
+    )
+
+
 def execute_in_simulator(scenario: Scenario, plan: PlanningResult) -> RunResult:
     """Run the fleet following ``plan`` in the lockstep simulator (with the scenario's network faults)."""
-    result = simulate(scenario, policies=plan_policies(plan))
-    return replace(result, planning_time_s=plan.planning_time_s, plan_bytes=plan_size_bytes(plan), policy=plan.planner)
+    policies = plan_policies(plan)
+    size = distributed_bytes(policies)
+    result = simulate(scenario, policies=policies)
+    return replace(result, planning_time_s=plan.planning_time_s, plan_bytes=size, policy=plan.planner)

@@ -105,8 +105,8 @@ class RunResult:
     time, its robots' ``time_s`` are wall-clock arrival times, and
     ``ideal_makespan_s`` is the longest single-robot path time at the run's
     speed. Runs executing a central plan carry the wall time spent planning,
-    ``planning_time_s``, and the size of the plan handed to the robots,
-    ``plan_bytes``.
+    ``planning_time_s``, and the size of the shares of the plan handed to the
+    robots (their moves and dependencies), ``plan_bytes``.
     """
 
     scenario: str

@@ -1,9 +1,12 @@
 """Central plans on disk: what a planner hands to the fleet.
 
-A plan file is a JSON object ``{"format": 1, "planner": ..., "status": ...,
-"planning_time_s": ..., "robots": [{"id": ..., "path": [[x, y], ...]}, ...]}``,
-robots in scenario order. Each robot of a live fleet reads its own path from it
-(and computes the dependencies it must wait for from the others' paths).
+* A *plan file* is the whole plan, for the record: ``{"format": 1, "planner": ...,
+  "status": ..., "planning_time_s": ..., "robots": [{"id": ..., "path": [[x, y],
+  ...]}, ...]}``, robots in scenario order.
+* A *share* is what one robot receives: ``{"format": 1, "robot": id, "moves":
+  [[x, y], ...], "dependencies": [[move, robot index, progress], ...]}``, its own
+  moves and, for each, the progress of other robots it must wait for
+  (:mod:`mrmp.centralized.dependencies`).
 
 Examples
 --------
@@ -19,9 +22,10 @@ Examples
 from __future__ import annotations
 
 import json
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 
 from mrmp.centralized.plan import PlanningResult
+from mrmp.core.cell import Cell
 from mrmp.core.errors import InputError, Problem
 from mrmp.io._files import PathLike, atomic_write_text, read_text
 
@@ -68,3 +72,40 @@ def read_plan(path: PathLike, robot_ids: Sequence[str]) -> PlanningResult:
     if any(not path for path in paths) or len({len(path) for path in paths}) > 1:
         raise InputError(Problem(where, "every robot's path must be non-empty and of the same length"))
     return PlanningResult("solved", paths, seconds, planner)
+
+
+def write_share(path: PathLike, robot_id: str, moves: Sequence[Cell], dependencies: Mapping[int, Sequence[tuple[int, int]]]) -> None:
+    """Write one robot's share of a plan, atomically.
+
+    >>> import tempfile, pathlib
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "plan-A.json"
+    >>> write_share(path, "A", [(0, 1), (0, 2)], {1: [(1, 1)]})
+    >>> read_share(path, "A")
+    ([(0, 1), (0, 2)], {1: [(1, 1)]})
+    """
+    rows = [[move, robot, progress] for move, needs in sorted(dependencies.items()) for robot, progress in needs]
+    data = {"format": 1, "robot": robot_id, "moves": [list(cell) for cell in moves], "dependencies": rows}
+    atomic_write_text(path, json.dumps(data) + "\n")
+
+
+def read_share(path: PathLike, robot_id: str) -> tuple[list[Cell], dict[int, list[tuple[int, int]]]]:
+    """Read the share of robot ``robot_id``: its moves and its dependencies.
+
+    Raises
+    ------
+    InputError
+        If the file is not a share, or is another robot's (naming the file).
+    """
+    where = str(path)
+    try:
+        data = json.loads(read_text(path))
+        owner = str(data["robot"])
+        moves = [(int(cell[0]), int(cell[1])) for cell in data["moves"]]
+        dependencies: dict[int, list[tuple[int, int]]] = {}
+        for move, robot, progress in data["dependencies"]:
+            dependencies.setdefault(int(move), []).append((int(robot), int(progress)))
+    except (ValueError, KeyError, TypeError, IndexError) as error:
+        raise InputError(Problem(where, f"not a robot's share of a plan: {error}")) from None
+    if owner != robot_id:
+        raise InputError(Problem(where, f"this share is robot {owner!r}'s, not {robot_id!r}'s"))
+    return moves, dependencies

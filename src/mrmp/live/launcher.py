@@ -23,12 +23,13 @@ from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from mrmp.centralized.plan import PlanningResult, plan_size_bytes
+from mrmp.centralized.execution import distributed_bytes, plan_policies
+from mrmp.centralized.plan import PlanningResult
 from mrmp.core.errors import InputError, Problem
 from mrmp.core.result import RunResult
 from mrmp.core.scenario import Scenario
 from mrmp.io.live_files import read_json, write_key_file
-from mrmp.io.plans import write_plan
+from mrmp.io.plans import write_plan, write_share
 from mrmp.io.scenario_file import save_scenario
 from mrmp.live.agent import AgentTiming
 from mrmp.live.process import TRANSPORTS
@@ -124,14 +125,19 @@ def run_live(scenario: Scenario, options: LiveOptions, say: Callable[[str], None
             raise InputError(Problem("--kill", f"no robot has the id {robot_id!r}"))
     results = options.results or Path(tempfile.mkdtemp(prefix="mrmp-live-"))
     results.mkdir(parents=True, exist_ok=True)
-    for stale in [*results.glob("trace-*.jsonl"), *results.glob("agent-*.json"), results / "referee.json", results / "done"]:
+    for stale in [
+        *results.glob("trace-*.jsonl"), *results.glob("agent-*.json"), *results.glob("plan-*.json"),
+        results / "referee.json", results / "done",
+    ]:
         stale.unlink(missing_ok=True)
     scenario_file = results / "scenario.yaml"
     save_scenario(scenario, scenario_file)
-    plan_arguments = []
+    shares: list[Path] = []
     if options.plan is not None:
         write_plan(results / "plan.json", options.plan, ids)
-        plan_arguments = [f"--plan={results / 'plan.json'}"]
+        for index, policy in enumerate(plan_policies(options.plan)):
+            shares.append(results / f"plan-{index}.json")
+            write_share(shares[-1], ids[index], policy.moves, policy.dependencies)
     key_file = results / "fleet.key"
     write_key_file(key_file, os.urandom(32).hex().encode())
     session = random.SystemRandom().randrange(1, 2**31)
@@ -165,11 +171,14 @@ def run_live(scenario: Scenario, options: LiveOptions, say: Callable[[str], None
         f"--timeout={timeout}",
         f"--listen-time={options.timing.listen_time}",
         *([] if options.guarded else ["--unsafe"]),
-        *plan_arguments,
     ]
     agents = [
         subprocess.Popen(
-            [*python, "agent", f"--robot={spec.id}", *common, *transport_arguments(options.transport, index, ids, ports, group_port, fleet)],
+            [
+                *python, "agent", f"--robot={spec.id}", *common,
+                *([f"--plan={shares[index]}"] if shares else []),
+                *transport_arguments(options.transport, index, ids, ports, group_port, fleet),
+            ],
             start_new_session=True,
         )
         for index, spec in enumerate(scenario.robots)
@@ -222,5 +231,10 @@ def run_live(scenario: Scenario, options: LiveOptions, say: Callable[[str], None
         time_scale=options.time_scale,
     )
     if options.plan is not None:
-        result = replace(result, policy=options.plan.planner, planning_time_s=options.plan.planning_time_s, plan_bytes=plan_size_bytes(options.plan))
+        result = replace(
+            result,
+            policy=options.plan.planner,
+            planning_time_s=options.plan.planning_time_s,
+            plan_bytes=distributed_bytes(plan_policies(options.plan)),
+        )
     return result

@@ -20,9 +20,9 @@ from pathlib import Path
 
 from mrmp.core.errors import InputError, Problem
 from mrmp.core.scenario import Scenario
-from mrmp.centralized.execution import plan_policies
 from mrmp.io.live_files import TraceReader, TraceWriter, write_json
-from mrmp.io.plans import read_plan
+from mrmp.io.plans import read_share
+from mrmp.policies.plan_following import PlanFollowingPolicy
 from mrmp.live.agent import Agent, AgentReport, AgentTiming
 from mrmp.live.body import OccupancyRecorder, SimulatedBody
 from mrmp.live.referee import IntervalReferee
@@ -129,6 +129,7 @@ class AgentOptions:
     seed: int = 0
     timing: AgentTiming = AgentTiming()
     plan: Path | None = None
+    """This robot's share of a central plan (``mrmp.io.plans.write_share``)."""
 
 
 def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
@@ -137,8 +138,8 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
     options.results.mkdir(parents=True, exist_ok=True)
     policy = None
     if options.plan is not None:
-        plan = read_plan(options.plan, [robot.id for robot in scenario.robots])
-        policy = plan_policies(plan)[index]
+        moves, dependencies = read_share(options.plan, scenario.robots[index].id)
+        policy = PlanFollowingPolicy(moves, dependencies)
     spec = scenario.robots[index]
     report_path = options.results / f"agent-{index}.json"
     trace = TraceWriter(options.results / f"trace-{index}.jsonl", index)
