@@ -107,5 +107,5 @@ def read_share(path: PathLike, robot_id: str) -> tuple[list[Cell], dict[int, lis
     except (ValueError, KeyError, TypeError, IndexError) as error:
         raise InputError(Problem(where, f"not a robot's share of a plan: {error}")) from None
     if owner != robot_id:
-        raise InputError(Problem(where, f"this share is robot {owner!r}'s, not {robot_id!r}'s"))
+        raise InputError(Problem(where, f"this share belongs to robot {owner!r}, not {robot_id!r}"))
     return moves, dependencies

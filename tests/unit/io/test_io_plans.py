@@ -21,7 +21,7 @@ def test_each_robot_reads_back_exactly_its_share(tmp_path):
     for index, (robot, policy) in enumerate(zip("AB", plan_policies(PLAN))):
         write_share(tmp_path / f"plan-{index}.json", robot, policy.moves, policy.dependencies)
         assert read_share(tmp_path / f"plan-{index}.json", robot) == (policy.moves, policy.dependencies)
-    with pytest.raises(InputError, match="this share is robot 'A's, not 'B's"):
+    with pytest.raises(InputError, match="this share belongs to robot 'A', not 'B'"):
         read_share(tmp_path / "plan-0.json", "B")
 
 
