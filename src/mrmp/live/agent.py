@@ -35,6 +35,7 @@ import time
 from collections import Counter
 from collections.abc import Callable
 from dataclasses import dataclass, field
+from enum import Enum
 from typing import Any
 
 from mrmp.core.cell import Cell
@@ -46,6 +47,15 @@ from mrmp.policies.registry import make_policy
 from mrmp.protocol.auth import Opener, Sealer
 from mrmp.protocol.messages import Message
 from mrmp.robot.robot import Outgoing, Robot
+
+
+class Phase(Enum):
+    """Where a live robot is in its step (module docstring)."""
+
+    LISTEN = "announced Next; listening before deciding"
+    CLAIM = "decided; waiting for the safety layer to allow the move"
+    MOVING = "the body is moving"
+    PAUSE = "stays this step; announces again after a pause"
 
 
 @dataclass(frozen=True)
@@ -180,6 +190,16 @@ class Agent:
             if message is not None:
                 self._inbox.put(message)
 
+    def _drain_inbox(self, now: float) -> None:
+        """Hand the brain every message the receiving thread queued, and send its answers."""
+        while True:
+            try:
+                message = self._inbox.get_nowait()
+            except queue.Empty:
+                return
+            self.report.messages_received += 1
+            self._send(self.robot.receive(message, now))
+
     # -- sending ---------------------------------------------------------------------------
 
     def _send(self, outgoing: list[Outgoing]) -> None:
@@ -214,7 +234,7 @@ class Agent:
         self._send(robot.announce(started))
         last_state = started
         next_decision = started + timing.listen_time
-        phase = "listen"
+        phase = Phase.LISTEN
         decided_at = started
         everyone_done_since: float | None = None
         last_progress = started
@@ -224,13 +244,7 @@ class Agent:
                 if now - started > timing.timeout:
                     report.stop_reason = "timeout"
                     break
-                while True:
-                    try:
-                        message = self._inbox.get_nowait()
-                    except queue.Empty:
-                        break
-                    report.messages_received += 1
-                    self._send(robot.receive(message, now))
+                self._drain_inbox(now)
                 if body.moving:
                     if body.poll(now):
                         robot.arrived_at(body.cell, body.heading)
@@ -238,27 +252,27 @@ class Agent:
                         report.believed_path.append((now, body.cell))
                         self._send(robot.announce(now))
                         last_state = now
-                        phase, next_decision = "listen", now + timing.listen_time
+                        phase, next_decision = Phase.LISTEN, now + timing.listen_time
                         if robot.arrived and report.arrival_time is None:
                             report.arrival_time = now - started
                         elif not robot.arrived:
                             report.arrival_time = None
-                elif phase == "listen" and now >= next_decision:
+                elif phase is Phase.LISTEN and now >= next_decision:
                     self._send(robot.decide(now))
-                    phase, decided_at = "claim", now
-                if phase == "claim" and not body.moving:
+                    phase, decided_at = Phase.CLAIM, now
+                if phase is Phase.CLAIM and not body.moving:
                     target = robot.motion(now)
                     if target is not None:
                         body.start_move(target, now)
                         report.decision_latency.append(now - decided_at)
-                        phase = "moving"
+                        phase = Phase.MOVING
                     elif robot.wanted is None and robot.safety.pending is None:
                         pause = timing.heartbeat if robot.arrived else timing.listen_time * (1 + self.random.random())
-                        phase, next_decision = "wait", now + pause
-                if phase == "wait" and now >= next_decision:
+                        phase, next_decision = Phase.PAUSE, now + pause
+                if phase is Phase.PAUSE and now >= next_decision:
                     self._send(robot.announce(now))
                     last_state = now
-                    phase, next_decision = "listen", now + timing.listen_time
+                    phase, next_decision = Phase.LISTEN, now + timing.listen_time
                 self._send(robot.expire(now))
                 if now - last_state >= timing.heartbeat:
                     self._send(robot.announce(now))
@@ -290,13 +304,7 @@ class Agent:
         last_state = -float("inf")
         while not self.stop_requested.is_set() and len(robot.belief.peers) < self._peers and clock() < deadline:
             now = clock()
-            while True:
-                try:
-                    message = self._inbox.get_nowait()
-                except queue.Empty:
-                    break
-                self.report.messages_received += 1
-                self._send(robot.receive(message, now))
+            self._drain_inbox(now)
             if now - last_state >= self.timing.heartbeat:
                 self._send([Outgoing(robot.state_message())])
                 last_state = now
