@@ -11,6 +11,7 @@ zenoh = pytest.importorskip("zenoh")
 
 from mrmp.live.zenoh_transport import ZenohTransport, session_config
 from mrmp.protocol.auth import MAX_DATAGRAM_BYTES
+from polling import drain, receive_within
 
 LOOPBACK = "127.0.0.1"
 
@@ -75,24 +76,6 @@ def mesh(fleet):
     assert all(robot.wait_for_peers(2, timeout=5.0) for robot in robots)
     return robots
 
-
-def receive_within(transport, timeout=2.0):
-    deadline = time.monotonic() + timeout
-    while time.monotonic() < deadline:
-        data = transport.receive(0.05)
-        if data is not None:
-            return data
-    return None
-
-
-def drain(transport, duration):
-    received = []
-    deadline = time.monotonic() + duration
-    while (remaining := deadline - time.monotonic()) > 0:
-        data = transport.receive(min(remaining, 0.05))
-        if data is not None:
-            received.append(data)
-    return received
 
 
 def test_configuration_is_peer_mode_with_explicit_endpoints_only():
