@@ -210,6 +210,8 @@ def print_result(result: RunResult, console: Console) -> None:
             f"messages {result.messages}, wall time {result.wall_time_s:.1f} s"
         )
         console.print(f"  dropped by robots: {rejected or 'none'}; injected faults: {injected or 'none'}", markup=False)
+        if network.get("missed_lines"):
+            console.print(f"  grid lines missed by bodies: {network['missed_lines']} (positions believed wrong from then on)")
     else:
         console.print(
             f"{verdict} ({result.stop_reason} at tick {result.ticks}): makespan {result.makespan} ticks "

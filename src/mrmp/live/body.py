@@ -97,7 +97,8 @@ class SimulatedBody:
     miss_line:
         Probability that the line sensor misses the grid line ending a move: the
         body then drives one more cell (if the grid allows) and believes it
-        moved one.
+        moved one. A body whose true position has drifted against the grid's
+        edge or an obstacle bumps into it and stays where it truly is.
     rng:
         Random generator of this body.
     recorder:
@@ -129,6 +130,7 @@ class SimulatedBody:
         self.moving = False
         self.turns = 0
         self.missed_lines = 0
+        self.bumps = 0
         self._segments: list[_Segment] = []
         self._target: Cell = start
 
@@ -142,9 +144,14 @@ class SimulatedBody:
         t = now + turns * self.timing.turn_time * scale
         source = self.true_cell
         first = direction.ahead(source)
-        t_end = t + self.timing.cell_time * self.grid.cost(first) * scale if self.grid.in_bounds(first) else t
-        self._segments = [_Segment(source, first, t, t_end)]
-        if self.miss_line and self.random.random() < self.miss_line:
+        if not self.grid.is_free(first):
+            # Its position error has brought it to the grid's edge or an obstacle: it bumps and stays.
+            self._segments = [_Segment(source, source, t, t + self.timing.cell_time * scale)]
+            self.bumps += 1
+        else:
+            self._segments = [_Segment(source, first, t, t + self.timing.cell_time * self.grid.cost(first) * scale)]
+        t_end = self._segments[0].end
+        if self._segments[0].target != source and self.miss_line and self.random.random() < self.miss_line:
             beyond = direction.ahead(first)
             if self.grid.is_free(beyond):
                 self.missed_lines += 1
@@ -162,13 +169,15 @@ class SimulatedBody:
             return False
         while self._entered < len(self._segments) and self._segments[self._entered].enter_at <= now:
             segment = self._segments[self._entered]
-            self.recorder.record("enter", segment.target, segment.enter_at)
+            if segment.source != segment.target:
+                self.recorder.record("enter", segment.target, segment.enter_at)
             self._entered += 1
         last = self._segments[-1]
         if now < last.end:
             return False
         for segment in self._segments:
-            self.recorder.record("leave", segment.source, segment.end)
+            if segment.source != segment.target:
+                self.recorder.record("leave", segment.source, segment.end)
         self.true_cell = last.target
         self.cell = self._target  # what the line count says
         self.moving = False

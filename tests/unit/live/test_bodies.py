@@ -130,3 +130,12 @@ def test_interval_referee_finds_nothing_when_robots_follow():
     referee.feed(0, "enter", (0, 1), 2.0)  # enters exactly when B has left
     referee.feed(0, "leave", (0, 0), 3.0)
     assert referee.collisions() == []
+
+
+def test_a_drifted_body_bumps_at_the_edge_instead_of_leaving_the_grid():
+    recorder = OccupancyRecorder()
+    body = SimulatedBody((3, 0), Heading.NORTH, Grid(5, 5), Timing(1.0, 0.0), miss_line=0.0, recorder=recorder)
+    body.true_cell = (4, 0)  # an earlier missed line: the truth is one cell ahead of the belief
+    drive(body, (4, 0))
+    assert body.cell == (4, 0) and body.true_cell == (4, 0) and body.bumps == 1
+    assert recorder.events == []  # it never covered another cell
