@@ -25,6 +25,7 @@ from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Protocol
 
+from mrmp.core.faults import message_fates
 from mrmp.protocol.auth import MAX_DATAGRAM_BYTES
 
 Address = tuple[str, int]
@@ -229,18 +230,20 @@ class FaultyTransport:
         faults = self.faults
         rng = self._random
         self.counts.sent += 1
-        copies = 1
-        if faults.duplicate and rng.random() < faults.duplicate:
-            copies = 2
-            self.counts.duplicated += 1
-        for _ in range(copies):
-            if faults.loss and rng.random() < faults.loss:
-                self.counts.lost += 1
-                continue
-            delay = rng.uniform(faults.delay_min, faults.delay_max) if faults.delay_max else 0.0
-            if faults.reorder and rng.random() < faults.reorder:
+        fates = message_fates(
+            rng,
+            faults.loss,
+            faults.duplicate,
+            faults.reorder,
+            (lambda: rng.uniform(faults.delay_min, faults.delay_max)) if faults.delay_max else (lambda: 0.0),
+        )
+        self.counts.duplicated += fates.duplicated
+        self.counts.lost += fates.lost
+        for copy in fates.delivered:
+            delay = copy.delay
+            if copy.reordered:
                 self.counts.reordered += 1
-                delay += rng.uniform(0.0, max(faults.delay_max, 0.02))
+                delay += copy.hold * max(faults.delay_max, 0.02)  # held back so that later ones overtake it
             if delay <= 0:
                 self.inner.send(data, recipient)
                 continue

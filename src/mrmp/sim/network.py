@@ -9,7 +9,8 @@ knowledge as on real robots.
 
 Examples
 --------
->>> from mrmp.core.scenario import NetworkFaults
+>>> from mrmp.core.faults import message_fates
+from mrmp.core.scenario import NetworkFaults
 >>> network = SimulatedNetwork(NetworkFaults(delay_min=1, delay_max=1), seed=0)
 >>> network.send(0, 1, b"hi", tick=3)
 >>> network.deliver(3), network.deliver(4)
@@ -25,6 +26,7 @@ import random
 from collections.abc import Mapping
 from dataclasses import asdict, dataclass
 
+from mrmp.core.faults import message_fates
 from mrmp.core.scenario import NetworkFaults
 
 
@@ -82,20 +84,23 @@ class SimulatedNetwork:
             heapq.heappush(self._queue, (tick, float(self._order), sender, recipient, payload))
             return
         faults = self.links.get((sender, recipient), self.faults)
-        copies = 2 if faults.duplicate and self.random.random() < faults.duplicate else 1
-        if copies == 2:
-            stats.duplicated += 1
-        for _ in range(copies):
-            if faults.loss and self.random.random() < faults.loss:
-                stats.lost += 1
-                continue
-            delay = self.random.randint(faults.delay_min, faults.delay_max) if faults.delay_max else 0
+        rng = self.random
+        fates = message_fates(
+            rng,
+            faults.loss,
+            faults.duplicate,
+            faults.reorder,
+            (lambda: rng.randint(faults.delay_min, faults.delay_max)) if faults.delay_max else (lambda: 0),
+        )
+        stats.duplicated += fates.duplicated
+        stats.lost += fates.lost
+        for copy in fates.delivered:
             self._order += 1
             rank = float(self._order)
-            if faults.reorder and self.random.random() < faults.reorder:
+            if copy.reordered:
                 stats.reordered += 1
-                rank = self.random.uniform(0.0, rank)
-            heapq.heappush(self._queue, (tick + delay, rank, sender, recipient, payload))
+                rank *= copy.hold  # placed before some messages sent earlier
+            heapq.heappush(self._queue, (tick + int(copy.delay), rank, sender, recipient, payload))
 
     def deliver(self, tick: int) -> list[tuple[int, int, bytes]]:
         """Every ``(sender, recipient, payload)`` due at or before ``tick``, in delivery order."""
