@@ -9,8 +9,7 @@ knowledge as on real robots.
 
 Examples
 --------
->>> from mrmp.core.faults import message_fates
-from mrmp.core.scenario import NetworkFaults
+>>> from mrmp.core.scenario import NetworkFaults
 >>> network = SimulatedNetwork(NetworkFaults(delay_min=1, delay_max=1), seed=0)
 >>> network.send(0, 1, b"hi", tick=3)
 >>> network.deliver(3), network.deliver(4)
