@@ -86,7 +86,7 @@ def _apply_options(scenario: Scenario, **options: object) -> Scenario:
     if network_changes:
         network = NetworkFaults(**{**network.__dict__, **network_changes})
     changes: dict[str, object] = {"policy": policy, "network": network}
-    for key in ("seed", "max_ticks", "safety"):
+    for key in ("seed", "max_ticks", "safety", "lifelong"):
         if options.get(key) is not None:
             changes[key] = options[key]
     updated = scenario.with_changes(**changes)
@@ -212,6 +212,13 @@ def print_result(result: RunResult, console: Console) -> None:
         console.print(f"  dropped by robots: {rejected or 'none'}; injected faults: {injected or 'none'}", markup=False)
         if network.get("missed_lines"):
             console.print(f"  grid lines missed by bodies: {network['missed_lines']} (positions believed wrong from then on)")
+    elif result.lifelong:
+        goals = sum(robot.goals_reached for robot in result.robots)
+        console.print(
+            f"{verdict} ({result.stop_reason} at tick {result.ticks}): throughput {result.throughput:.3f} goals per tick "
+            f"({goals} goals reached), collisions: {len(result.collisions)}, messages {result.messages}, "
+            f"wall time {result.wall_time_s:.3f} s"
+        )
     else:
         console.print(
             f"{verdict} ({result.stop_reason} at tick {result.ticks}): makespan {result.makespan} ticks "
@@ -222,7 +229,7 @@ def print_result(result: RunResult, console: Console) -> None:
         console.print(f"  [red]{collision.describe()}[/red]")
     if len(result.collisions) > 10:
         console.print(f"  ... and {len(result.collisions) - 10} more collisions")
-    if result.not_arrived:
+    if result.not_arrived and not result.lifelong:
         names = ", ".join(result.not_arrived[:20]) + (" ..." if len(result.not_arrived) > 20 else "")
         console.print(f"  did not arrive: {names}")
 
@@ -237,6 +244,7 @@ def run(
     resolve: Annotated[Optional[str], typer.Option(help=f"Conflict resolution: {', '.join(RESOLUTIONS)}.")] = None,
     heading_aware: Annotated[Optional[bool], typer.Option("--heading-aware/--no-heading-aware", help="Charge turns when planning.")] = None,
     unsafe: Annotated[bool, typer.Option("--unsafe", help="Turn the safety layer off: the policy as written.")] = False,
+    lifelong: Annotated[bool, typer.Option("--lifelong", help="A robot that reaches its goal gets a new one (seeded); report throughput.")] = False,
     max_ticks: Annotated[Optional[int], typer.Option(help="Stop after this many ticks.")] = None,
     seed: Annotated[Optional[int], typer.Option(help="Seed of the simulated network.")] = None,
     loss: Annotated[Optional[float], typer.Option(help="Probability that a message is lost.")] = None,
@@ -272,7 +280,10 @@ def run(
             seed=seed,
             max_ticks=max_ticks,
             safety=False if unsafe else None,
+            lifelong=True if lifelong else None,
         )
+        if scenario.lifelong and (live or planner is not None):
+            raise InputError(Problem("--lifelong", "lifelong runs are simulated with a decentralized policy (not --live, not --planner)"))
         if animate is not None and animate.suffix.lower() not in (".gif", ".svg"):
             raise InputError(Problem("--animate", f"unsupported suffix {animate.suffix!r}; use .gif or .svg"))
         plan = None

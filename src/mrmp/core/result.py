@@ -62,6 +62,7 @@ class RobotResult:
     messages_sent: int = 0
     bytes_sent: int = 0
     time_s: float = 0.0
+    goals_reached: int = 0
 
     @property
     def arrived(self) -> bool:
@@ -106,7 +107,9 @@ class RunResult:
     ``ideal_makespan_s`` is the longest single-robot path time at the run's
     speed. Runs executing a central plan carry the wall time spent planning,
     ``planning_time_s``, and the size of the shares of the plan handed to the
-    robots (their moves and dependencies), ``plan_bytes``.
+    robots (their moves and dependencies), ``plan_bytes``. In a ``lifelong``
+    run robots receive new goals as they reach theirs; its figure is the
+    ``throughput``, goals reached per tick.
     """
 
     scenario: str
@@ -124,6 +127,7 @@ class RunResult:
     ideal_makespan_s: float | None = None
     planning_time_s: float | None = None
     plan_bytes: int | None = None
+    lifelong: bool = False
 
     @property
     def all_arrived(self) -> bool:
@@ -132,8 +136,15 @@ class RunResult:
 
     @property
     def success(self) -> bool:
-        """Every robot arrived and the referee found nothing."""
+        """Every robot arrived and the referee found nothing (lifelong: the run lasted its time, without collision)."""
+        if self.lifelong:
+            return self.stop_reason == "time up" and not self.collisions
         return self.all_arrived and not self.collisions
+
+    @property
+    def throughput(self) -> float:
+        """Goals reached per tick (lifelong runs; a one-shot run counts each robot's settling)."""
+        return sum(robot.goals_reached for robot in self.robots) / self.ticks if self.ticks else 0.0
 
     @property
     def makespan(self) -> int:

@@ -102,6 +102,8 @@ class Scenario:
 
     ``safety`` turns on the safety layer that guards every move
     (:mod:`mrmp.protocol.safety`); ``False`` runs the policy as written.
+    ``lifelong``: a robot that reaches its goal receives a new one (drawn with
+    the seed), and the run lasts until its tick limit.
     """
 
     grid: Grid
@@ -111,6 +113,7 @@ class Scenario:
     links: tuple[LinkFaults, ...] = ()
     policy: PolicyOptions = field(default_factory=PolicyOptions)
     safety: bool = True
+    lifelong: bool = False
     seed: int = 0
     max_ticks: int | None = None
     name: str = ""

@@ -47,6 +47,7 @@ def _robot_to_dict(robot: RobotResult) -> dict[str, Any]:
         "messages_sent": robot.messages_sent,
         "bytes_sent": robot.bytes_sent,
         "time_s": robot.time_s,
+        "goals_reached": robot.goals_reached,
         "path": [list(cell) for cell in robot.path],
         "headings": [Heading(heading).name for heading in robot.headings],
     }
@@ -110,6 +111,8 @@ def result_to_dict(result: RunResult, grid: Grid | None = None) -> dict[str, Any
         "ideal_makespan_s": result.ideal_makespan_s,
         "planning_time_s": result.planning_time_s,
         "plan_bytes": result.plan_bytes,
+        "lifelong": result.lifelong,
+        "throughput": result.throughput,
         "collisions": [_collision_to_dict(collision) for collision in result.collisions],
         "robots": [_robot_to_dict(robot) for robot in result.robots],
     }
@@ -222,6 +225,7 @@ def _robot_from_dict(data: Any, path: str, source: str) -> RobotResult:
         messages_sent=fields.get("messages_sent", int, "an integer", 0),
         bytes_sent=fields.get("bytes_sent", int, "an integer", 0),
         time_s=float(fields.get("time_s", (int, float), "a number", 0.0)),
+        goals_reached=fields.get("goals_reached", int, "an integer", 0),
     )
 
 
@@ -292,6 +296,7 @@ def result_from_dict(data: Mapping[str, Any], source: str = "result") -> RunResu
             fields.get("planning_time_s", (int, float, type(None)), "a number or null", None)
         ),
         plan_bytes=fields.get("plan_bytes", (int, type(None)), "an integer or null", None),
+        lifelong=fields.get("lifelong", bool, "true or false", False),
     )
 
 

@@ -24,6 +24,7 @@ A scenario file looks like this (only ``map`` and ``robots`` are required)::
         - {from: A, to: B, loss: 0.5} # unset settings are the network's
     policy: {name: thesis, resolve: divert, heading_aware: false}
     safety: true                      # false: no safety layer, the policy as written
+    lifelong: false                   # true: a robot that reaches its goal gets a new one
     seed: 0
     max_ticks: 100
 
@@ -106,6 +107,7 @@ TOP_KEYS = (
     "seed",
     "max_ticks",
     "safety",
+    "lifelong",
 )
 """Keys allowed at the top level of a scenario file."""
 MAP_KEYS = ("rows", "file", "width", "height")
@@ -593,6 +595,7 @@ class _Reader:
             robots = self.read_robots(top["robots"].value)
         timing, network, links, policy = self.read_settings(top)
         safety = self.optional(top, "safety", "safety", self.boolean)
+        lifelong = self.optional(top, "lifelong", "lifelong", self.boolean)
         seed = self.optional(top, "seed", "seed", self.integer)
         max_ticks = self.optional(top, "max_ticks", "max_ticks", self.integer)
         scenario = Scenario(
@@ -603,6 +606,7 @@ class _Reader:
             links=links,
             policy=policy,
             safety=True if safety is None or safety is _BAD else safety,
+            lifelong=False if lifelong is None or lifelong is _BAD else lifelong,
             seed=0 if seed is None or seed is _BAD else seed,
             max_ticks=None if max_ticks is _BAD else max_ticks,
             name=name,
@@ -894,6 +898,8 @@ def scenario_to_yaml(scenario: Scenario, map_file: str | None = None) -> str:
     )
     if not scenario.safety:
         lines.append("safety: false")
+    if scenario.lifelong:
+        lines.append("lifelong: true")
     lines.append(f"seed: {scenario.seed}")
     if scenario.max_ticks is not None:
         lines.append(f"max_ticks: {scenario.max_ticks}")

@@ -64,7 +64,7 @@ class AstarPolicy:
         present = situation.present
         if present == situation.goal:
             return present
-        if len(self._path) < 2 or self._path[0] != present:
+        if len(self._path) < 2 or self._path[0] != present or self._path[-1] != situation.goal:
             self._path = self._plan(situation) or [present]
         return self._path[1] if len(self._path) > 1 else present
 

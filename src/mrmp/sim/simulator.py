@@ -10,10 +10,13 @@ Per tick, as in the thesis (sections 3.5-3.6), with the safety layer:
 4. every robot whose move is allowed (guarded: a majority registered the cell
    to it; unguarded: always) moves, turning right first when the heading
    changes, and observes its new cell;
-5. the referee checks the new configuration, and the robots' timers run.
+5. the referee checks the new configuration, and the robots' timers run;
+6. robots on their goals count a goal reached; in a lifelong run each then
+   receives a new goal (drawn with the run's seed).
 
 Time for the safety layer's timers is counted in ticks. The run ends when every
-robot stands on its goal, at the tick limit, or when the same configuration of
+robot stands on its goal (never, in a lifelong run: it ends with "time up" at
+the tick limit), at the tick limit, or when the same configuration of
 every robot's cell and heading has recurred too often ("deadlock" if nobody
 moved meanwhile, else "livelock"), or on Ctrl-C ("interrupted"), always
 returning what was computed. It is deterministic for a seed.
@@ -29,6 +32,7 @@ Examples
 
 from __future__ import annotations
 
+import random
 import time
 from collections import Counter
 from collections.abc import Sequence
@@ -119,15 +123,18 @@ class LockstepSimulator:
         self._recurrences: Counter[tuple[tuple[Cell, ...], tuple[Heading, ...]]] = Counter()
         self._still_since = 0
         self._everyone = range(len(self.robots))
+        self._settled: set[int] = set()
+        self._goal_random = random.Random(scenario.seed * 1_000_003 + 7)
+        self._free_cells = grid.free_cells() if scenario.lifelong else []
 
     def run(self) -> RunResult:
         """Run to the end and return the result (partial on Ctrl-C)."""
         started = time.perf_counter()
         self.referee.check_start([robot.present for robot in self.robots])
-        stop_reason = "tick limit"
+        stop_reason = "time up" if self.scenario.lifelong else "tick limit"
         try:
             while self.tick < self.max_ticks:
-                if all(robot.arrived for robot in self.robots):
+                if not self.scenario.lifelong and all(robot.arrived for robot in self.robots):
                     stop_reason = "all arrived"
                     break
                 self.step()
@@ -136,7 +143,7 @@ class LockstepSimulator:
                     stop_reason = stuck
                     break
             else:
-                if all(robot.arrived for robot in self.robots):
+                if not self.scenario.lifelong and all(robot.arrived for robot in self.robots):
                     stop_reason = "all arrived"
         except KeyboardInterrupt:
             stop_reason = "interrupted"
@@ -182,6 +189,7 @@ class LockstepSimulator:
             self._durations[robot.index].append(duration)
         self.referee.check_tick(tick, before, [robot.present for robot in robots])
         self._still_since = self._still_since + 1 if not moved else 0
+        self._count_goals()
         for robot in robots:
             self._send(robot, robot.expire(tick))
 
@@ -218,10 +226,33 @@ class LockstepSimulator:
                 if replies:
                     self._send(robot, replies)
 
+    def _count_goals(self) -> None:
+        """Count goals reached this tick; in a lifelong run, hand each such robot a new goal.
+
+        New goals are drawn, with the run's seed, among free cells that are
+        nobody's goal and not the robot's own cell, robots taken in index order.
+        """
+        for robot in self.robots:
+            if not robot.arrived:
+                self._settled.discard(robot.index)
+                continue
+            if robot.index in self._settled:
+                continue  # still on the goal it was already counted for
+            self._results[robot.index].goals_reached += 1
+            self._settled.add(robot.index)
+            if self.scenario.lifelong:
+                taken = {other.goal for other in self.robots}
+                choices = [cell for cell in self._free_cells if cell not in taken and cell != robot.present]
+                if choices:
+                    robot.goal = self._goal_random.choice(choices)
+                    self._settled.discard(robot.index)
+
     def _stuck(self) -> str | None:
         configuration = (tuple(robot.present for robot in self.robots), tuple(robot.heading for robot in self.robots))
         self._recurrences[configuration] += 1
-        if self._recurrences[configuration] < self.recurrence_limit or all(robot.arrived for robot in self.robots):
+        if self._recurrences[configuration] < self.recurrence_limit or (
+            not self.scenario.lifelong and all(robot.arrived for robot in self.robots)
+        ):
             return None
         return "deadlock" if self._still_since >= self.recurrence_limit - 1 else "livelock"
 
@@ -246,6 +277,7 @@ class LockstepSimulator:
             lower_bound=sum(self.lengths),
             wall_time_s=wall_time,
             network=network,
+            lifelong=self.scenario.lifelong,
         )
 
 

@@ -83,6 +83,7 @@ def test_dict_has_the_robot_details() -> None:
         "messages_sent": 4,
         "bytes_sent": 96,
         "time_s": 3.5,
+        "goals_reached": 0,
         "path": [[0, 0], [1, 0], [1, 0], [1, 1], [1, 1]],
         "headings": ["NORTH", "NORTH", "EAST", "EAST", "EAST"],
     }
