@@ -1,5 +1,6 @@
 """Receiving from a transport in tests: bounded polling, never a blind sleep."""
 
+import threading
 import time
 
 
@@ -22,3 +23,20 @@ def drain(transport, duration):
         if data is not None:
             received.append(data)
     return received
+
+
+def receive_while_closing(transport, timeout, close_after=0.1):
+    """Block in ``receive(timeout)`` in a thread, close the transport meanwhile; return (data, seconds, thread)."""
+    outcome = {}
+
+    def receive():
+        started = time.monotonic()
+        outcome["data"] = transport.receive(timeout)
+        outcome["took"] = time.monotonic() - started
+
+    thread = threading.Thread(target=receive)
+    thread.start()
+    time.sleep(close_after)
+    transport.close()
+    thread.join(timeout=2.0)
+    return outcome.get("data"), outcome.get("took"), thread

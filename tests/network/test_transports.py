@@ -19,7 +19,7 @@ from mrmp.live.transport import (
 )
 from mrmp.protocol.auth import MAX_DATAGRAM_BYTES, Opener, Sealer
 from mrmp.protocol.messages import StateMessage
-from polling import drain, receive_within
+from polling import drain, receive_while_closing, receive_within
 
 LOOPBACK = "127.0.0.1"
 
@@ -127,20 +127,8 @@ def test_udp_send_to_an_unreachable_peer_is_a_lost_datagram():
 
 
 def test_udp_close_wakes_a_blocked_receive():
-    transport = UdpTransport((LOOPBACK, 0), {})
-    outcome = {}
-
-    def receive():
-        started = time.monotonic()
-        outcome["data"] = transport.receive(1.0)
-        outcome["took"] = time.monotonic() - started
-
-    thread = threading.Thread(target=receive)
-    thread.start()
-    time.sleep(0.1)
-    transport.close()
-    thread.join(timeout=2.0)
-    assert outcome["data"] is None and outcome["took"] < 0.5
+    data, took, _ = receive_while_closing(UdpTransport((LOOPBACK, 0), {}), timeout=1.0)
+    assert data is None and took < 0.5
 
 
 # -- UdpMulticastTransport ---------------------------------------------------------------------

@@ -1,7 +1,6 @@
 """The Zenoh transport: three robots in a full mesh of explicit loopback TCP endpoints."""
 
 import socket
-import threading
 import time
 import uuid
 
@@ -11,7 +10,7 @@ zenoh = pytest.importorskip("zenoh")
 
 from mrmp.live.zenoh_transport import ZenohTransport, session_config
 from mrmp.protocol.auth import MAX_DATAGRAM_BYTES
-from polling import drain, receive_within
+from polling import drain, receive_while_closing, receive_within
 
 LOOPBACK = "127.0.0.1"
 
@@ -187,21 +186,9 @@ def test_close_is_prompt_and_peers_see_it(mesh):
 
 
 def test_close_wakes_a_blocked_receive(mesh):
-    a = mesh[0]
-    outcome = {}
-
-    def receive():
-        started = time.monotonic()
-        outcome["data"] = a.receive(5.0)
-        outcome["took"] = time.monotonic() - started
-
-    thread = threading.Thread(target=receive)
-    thread.start()
-    time.sleep(0.1)
-    a.close()
-    thread.join(timeout=2.0)
+    data, took, thread = receive_while_closing(mesh[0], timeout=5.0)
     assert not thread.is_alive()
-    assert outcome["data"] is None and outcome["took"] < 1.0
+    assert data is None and took < 1.0
 
 
 def test_the_queue_is_capped_dropping_the_oldest(fleet):

@@ -167,17 +167,15 @@ def prioritized(
     paths: list[tuple[Cell, ...] | None] = [None] * len(instance)
     headings: list[tuple[Heading, ...] | None] = [None] * len(instance)
     expansions = 0
+
+    def time_limit(when: str) -> PlanningResult:
+        message = f"time limit of {time_limit_s:g} s reached {when} robot {robot_id}"
+        return PlanningResult("limit", None, time.perf_counter() - began, "pp", nodes=expansions, message=message)
+
     for rank, index in enumerate(ranking):
         robot_id = instance.ids[index]
         if deadline is not None and time.perf_counter() > deadline:
-            return PlanningResult(
-                "limit",
-                None,
-                time.perf_counter() - began,
-                "pp",
-                nodes=expansions,
-                message=f"time limit of {time_limit_s:g} s reached before planning robot {robot_id}",
-            )
+            return time_limit("before planning")
         found = space_time_astar(
             instance.grid,
             instance.starts[index],
@@ -190,14 +188,7 @@ def prioritized(
         )
         expansions += found.expansions
         if found.status == "deadline":
-            return PlanningResult(
-                "limit",
-                None,
-                time.perf_counter() - began,
-                "pp",
-                nodes=expansions,
-                message=f"time limit of {time_limit_s:g} s reached while planning robot {robot_id}",
-            )
+            return time_limit("while planning")
         if not found.found or found.path is None:
             reason = "within the horizon" if found.status == "horizon" else "around the robots planned before it"
             before = ", ".join(instance.ids[i] for i in ranking[:rank]) or "none"

@@ -49,7 +49,7 @@ def obstacle_found(next_cell: Cell, peer: PeerState) -> bool:
 
 def conflicting_peers(next_cell: Cell, peers: Mapping[int, PeerState]) -> list[PeerState]:
     """Every known peer for which :func:`obstacle_found` holds, by increasing index."""
-    return [peer for _, peer in sorted(peers.items()) if next_cell == peer.present or next_cell == peer.next]
+    return [peer for _, peer in sorted(peers.items()) if obstacle_found(next_cell, peer)]
 
 
 def outranks_all(present: Cell, index: int, others: Iterable[PeerState]) -> bool:
