@@ -66,6 +66,7 @@ import numpy as np
 
 from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
+from mrmp.policies.pibt_rules import swap_possible, swap_required
 from mrmp.search.distance import DistanceTable, distance_table
 
 __all__ = [
@@ -401,7 +402,8 @@ class PIBT:
 
     def _swap_agent(self, robot: int, candidates: list[int], current: Sequence[int], target: list[int]) -> int:
         """``is_swap_required_and_possible``: the robot to pull behind ``robot``, or ``NO_AGENT``."""
-        occ_now = self._occ_now
+        occ_now, neighbours, dists = self._occ_now, self._neighbours, self._distances
+        settled = self._settled()
         best = candidates[0]
         here = current[robot]
         other = occ_now[best]
@@ -409,68 +411,38 @@ class PIBT:
             other != NO_AGENT
             and other != robot
             and target[other] == NO_CELL
-            and self._swap_required(robot, other, here, current[other])
-            and self._swap_possible(current[other], here)
+            and swap_required(neighbours, settled, dists[robot], dists[other], here, current[other])
+            and swap_possible(neighbours, settled, current[other], here)
         ):
             return other
         if best != here:  # "clear" operation, as in push and swap
-            for cell in self._neighbours[here]:
+            for cell in neighbours[here]:
                 other = occ_now[cell]
                 if (
                     other != NO_AGENT
                     and best != current[other]
-                    and self._swap_required(other, robot, here, best)
-                    and self._swap_possible(best, here)
+                    and swap_required(neighbours, settled, dists[other], dists[robot], here, best)
+                    and swap_possible(neighbours, settled, best, here)
                 ):
                     return other
         return NO_AGENT
 
-    def _open_neighbours(self, cell: int, behind: int) -> tuple[int, int]:
-        """How many ways lead on from ``cell`` (not back to ``behind``, not into a settled dead end), and one of them."""
-        neighbours, occ_now, goals = self._neighbours, self._occ_now, self._goals
-        row = neighbours[cell]
-        count = len(row)
-        onward = NO_CELL
-        for next_cell in row:
-            occupant = occ_now[next_cell]
-            if next_cell == behind or (
-                len(neighbours[next_cell]) == 1 and occupant != NO_AGENT and goals[occupant] == next_cell
-            ):
-                count -= 1
-            else:
-                onward = next_cell
-        return count, onward
+    def _settled(self) -> _Settled:
+        return _Settled(self._occ_now, self._goals)
 
-    def _swap_required(self, pusher: int, puller: int, pusher_cell: int, puller_cell: int) -> bool:
-        """Whether ``pusher`` and ``puller`` are head-on in a corridor and must pass each other."""
-        dist = self._distances[pusher]
-        for _ in range(len(self._neighbours)):
-            if not dist[puller_cell] < dist[pusher_cell]:
-                break
-            count, onward = self._open_neighbours(puller_cell, pusher_cell)
-            if count >= 2:
-                return False  # they can pass at puller_cell
-            if count <= 0:
-                break
-            pusher_cell, puller_cell = puller_cell, onward
-        back = self._distances[puller]
-        return back[pusher_cell] < back[puller_cell] and (
-            dist[pusher_cell] == 0 or dist[puller_cell] < dist[pusher_cell]
-        )
 
-    def _swap_possible(self, pusher_origin: int, puller_origin: int) -> bool:
-        """Whether walking back from ``puller_origin`` (away from ``pusher_origin``) reaches a passing place."""
-        pusher_cell, puller_cell = pusher_origin, puller_origin
-        for _ in range(len(self._neighbours)):
-            if puller_cell == pusher_origin:
-                return False  # went round a loop
-            count, onward = self._open_neighbours(puller_cell, pusher_cell)
-            if count >= 2:
-                return True
-            if count <= 0:
-                return False
-            pusher_cell, puller_cell = puller_cell, onward
-        return False
+class _Settled:
+    """The cells on which a robot stands on its own goal, read from the occupancy list."""
+
+    __slots__ = ("_goals", "_occupied")
+
+    def __init__(self, occupied: list[int], goals: list[int]) -> None:
+        self._occupied = occupied
+        self._goals = goals
+
+    def __contains__(self, cell: object) -> bool:
+        occupant = self._occupied[cell]  # type: ignore[index]
+        return occupant != NO_AGENT and self._goals[occupant] == cell
 
 
 def pibt_step(

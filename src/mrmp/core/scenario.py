@@ -88,12 +88,17 @@ class PolicyOptions:
     """Which decision rule robots run and its settings.
 
     ``resolve`` chooses the thesis's two collision-avoidance techniques
-    (section 2.1); ``heading_aware`` makes planners charge turns.
+    (section 2.1); ``heading_aware`` makes planners charge turns (``pibt``:
+    prefer fewer turns among equally near cells). ``radius`` (cells,
+    Manhattan, at least 2) is how far a ``pibt`` robot's beacon reaches;
+    ``swap`` turns on ``pibt``'s swap technique.
     """
 
     name: str = "thesis"
     resolve: str = "divert"
     heading_aware: bool = False
+    radius: int = 2
+    swap: bool = True
 
 
 @dataclass(frozen=True)
@@ -221,6 +226,8 @@ def scenario_problems(scenario: Scenario) -> list[Problem]:
         if link.sender == link.recipient:
             problems.append(Problem(f"{where}.to", "a link joins two different robots"))
         problems.extend(_fault_problems(link.faults, where))
+    if scenario.policy.radius < 2:
+        problems.append(Problem("policy.radius", f"must be at least 2 (cells), got {scenario.policy.radius}"))
     if scenario.policy.resolve not in RESOLUTIONS:
         problems.append(Problem("policy.resolve", f"must be one of {', '.join(RESOLUTIONS)}, got {scenario.policy.resolve!r}"))
     if scenario.max_ticks is not None and scenario.max_ticks <= 0:

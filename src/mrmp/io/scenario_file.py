@@ -122,7 +122,7 @@ NETWORK_KEYS = (*FAULT_KEYS, "links")
 """Keys allowed under ``network``."""
 LINK_KEYS = ("from", "to", *FAULT_KEYS)
 """Keys allowed in each entry of ``network.links``; unset faults are the network's."""
-POLICY_KEYS = ("name", "resolve", "heading_aware")
+POLICY_KEYS = ("name", "resolve", "heading_aware", "radius", "swap")
 """Keys allowed under ``policy``."""
 
 _BAD: Any = object()
@@ -516,6 +516,8 @@ class _Reader:
             "name": self.optional(policy_entries, "name", "policy.name", self.text),
             "resolve": self.optional(policy_entries, "resolve", "policy.resolve", self.text),
             "heading_aware": self.optional(policy_entries, "heading_aware", "policy.heading_aware", self.boolean),
+            "radius": self.optional(policy_entries, "radius", "policy.radius", self.integer),
+            "swap": self.optional(policy_entries, "swap", "policy.swap", self.boolean),
         }
         policy = PolicyOptions(**_given(policy_values))
         if (
@@ -893,8 +895,10 @@ def scenario_to_yaml(scenario: Scenario, map_file: str | None = None) -> str:
             ends = f"from: {_quote(link.sender)}, to: {_quote(link.recipient)}"
             lines.append(f"    - {{{ends}, {_faults_text(link.faults)}}}")
     heading_aware = "true" if policy.heading_aware else "false"
+    swap = "true" if policy.swap else "false"
     lines.append(
-        f"policy: {{name: {_quote(policy.name)}, resolve: {_quote(policy.resolve)}, heading_aware: {heading_aware}}}"
+        f"policy: {{name: {_quote(policy.name)}, resolve: {_quote(policy.resolve)}, heading_aware: {heading_aware},"
+        f" radius: {policy.radius}, swap: {swap}}}"
     )
     if not scenario.safety:
         lines.append("safety: false")

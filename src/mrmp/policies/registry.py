@@ -28,7 +28,11 @@ POLICIES: dict[str, PolicyFactory] = {
 }
 """Every policy name a scenario or ``--policy`` may use, with its factory."""
 
-POLICY_NAMES: tuple[str, ...] = tuple(POLICIES)
+ROUND_POLICIES: tuple[str, ...] = ("pibt",)
+"""Policies whose robots decide together by messages in synchronous rounds
+(:mod:`mrmp.sim.rounds`), rather than each alone by a :class:`Policy`."""
+
+POLICY_NAMES: tuple[str, ...] = (*POLICIES, *ROUND_POLICIES)
 
 
 def make_policy(options: PolicyOptions, timing: Timing | None = None) -> Policy:
@@ -39,6 +43,10 @@ def make_policy(options: PolicyOptions, timing: Timing | None = None) -> Policy:
     InputError
         If ``options.name`` is not a known policy.
     """
+    if options.name in ROUND_POLICIES:
+        raise InputError(
+            Problem("policy.name", f"{options.name!r} runs in synchronous rounds (mrmp.sim.rounds), not as a per-robot policy")
+        )
     try:
         factory = POLICIES[options.name]
     except KeyError:

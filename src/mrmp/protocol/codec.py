@@ -16,6 +16,11 @@ Bodies (cells are two signed 32-bit integers)::
              progress (u32)                                                             52 bytes in all
     2 claim  claim (u32), cell                                                          22 bytes in all
     3 reply  claimant (u32), claim (u32), cell, granted (1 byte, 0 or 1)                 27 bytes in all
+    4 beacon step (u32), present, goal, elapsed (u32), tie (u32), heading (1 byte)      39 bytes in all
+    5 inherit step (u32), cell                                                          22 bytes in all
+    6 answer step (u32), moved (1 byte, 0 or 1)                                         15 bytes in all
+    7 reserve step (u32), cell                                                          22 bytes in all
+    8 pull   step (u32), cell                                                           22 bytes in all
 
 Every datagram is at most :data:`MAX_MESSAGE_BYTES`. Authentication (a MAC
 over these bytes) is a separate layer, :mod:`mrmp.protocol.auth`.
@@ -45,9 +50,20 @@ import struct
 
 from mrmp.core.errors import MrmpError
 from mrmp.core.heading import Heading
-from mrmp.protocol.messages import NO_CELL, ClaimMessage, Message, ReplyMessage, StateMessage
+from mrmp.protocol.messages import (
+    NO_CELL,
+    AnswerMessage,
+    BeaconMessage,
+    ClaimMessage,
+    InheritMessage,
+    Message,
+    PullMessage,
+    ReplyMessage,
+    ReserveMessage,
+    StateMessage,
+)
 
-PROTOCOL_VERSION = 3
+PROTOCOL_VERSION = 4
 """Version byte of every datagram; a receiver drops other versions."""
 MAX_MESSAGE_BYTES = 512
 """Upper bound on the size of any encoded message."""
@@ -59,9 +75,23 @@ _HEADER = struct.Struct("!BBII")
 _STATE_BODY = struct.Struct("!iiiiiiiiBBII")
 _CLAIM_BODY = struct.Struct("!Iii")
 _REPLY_BODY = struct.Struct("!IIiiB")
-_STATE, _CLAIM, _REPLY = 1, 2, 3
+_BEACON_BODY = struct.Struct("!IiiiiIIB")
+_STEP_CELL_BODY = struct.Struct("!Iii")
+_ANSWER_BODY = struct.Struct("!IB")
+_STATE, _CLAIM, _REPLY, _BEACON, _INHERIT, _ANSWER, _RESERVE, _PULL = 1, 2, 3, 4, 5, 6, 7, 8
 _ARRIVED, _MOVING, _CLAIMING = 0x01, 0x02, 0x04
-_BODIES = {_STATE: _STATE_BODY, _CLAIM: _CLAIM_BODY, _REPLY: _REPLY_BODY}
+_BODIES = {
+    _STATE: _STATE_BODY,
+    _CLAIM: _CLAIM_BODY,
+    _REPLY: _REPLY_BODY,
+    _BEACON: _BEACON_BODY,
+    _INHERIT: _STEP_CELL_BODY,
+    _ANSWER: _ANSWER_BODY,
+    _RESERVE: _STEP_CELL_BODY,
+    _PULL: _STEP_CELL_BODY,
+}
+_STEP_CELL_TYPES: dict[type, int] = {InheritMessage: _INHERIT, ReserveMessage: _RESERVE, PullMessage: _PULL}
+_STEP_CELL_CLASSES = {code: cls for cls, code in _STEP_CELL_TYPES.items()}
 
 
 class DecodeError(MrmpError):
@@ -100,6 +130,17 @@ def encode(message: Message) -> bytes:
     elif isinstance(message, ReplyMessage):
         body = _REPLY_BODY.pack(message.claimant, message.claim, *message.cell, 1 if message.granted else 0)
         type_code = _REPLY
+    elif isinstance(message, BeaconMessage):
+        body = _BEACON_BODY.pack(
+            message.step, *message.present, *message.goal, message.elapsed, message.tie, int(message.heading)
+        )
+        type_code = _BEACON
+    elif isinstance(message, AnswerMessage):
+        body = _ANSWER_BODY.pack(message.step, 1 if message.moved else 0)
+        type_code = _ANSWER
+    elif type(message) in _STEP_CELL_TYPES:
+        body = _STEP_CELL_BODY.pack(message.step, *message.cell)  # type: ignore[union-attr]
+        type_code = _STEP_CELL_TYPES[type(message)]
     else:
         raise TypeError(f"cannot encode {type(message).__name__}")
     return _HEADER.pack(PROTOCOL_VERSION, type_code, message.sender, message.seq) + body
@@ -150,6 +191,19 @@ def decode(data: bytes) -> Message:
             (cx, cy) if claiming else None,
             progress,
         )
+    if type_code == _BEACON:
+        step, px, py, gx, gy, elapsed, tie, heading = fields
+        if not 1 <= heading <= 4:
+            raise DecodeError("malformed", f"heading {heading} is not 1..4")
+        return BeaconMessage(sender, seq, step, (px, py), (gx, gy), elapsed, tie, Heading(heading))
+    if type_code == _ANSWER:
+        step, moved = fields
+        if moved > 1:
+            raise DecodeError("malformed", f"answer with moved={moved}")
+        return AnswerMessage(sender, seq, step, bool(moved))
+    if type_code in _STEP_CELL_CLASSES:
+        step, cx, cy = fields
+        return _STEP_CELL_CLASSES[type_code](sender, seq, step, (cx, cy))  # type: ignore[no-any-return]
     if type_code == _CLAIM:
         claim, cx, cy = fields
         if claim == 0:

@@ -10,7 +10,9 @@ the state of its safety protocol (the cell its body is entering, and its
 current claim; see ``docs/protocol.md``).
 
 :class:`ClaimMessage` and :class:`ReplyMessage` are the safety protocol's
-request for a cell and its answer.
+request for a cell and its answer. :class:`BeaconMessage`,
+:class:`InheritMessage`, :class:`AnswerMessage`, :class:`ReserveMessage` and
+:class:`PullMessage` carry decentralized PIBT (:mod:`mrmp.robot.pibt_robot`).
 
 Robots are named on the wire by their index in the scenario (the same scenario
 file is loaded by every robot), which keeps messages small.
@@ -106,5 +108,67 @@ class ReplyMessage:
     granted: bool
 
 
-Message = StateMessage | ClaimMessage | ReplyMessage
+@dataclass(frozen=True, slots=True)
+class BeaconMessage:
+    """PIBT, one step: the sender's cell, goal and priority, to every robot within the radio radius.
+
+    The priority of a robot is ``(elapsed, tie, -index)``, compared as a tuple:
+    ``elapsed`` counts the steps since it last reached a goal, ``tie`` is a
+    fixed tie-breaker (see :mod:`mrmp.robot.pibt_robot`).
+    """
+
+    sender: int
+    seq: int
+    step: int
+    present: Cell
+    goal: Cell
+    elapsed: int
+    tie: int
+    heading: Heading = Heading.NORTH
+
+
+@dataclass(frozen=True, slots=True)
+class InheritMessage:
+    """PIBT priority inheritance: the sender reserved ``cell``, the recipient's cell; the recipient must decide."""
+
+    sender: int
+    seq: int
+    step: int
+    cell: Cell
+
+
+@dataclass(frozen=True, slots=True)
+class AnswerMessage:
+    """The answer to an :class:`InheritMessage`: whether the sender could leave its cell (``moved``)."""
+
+    sender: int
+    seq: int
+    step: int
+    moved: bool
+
+
+@dataclass(frozen=True, slots=True)
+class ReserveMessage:
+    """The sender reserved ``cell`` for the end of step ``step`` (its latest reservation replaces earlier ones)."""
+
+    sender: int
+    seq: int
+    step: int
+    cell: Cell
+
+
+@dataclass(frozen=True, slots=True)
+class PullMessage:
+    """The swap technique: the sender leaves ``cell`` and asks the recipient to follow into it."""
+
+    sender: int
+    seq: int
+    step: int
+    cell: Cell
+
+
+PibtMessage = BeaconMessage | InheritMessage | AnswerMessage | ReserveMessage | PullMessage
+"""The messages of decentralized PIBT (:mod:`mrmp.robot.pibt_robot`)."""
+
+Message = StateMessage | ClaimMessage | ReplyMessage | PibtMessage
 """Every message type the codec knows."""

@@ -32,7 +32,6 @@ Examples
 
 from __future__ import annotations
 
-import random
 import time
 from collections import Counter
 from collections.abc import Sequence
@@ -42,13 +41,15 @@ from mrmp.core.heading import Heading, right_turns
 from mrmp.core.result import RobotResult, RunResult
 from mrmp.core.scenario import Scenario
 from mrmp.policies.base import Decision, Policy
-from mrmp.policies.registry import make_policy
+from mrmp.policies.registry import ROUND_POLICIES, make_policy
 from mrmp.protocol.codec import DecodeError, decode, encode
 from mrmp.protocol.messages import Message
 from mrmp.robot.robot import Outgoing, Robot
+from mrmp.sim.goals import goal_random, new_goal
 from mrmp.sim.metrics import default_max_ticks, network_slowdown, shortest_steps
 from mrmp.sim.network import SimulatedNetwork
 from mrmp.sim.referee import Referee
+from mrmp.sim.rounds import RoundsSimulator
 
 RECURRENCE_LIMIT = 10
 """How often one configuration may recur before the run is declared stuck (plus
@@ -124,7 +125,7 @@ class LockstepSimulator:
         self._still_since = 0
         self._everyone = range(len(self.robots))
         self._settled: set[int] = set()
-        self._goal_random = random.Random(scenario.seed * 1_000_003 + 7)
+        self._goal_random = goal_random(scenario.seed)
         self._free_cells = grid.free_cells() if scenario.lifelong else []
 
     def run(self) -> RunResult:
@@ -241,10 +242,9 @@ class LockstepSimulator:
             self._results[robot.index].goals_reached += 1
             self._settled.add(robot.index)
             if self.scenario.lifelong:
-                taken = {other.goal for other in self.robots}
-                choices = [cell for cell in self._free_cells if cell not in taken and cell != robot.present]
-                if choices:
-                    robot.goal = self._goal_random.choice(choices)
+                goal = new_goal(self._goal_random, self._free_cells, {other.goal for other in self.robots}, robot.present)
+                if goal is not None:
+                    robot.goal = goal
                     self._settled.discard(robot.index)
 
     def _stuck(self) -> str | None:
@@ -282,5 +282,12 @@ class LockstepSimulator:
 
 
 def simulate(scenario: Scenario, record_decisions: bool = False, policies: Sequence[Policy] | None = None) -> RunResult:
-    """Run ``scenario`` in the lockstep simulator and return its result."""
+    """Run ``scenario`` in the lockstep simulator and return its result.
+
+    Policy ``pibt`` runs in synchronous rounds (:class:`mrmp.sim.rounds.RoundsSimulator`).
+    """
+    if scenario.policy.name in ROUND_POLICIES and policies is None:
+        if record_decisions:
+            raise ValueError("decisions are recorded for per-robot policies only")
+        return RoundsSimulator(scenario).run()
     return LockstepSimulator(scenario, record_decisions=record_decisions, policies=policies).run()

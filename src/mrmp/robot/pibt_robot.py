@@ -1,0 +1,386 @@
+"""A robot that computes PIBT with its neighbours, by messages: the sans-IO brain of policy ``pibt``.
+
+PIBT (Okumura, Machida, Défago and Tamura, "Priority Inheritance with
+Backtracking for Iterative Multi-agent Path Finding", IJCAI 2019; AIJ 310,
+2022) decides every robot's next cell one step at a time. The paper notes that
+it "can be fully decentralized": everything a robot needs lies within two
+hops. Here each robot holds only what its messages told it, and the step is a
+conversation:
+
+1. :meth:`PibtRobot.begin_step`: the robot sends a :class:`BeaconMessage` (its
+   cell, goal, heading and priority) to every robot within ``radius`` cells
+   (Manhattan distance, at least 2);
+2. when its turn comes (:meth:`PibtRobot.start`) or when a neighbour reserves
+   its cell and asks it to decide (:class:`InheritMessage`, *priority
+   inheritance*), it tries its candidate cells, nearest to its goal first. It
+   skips cells reserved by others and cells whose occupant moves into its own
+   cell (no swap); it reserves a cell with a :class:`ReserveMessage` to every
+   robot within 2 cells (everyone who could want that cell, or check whether
+   the sender has decided); if the cell is occupied by a robot that has not
+   decided, it sends that robot an :class:`InheritMessage` and waits for its
+   :class:`AnswerMessage`; on "could not move" it tries its next candidate
+   (*backtracking*); with no candidate left it stays and answers "could not
+   move" to the robot that pushed it;
+3. with ``swap`` on, the swap technique of LaCAM* engineering (Okumura, AAMAS
+   2024) lets two robots pass each other in a corridor: the robot walks away
+   from its goal and asks the other to follow (:class:`PullMessage`);
+4. :meth:`PibtRobot.finish_step`: every robot has decided; it moves to the
+   cell it reserved.
+
+Its decisions equal those of :class:`mrmp.centralized.pibt_step.PIBT` given
+the same priorities, when robots start in priority order and every message of
+a round arrives before the next round (the synchronous rounds of
+:mod:`mrmp.sim.rounds`); the swap test reads only what the robot heard, so it
+can differ when a corridor walk leaves the radio radius. ``docs/protocol.md``
+states the argument and its limits.
+
+**Priorities** are dynamic, as in PIBT: ``(elapsed, tie, -index)`` where
+``elapsed`` counts the steps since the robot last stood on its goal and
+``tie`` is the distance from its start to its first goal (pypibt's
+``dist / |V|`` fraction, as an integer). The highest-priority robot always
+gets its best cell, so on graphs where every edge lies on a cycle every robot
+reaches its goal (the PIBT theorem; bound in ``docs/algorithms.md``).
+
+Nothing here reads a clock, draws a random number or opens a socket: the
+driver delivers messages (:meth:`PibtRobot.receive`), lets the robot act on
+what a round brought (:meth:`PibtRobot.act`), and carries out what it returns.
+
+Examples
+--------
+Two robots in a corridor ``0-1-2`` with a bay above cell 1: robot 0 (at 0,
+for 2) asks robot 1 (at 1, for 0) for cell 1; robot 1 inherits, cannot swap,
+and steps into the bay.
+
+>>> from mrmp.core.grid import Grid
+>>> from mrmp.search.flat_map import FlatMap
+>>> flat = FlatMap(Grid.from_rows(["#.#", "..."]))
+>>> a = PibtRobot(0, flat.index((0, 0)), flat.index((0, 2)), flat, tie=2)
+>>> b = PibtRobot(1, flat.index((0, 1)), flat.index((0, 0)), flat, tie=1)
+>>> beacons = a.begin_step(1) + b.begin_step(1)
+>>> for sent in beacons:
+...     (b if sent.message.sender == 0 else a).receive(sent.message)
+>>> sent = a.start()
+>>> [type(item.message).__name__ for item in sent]
+['ReserveMessage', 'InheritMessage']
+>>> for item in sent:
+...     b.receive(item.message)
+>>> [type(item.message).__name__ for item in b.act()]
+['ReserveMessage', 'AnswerMessage']
+>>> flat.cell(b.target)
+(1, 1)
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from dataclasses import dataclass
+
+from mrmp.core.heading import Heading
+from mrmp.policies.pibt_rules import sorted_candidates, swap_possible, swap_required, turn_aware_candidates
+from mrmp.protocol.messages import (
+    AnswerMessage,
+    BeaconMessage,
+    InheritMessage,
+    PibtMessage,
+    PullMessage,
+    ReserveMessage,
+)
+from mrmp.search.flat_map import FlatMap
+
+__all__ = ["MIN_RADIUS", "RESERVE_RADIUS", "PibtRobot", "Transmission"]
+
+MIN_RADIUS = 2
+"""The smallest radio radius PIBT works with: two robots two cells apart may want the same cell."""
+RESERVE_RADIUS = 2
+"""Reservations go to every robot within 2 cells: all that could want the cell, or push the sender."""
+
+
+@dataclass(frozen=True, slots=True)
+class Transmission:
+    """A message to send: to robot ``recipient``, or (``recipient`` None) to every robot within ``radius`` cells."""
+
+    message: PibtMessage
+    recipient: int | None = None
+    radius: int = 0
+
+
+class _Settled:
+    """The cells, as far as the robot heard, on which a robot stands on its own goal."""
+
+    __slots__ = ("_goals", "_occupants")
+
+    def __init__(self, occupants: dict[int, int], goals: dict[int, int]) -> None:
+        self._occupants = occupants
+        self._goals = goals
+
+    def __contains__(self, cell: object) -> bool:
+        occupant = self._occupants.get(cell)  # type: ignore[call-overload]
+        return occupant is not None and self._goals.get(occupant) == cell
+
+
+class PibtRobot:
+    """One robot's PIBT brain (module docstring has the protocol).
+
+    Parameters
+    ----------
+    index:
+        The robot's index in the scenario (its name on the wire).
+    start, goal:
+        Flat cells of ``flat``.
+    flat:
+        The map, known beforehand, with its distance lists.
+    tie:
+        Fixed tie-breaker of the priority (larger goes first).
+    heading:
+        Initial heading.
+    radius:
+        Radio radius of beacons, in cells (Manhattan), at least :data:`MIN_RADIUS`.
+    swap:
+        Use the swap technique (LaCAM* engineering, Okumura AAMAS 2024).
+    heading_aware:
+        Among equally near candidate cells, prefer fewer right turns.
+    """
+
+    def __init__(
+        self,
+        index: int,
+        start: int,
+        goal: int,
+        flat: FlatMap,
+        *,
+        tie: int = 0,
+        heading: Heading = Heading.NORTH,
+        radius: int = MIN_RADIUS,
+        swap: bool = True,
+        heading_aware: bool = False,
+    ) -> None:
+        if radius < MIN_RADIUS:
+            raise ValueError(f"radius {radius} is below {MIN_RADIUS}: robots two cells apart could take the same cell")
+        self.index = index
+        self.present = start
+        self.goal = goal
+        self.flat = flat
+        self.tie = tie
+        self.heading = heading
+        self.radius = radius
+        self.swap = swap
+        self.heading_aware = heading_aware
+        self.elapsed = 0
+        self.step = 0
+        self.seq = 0
+        self.target: int | None = None
+        self.dropped: Counter[str] = Counter()
+        # what this step's messages told the robot
+        self._occupants: dict[int, int] = {}
+        self._goals: dict[int, int] = {}
+        self._reserved: dict[int, int] = {}
+        self._targets: dict[int, int] = {}
+        self._seen: set[tuple[int, int]] = set()
+        self._control: list[PibtMessage] = []
+        # the robot's own PIBT call, while it runs
+        self._candidates: list[int] = []
+        self._next = 0
+        self._pulled: int | None = None
+        self._parent: int | None = None
+        self._waiting: int | None = None
+
+    # -- state ---------------------------------------------------------------------
+
+    @property
+    def priority(self) -> tuple[int, int, int]:
+        """``(elapsed, tie, -index)``: larger goes first."""
+        return (self.elapsed, self.tie, -self.index)
+
+    @property
+    def decided(self) -> bool:
+        """Whether the robot knows its cell for the end of this step."""
+        return self.target is not None and self._waiting is None
+
+    @property
+    def at_goal(self) -> bool:
+        """Whether the robot stands on its goal."""
+        return self.present == self.goal
+
+    def _seq(self) -> int:
+        self.seq += 1
+        return self.seq
+
+    # -- the step ------------------------------------------------------------------
+
+    def begin_step(self, step: int) -> list[Transmission]:
+        """Start step ``step``: forget the last step's view and announce cell, goal and priority."""
+        self.step = step
+        self.target = None
+        self._waiting = self._parent = self._pulled = None
+        self._occupants = {self.present: self.index}
+        self._goals = {self.index: self.goal}
+        self._reserved = {}
+        self._targets = {}
+        self._seen = set()
+        self._control = []
+        x, y = divmod(self.goal, self.flat.y_size)
+        px, py = divmod(self.present, self.flat.y_size)
+        beacon = BeaconMessage(self.index, self._seq(), step, (px, py), (x, y), self.elapsed, self.tie, self.heading)
+        return [Transmission(beacon, None, self.radius)]
+
+    def receive(self, message: PibtMessage) -> None:
+        """Take in a message delivered this round; act on it in :meth:`act`.
+
+        Messages of another step and second copies are dropped and counted.
+        """
+        if message.step != self.step:
+            self.dropped["stale"] += 1
+            return
+        key = (message.sender, message.seq)
+        if key in self._seen:
+            self.dropped["duplicate"] += 1
+            return
+        self._seen.add(key)
+        kind = type(message)
+        if kind is BeaconMessage:
+            flat = self.flat
+            self._occupants[flat.index(message.present)] = message.sender  # type: ignore[union-attr]
+            self._goals[message.sender] = flat.index(message.goal)  # type: ignore[union-attr]
+        elif kind is ReserveMessage:
+            cell = self.flat.index(message.cell)  # type: ignore[union-attr]
+            self._reserved[cell] = message.sender
+            self._targets[message.sender] = cell
+        else:
+            self._control.append(message)
+
+    def act(self) -> list[Transmission]:
+        """Act on the requests and answers of this round; return what to send."""
+        if not self._control:
+            return []
+        control, self._control = self._control, []
+        out: list[Transmission] = []
+        for message in control:
+            kind = type(message)
+            if kind is InheritMessage:
+                if self.target is not None:
+                    self.dropped["late_inherit"] += 1  # cannot happen in synchronous rounds; refuse
+                    out.append(Transmission(AnswerMessage(self.index, self._seq(), self.step, False), message.sender))
+                    continue
+                self._reserved[self.present] = message.sender
+                self._targets[message.sender] = self.present
+                self._parent = message.sender
+                self._begin_call(out)
+            elif kind is AnswerMessage:
+                if message.sender != self._waiting:
+                    self.dropped["unexpected_answer"] += 1
+                    continue
+                self._waiting = None
+                if message.moved:  # type: ignore[union-attr]
+                    self._finish(True, out)
+                else:
+                    self._next += 1  # backtracking: the pushed robot stays; try the next cell
+                    self._continue(out)
+            elif kind is PullMessage:
+                cell = self.flat.index(message.cell)  # type: ignore[union-attr]
+                if self.target is None and cell not in self._reserved:
+                    self._reserve(cell, out)
+        return out
+
+    def start(self) -> list[Transmission]:
+        """This robot's turn to decide (it is the highest-priority robot not yet decided)."""
+        out: list[Transmission] = []
+        if self.target is None:
+            self._begin_call(out)
+        return out
+
+    def finish_step(self) -> int:
+        """Move to the reserved cell (or stay, when undecided); update heading and priority; return the cell."""
+        target = self.target if self.target is not None else self.present
+        if target != self.present:
+            self.heading = Heading.between(self.flat.cell(self.present), self.flat.cell(target))
+        self.present = target
+        self.elapsed = 0 if target == self.goal else self.elapsed + 1
+        return target
+
+    # -- PIBT's call, by messages -------------------------------------------------------
+
+    def _reserve(self, cell: int, out: list[Transmission]) -> None:
+        self.target = cell
+        self._reserved[cell] = self.index
+        self._targets[self.index] = cell
+        x, y = divmod(cell, self.flat.y_size)
+        out.append(Transmission(ReserveMessage(self.index, self._seq(), self.step, (x, y)), None, RESERVE_RADIUS))
+
+    def _begin_call(self, out: list[Transmission]) -> None:
+        flat = self.flat
+        distances = flat.distances(self.goal)
+        if self.heading_aware:
+            candidates = turn_aware_candidates(flat.neighbours, self.present, distances, self.heading, flat.y_size)
+        else:
+            candidates = sorted_candidates(flat.neighbours, self.present, distances)
+        self._pulled = None
+        if self.swap:
+            self._pulled = self._swap_partner(candidates, distances)
+            if self._pulled is not None:
+                candidates.reverse()
+        self._candidates = candidates
+        self._next = 0
+        self._continue(out)
+
+    def _continue(self, out: list[Transmission]) -> None:
+        here = self.present
+        reserved, occupants, targets = self._reserved, self._occupants, self._targets
+        candidates = self._candidates
+        while self._next < len(candidates):
+            cell = candidates[self._next]
+            if cell in reserved:
+                self._next += 1
+                continue
+            occupant = occupants.get(cell)
+            if occupant is not None and targets.get(occupant) == here:
+                self._next += 1  # the occupant moves into our cell: taking its cell would swap
+                continue
+            self._reserve(cell, out)
+            if occupant is not None and occupant != self.index and occupant not in targets:
+                self._waiting = occupant  # priority inheritance
+                out.append(Transmission(InheritMessage(self.index, self._seq(), self.step, self.flat.cell(cell)), occupant))
+                return
+            self._finish(True, out)
+            return
+        self._reserve(here, out)  # no candidate left: stay
+        self._finish(False, out)
+
+    def _finish(self, moved: bool, out: list[Transmission]) -> None:
+        pulled = self._pulled
+        if moved and self._next == 0 and pulled is not None:
+            here = self.present
+            if pulled not in self._targets and here not in self._reserved:
+                self._reserved[here] = pulled
+                self._targets[pulled] = here
+                out.append(Transmission(PullMessage(self.index, self._seq(), self.step, self.flat.cell(here)), pulled))
+        if self._parent is not None:
+            out.append(Transmission(AnswerMessage(self.index, self._seq(), self.step, moved), self._parent))
+            self._parent = None
+
+    def _swap_partner(self, candidates: list[int], distances: list[float]) -> int | None:
+        """``is_swap_required_and_possible`` on what the robot heard: the robot to pull, or None."""
+        flat = self.flat
+        neighbours, occupants, targets, goals = flat.neighbours, self._occupants, self._targets, self._goals
+        settled = _Settled(occupants, goals)
+        here = self.present
+        best = candidates[0]
+        other = occupants.get(best)
+        if (
+            other is not None
+            and other != self.index
+            and other not in targets
+            and swap_required(neighbours, settled, distances, flat.distances(goals[other]), here, best)
+            and swap_possible(neighbours, settled, best, here)
+        ):
+            return other
+        if best != here:  # "clear" operation, as in push and swap
+            for cell in neighbours[here]:
+                other = occupants.get(cell)
+                if (
+                    other is not None
+                    and best != cell
+                    and swap_required(neighbours, settled, flat.distances(goals[other]), distances, here, best)
+                    and swap_possible(neighbours, settled, best, here)
+                ):
+                    return other
+        return None

@@ -1,0 +1,394 @@
+"""Synchronous rounds: the simulator of policy ``pibt``, robots computing PIBT by messages.
+
+Each step of decentralized PIBT (:mod:`mrmp.robot.pibt_robot`) is a
+conversation in *synchronous rounds* (Lynch, *Distributed Algorithms*, 1996,
+chapter 2): in a round every robot receives all messages sent to it in the
+previous round, then acts on them. A step runs as follows:
+
+1. every robot sends its beacon to the robots within its radio radius (the
+   simulator plays the radio: it delivers a broadcast of radius ``r`` to
+   every robot within ``r`` cells, Manhattan distance, of the sender);
+2. robots decide in priority order: the highest-priority robot that has not
+   decided yet starts its PIBT call, and the rounds run until no message is in
+   flight; then the next. Robots farther than two cells apart from every robot
+   of another *group* (the connected parts of the "within two cells" relation)
+   never exchange a message, so groups run at the same time; the simulator
+   serves them one after the other and charges time per group;
+3. every robot moves to the cell it reserved; the referee checks the move.
+
+**Faults.** Messages cross a link layer with acknowledgements and
+retransmission (automatic repeat request): each try is lost, duplicated,
+delayed or reordered as the scenario's network says (one draw of
+:func:`mrmp.core.faults.message_fates` per try); a lost try or a lost
+acknowledgement is sent again after ``2 * delay_max + 1`` ticks. A round ends
+when its last message has arrived, so delays make steps take longer (robots
+stand still meanwhile) but never change a decision; duplicates are dropped by
+the robots. A message that still has not arrived after 64 tries (a cut link)
+abandons the step: nobody moves, which is always safe. Messages, tries,
+acknowledgements, duplicates and rounds are counted in the result's ``network``.
+
+Deterministic for a seed. Ends when every robot stands on its goal (never in a
+lifelong run), at the tick limit, or on Ctrl-C, returning what was computed.
+
+Examples
+--------
+>>> from mrmp.core import Grid, PolicyOptions, RobotSpec, Scenario
+>>> swap = Scenario(Grid(5, 5), (RobotSpec("A", (0, 2), (4, 2)), RobotSpec("B", (4, 2), (0, 2))),
+...                 policy=PolicyOptions(name="pibt"))
+>>> result = RoundsSimulator(swap).run()
+>>> result.success, result.makespan, result.sum_of_costs, result.lower_bound
+(True, 5, 10, 8)
+"""
+
+from __future__ import annotations
+
+import random
+import time
+from collections import Counter
+from collections.abc import Sequence
+
+from mrmp.core.heading import right_turns
+from mrmp.core.faults import message_fates
+from mrmp.core.result import RobotResult, RunResult
+from mrmp.core.scenario import NetworkFaults, Scenario
+from mrmp.protocol.codec import encode
+from mrmp.protocol.messages import AnswerMessage, BeaconMessage, InheritMessage, PullMessage, ReserveMessage
+from mrmp.robot.pibt_robot import RESERVE_RADIUS, PibtRobot, Transmission
+from mrmp.search.flat_map import FlatMap
+from mrmp.sim.goals import goal_random, new_goal
+from mrmp.sim.metrics import default_max_ticks, network_slowdown, shortest_steps
+from mrmp.sim.referee import Referee
+
+__all__ = ["MAX_TRIES", "RoundsSimulator", "message_size"]
+
+MAX_TRIES = 64
+"""Tries of one message before its link counts as cut and the step is abandoned."""
+
+_SIZES = {
+    kind: len(encode(sample))
+    for kind, sample in (
+        (BeaconMessage, BeaconMessage(0, 0, 0, (0, 0), (0, 0), 0, 0)),
+        (InheritMessage, InheritMessage(0, 0, 0, (0, 0))),
+        (AnswerMessage, AnswerMessage(0, 0, 0, False)),
+        (ReserveMessage, ReserveMessage(0, 0, 0, (0, 0))),
+        (PullMessage, PullMessage(0, 0, 0, (0, 0))),
+    )
+}
+
+
+def message_size(message: object) -> int:
+    """Bytes of ``message`` on the wire (every message of a PIBT type has the same size).
+
+    >>> message_size(ReserveMessage(3, 1, 7, (2, 2)))
+    22
+    """
+    return _SIZES[type(message)]
+
+
+class _CutLink(Exception):
+    """A message did not get through in :data:`MAX_TRIES` tries."""
+
+
+class RoundsSimulator:
+    """Runs a scenario with robots computing PIBT by messages (module docstring).
+
+    Parameters
+    ----------
+    scenario:
+        What to run. Its policy options give the radio radius (``radius``),
+        the swap technique (``swap``) and turn-aware ordering (``heading_aware``).
+    """
+
+    def __init__(self, scenario: Scenario) -> None:
+        self.scenario = scenario
+        options = scenario.policy
+        grid = scenario.grid
+        self.flat = FlatMap(grid)
+        flat = self.flat
+        self.robots: list[PibtRobot] = []
+        for index, spec in enumerate(scenario.robots):
+            goal = flat.index(spec.goal)
+            start = flat.index(spec.start)
+            distance = flat.distances(goal)[start]
+            self.robots.append(
+                PibtRobot(
+                    index,
+                    start,
+                    goal,
+                    flat,
+                    tie=int(distance) if distance != float("inf") else 0,
+                    heading=spec.heading,
+                    radius=options.radius,
+                    swap=options.swap,
+                    heading_aware=options.heading_aware,
+                )
+            )
+        self.referee = Referee(grid, [spec.id for spec in scenario.robots])
+        self.lengths = shortest_steps(scenario)
+        self.max_ticks = scenario.max_ticks or self._default_max_ticks()
+        self.tick = 0
+        self.step_count = 0
+        self._results = [
+            RobotResult(spec.id, spec.start, spec.goal, path=[spec.start], headings=[spec.heading])
+            for spec in scenario.robots
+        ]
+        self._durations: list[list[float]] = [[] for _ in scenario.robots]
+        self._random = random.Random(scenario.seed)
+        index_of = {spec.id: index for index, spec in enumerate(scenario.robots)}
+        self._links = {(index_of[link.sender], index_of[link.recipient]): link.faults for link in scenario.links}
+        self._perfect = scenario.network.is_perfect and not self._links
+        self._near: dict[int, list[tuple[int, ...] | None]] = {}
+        self._occupant: dict[int, int] = {}
+        self._group_of: list[int] = []
+        self.stats: Counter[str] = Counter()
+        self._goal_random = goal_random(scenario.seed)
+        self._free_cells = grid.free_cells() if scenario.lifelong else []
+        self._settled: set[int] = set()
+
+    def _default_max_ticks(self) -> int:
+        ticks = default_max_ticks(self.scenario.with_changes(safety=False), self.lengths)
+        if not self.scenario.worst_faults().is_perfect:
+            ticks = int(ticks * network_slowdown(self.scenario.with_changes(safety=True)))
+        return ticks
+
+    # -- the run ---------------------------------------------------------------------
+
+    def run(self) -> RunResult:
+        """Run to the end and return the result (partial on Ctrl-C)."""
+        started = time.perf_counter()
+        robots = self.robots
+        self.referee.check_start([spec.start for spec in self.scenario.robots])
+        stop_reason = "time up" if self.scenario.lifelong else "tick limit"
+        try:
+            while self.tick < self.max_ticks:
+                if not self.scenario.lifelong and all(robot.at_goal for robot in robots):
+                    stop_reason = "all arrived"
+                    break
+                self.step()
+            else:
+                if not self.scenario.lifelong and all(robot.at_goal for robot in robots):
+                    stop_reason = "all arrived"
+        except KeyboardInterrupt:
+            stop_reason = "interrupted"
+        return self._result(stop_reason, time.perf_counter() - started)
+
+    def step(self) -> None:
+        """One PIBT step: beacons, decisions in priority order, waits for slow rounds, then the moves."""
+        self.step_count += 1
+        step = self.step_count
+        robots = self.robots
+        self._occupant = {robot.present: robot.index for robot in robots}
+        if not self._perfect:
+            self._group_of = self._groups()
+        outbox = [(robot.index, sent) for robot in robots for sent in robot.begin_step(step)]
+        try:
+            extra = self._rounds(outbox)
+            group_time: Counter[int] = Counter()
+            for robot in sorted(robots, key=PibtRobot.priority.fget, reverse=True):  # type: ignore[arg-type]
+                if robot.target is None:
+                    spent = self._rounds([(robot.index, sent) for sent in robot.start()])
+                    if spent:
+                        group_time[self._group_of[robot.index]] += spent
+            extra += max(group_time.values(), default=0)
+            abandoned = False
+        except _CutLink:
+            abandoned = True
+            extra = 0
+            self.stats["abandoned_steps"] += 1
+        for _ in range(extra):
+            if self.tick >= self.max_ticks:
+                return
+            self._advance(moves=False)
+        if self.tick < self.max_ticks:
+            self._advance(moves=not abandoned)
+
+    def _advance(self, moves: bool) -> None:
+        """One tick: the robots move to their reserved cells (``moves``) or all stand still."""
+        self.tick += 1
+        robots = self.robots
+        flat = self.flat
+        timing = self.scenario.timing
+        grid = self.scenario.grid
+        before = [flat.cell(robot.present) for robot in robots]
+        for robot in robots:
+            result = self._results[robot.index]
+            heading = robot.heading
+            duration = timing.cell_time
+            if moves:
+                was = robot.present
+                robot.finish_step()
+                if robot.present != was:
+                    turns = right_turns(heading, robot.heading)
+                    result.turns += turns
+                    duration = turns * timing.turn_time + timing.cell_time * grid.cost(flat.cell(robot.present))
+            result.path.append(flat.cell(robot.present))
+            result.headings.append(robot.heading)
+            self._durations[robot.index].append(duration)
+        self.referee.check_tick(self.tick, before, [flat.cell(robot.present) for robot in robots])
+        self._count_goals()
+
+    def _count_goals(self) -> None:
+        """Count goals reached; in a lifelong run, hand each such robot a new goal (drawn with the seed)."""
+        flat = self.flat
+        for robot in self.robots:
+            if not robot.at_goal:
+                self._settled.discard(robot.index)
+                continue
+            if robot.index in self._settled:
+                continue
+            self._results[robot.index].goals_reached += 1
+            self._settled.add(robot.index)
+            if self.scenario.lifelong:
+                taken = {flat.cell(other.goal) for other in self.robots}
+                goal = new_goal(self._goal_random, self._free_cells, taken, flat.cell(robot.present))
+                if goal is not None:
+                    robot.goal = flat.index(goal)
+                    robot.elapsed = 0
+                    self._settled.discard(robot.index)
+
+    # -- rounds ------------------------------------------------------------------------
+
+    def _within(self, cell: int, radius: int) -> tuple[int, ...]:
+        """The flat cells within ``radius`` (Manhattan) of ``cell``, itself excluded."""
+        table = self._near.get(radius)
+        if table is None:
+            table = self._near[radius] = [None] * len(self.flat.neighbours)
+        cells = table[cell]
+        if cells is None:
+            grid = self.scenario.grid
+            x, y = self.flat.cell(cell)
+            cells = tuple(
+                self.flat.index((x + dx, y + dy))
+                for dx in range(-radius, radius + 1)
+                for dy in range(-radius + abs(dx), radius - abs(dx) + 1)
+                if (dx or dy) and grid.in_bounds((x + dx, y + dy))
+            )
+            table[cell] = cells
+        return cells
+
+    def _rounds(self, outbox: list[tuple[int, Transmission]]) -> int:
+        """Run rounds until no message is in flight; return the ticks they took."""
+        robots = self.robots
+        results = self._results
+        occupant = self._occupant
+        stats = self.stats
+        perfect = self._perfect
+        spent = 0
+        while outbox:
+            stats["rounds"] += 1
+            acting: dict[int, None] = {}
+            late: list[tuple[int, object]] = []
+            round_time = 0
+            for sender, sent in outbox:
+                message = sent.message
+                if sent.recipient is not None:
+                    recipients: Sequence[int] = (sent.recipient,)
+                else:
+                    recipients = [
+                        occupant[cell]
+                        for cell in self._within(robots[sender].present, sent.radius)
+                        if cell in occupant
+                    ]
+                size = _SIZES[type(message)]
+                result = results[sender]
+                result.messages_sent += len(recipients)
+                result.bytes_sent += size * len(recipients)
+                for recipient in recipients:
+                    if perfect:
+                        robots[recipient].receive(message)  # type: ignore[arg-type]
+                    else:
+                        latency, copies, held = self._link(sender, recipient)
+                        round_time = max(round_time, latency)
+                        for _ in range(copies - held):
+                            robots[recipient].receive(message)  # type: ignore[arg-type]
+                        late.extend((recipient, message) for _ in range(held))
+                    acting[recipient] = None
+            for recipient, message in late:  # copies held back arrive last in the round
+                robots[recipient].receive(message)  # type: ignore[arg-type]
+            spent += round_time
+            outbox = [(index, sent) for index in acting for sent in robots[index].act()]
+        return spent
+
+    def _link(self, sender: int, recipient: int) -> tuple[int, int, int]:
+        """Send one message over a faulty link with retransmission: (ticks until it arrives, copies, copies held back)."""
+        faults: NetworkFaults = self._links.get((sender, recipient), self.scenario.network)
+        rng = self._random
+        stats = self.stats
+        timeout = 2 * faults.delay_max + 1 if faults.delay_max else 0
+
+        def delay() -> int:
+            return rng.randint(faults.delay_min, faults.delay_max)
+
+        waited = 0
+        arrival: int | None = None
+        copies = held = 0
+        for _ in range(MAX_TRIES):
+            stats["tries"] += 1
+            fates = message_fates(rng, faults.loss, faults.duplicate, faults.reorder, delay)
+            stats["lost"] += fates.lost
+            stats["duplicated"] += int(fates.duplicated)
+            acknowledged = False
+            for copy in fates.delivered:
+                copies += 1
+                held += int(copy.reordered)
+                stats["delivered"] += 1
+                stats["acks"] += 1
+                if arrival is None or waited + int(copy.delay) < arrival:
+                    arrival = waited + int(copy.delay)
+                if not (faults.loss and rng.random() < faults.loss):
+                    acknowledged = True
+                else:
+                    stats["acks_lost"] += 1
+            if acknowledged:
+                if copies > 1:
+                    stats["extra_copies"] += copies - 1
+                return arrival or 0, copies, held
+            stats["retransmissions"] += 1
+            waited += timeout
+        if arrival is not None:
+            return arrival, copies, held
+        raise _CutLink
+
+    def _groups(self) -> list[int]:
+        """Each robot's group: robots within two cells of each other, transitively (union-find)."""
+        parent = list(range(len(self.robots)))
+
+        def root(index: int) -> int:
+            while parent[index] != index:
+                parent[index] = parent[parent[index]]
+                index = parent[index]
+            return index
+
+        occupant = self._occupant
+        for robot in self.robots:
+            for cell in self._within(robot.present, RESERVE_RADIUS):
+                other = occupant.get(cell)
+                if other is not None:
+                    parent[root(other)] = root(robot.index)
+        return [root(index) for index in range(len(self.robots))]
+
+    # -- the result --------------------------------------------------------------------
+
+    def _result(self, stop_reason: str, wall_time: float) -> RunResult:
+        for index, result in enumerate(self._results):
+            result.time_s = sum(self._durations[index][: result.cost])
+        network = {name: int(value) for name, value in sorted(self.stats.items())}
+        network["steps"] = self.step_count
+        network["messages"] = sum(result.messages_sent for result in self._results)
+        network["dropped_by_robots"] = sum(sum(robot.dropped.values()) for robot in self.robots)
+        network["distance_tables"] = self.flat.tables_computed
+        return RunResult(
+            scenario=self.scenario.name,
+            policy="pibt",
+            seed=self.scenario.seed,
+            robots=self._results,
+            collisions=list(self.referee.collisions),
+            stop_reason=stop_reason,
+            ticks=self.tick,
+            lower_bound=sum(self.lengths),
+            wall_time_s=wall_time,
+            network=network,
+            planning_time_s=self.flat.table_seconds,
+            lifelong=self.scenario.lifelong,
+        )
+

@@ -1,0 +1,109 @@
+"""The message-driven PIBT robots decide exactly as the central PIBT generator, step by step."""
+
+import random
+
+import pytest
+
+from mrmp.centralized.pibt_step import PIBT
+from mrmp.core import Grid, NetworkFaults, PolicyOptions, RobotSpec, Scenario
+from mrmp.core.grid import connected_regions
+from mrmp.protocol.codec import decode, encode
+from mrmp.protocol.messages import AnswerMessage, BeaconMessage, InheritMessage, PullMessage, ReserveMessage
+from mrmp.robot.pibt_robot import PibtRobot
+from mrmp.search.flat_map import FlatMap
+from mrmp.sim.rounds import RoundsSimulator
+
+
+def random_scenario(seed, swap, radius=2, faults=NetworkFaults()):
+    rng = random.Random(seed)
+    x_size, y_size = rng.randint(3, 9), rng.randint(3, 9)
+    cells = [(x, y) for x in range(x_size) for y in range(y_size)]
+    blocked = set(rng.sample(cells, k=rng.randint(0, len(cells) // 5)))
+    grid = Grid(x_size, y_size, blocked)
+    region = max(connected_regions(grid, grid.free_cells())[1], key=len)
+    free = sorted(region)
+    count = rng.randint(1, max(1, len(free) // 2))
+    starts, goals = rng.sample(free, count), rng.sample(free, count)
+    robots = tuple(RobotSpec(f"r{i}", s, g) for i, (s, g) in enumerate(zip(starts, goals)))
+    return Scenario(grid, robots, network=faults, policy=PolicyOptions(name="pibt", radius=radius, swap=swap), seed=seed)
+
+
+def central_next(simulator, swap):
+    robots = simulator.robots
+    flat = simulator.flat
+    pibt = PIBT(flat.neighbours, [flat.distances(robot.goal) for robot in robots], [robot.goal for robot in robots], swap=swap)
+    order = [robot.index for robot in sorted(robots, key=lambda robot: robot.priority, reverse=True)]
+    return pibt.step([robot.present for robot in robots], order)
+
+
+@pytest.mark.parametrize("swap", [False, True])
+@pytest.mark.parametrize("seed", range(40))
+def test_decisions_equal_central_pibt(seed, swap):
+    scenario = random_scenario(seed, swap, radius=32)  # the radius covers the map: nothing is unknown
+    simulator = RoundsSimulator(scenario)
+    for _ in range(30):
+        expected = central_next(simulator, swap)
+        simulator.step()
+        assert [robot.present for robot in simulator.robots] == expected
+    assert simulator.referee.collisions == []
+
+
+@pytest.mark.parametrize("seed", range(40))
+def test_radius_two_without_swap_is_exact(seed):
+    scenario = random_scenario(seed, swap=False, radius=2)
+    simulator = RoundsSimulator(scenario)
+    for _ in range(30):
+        expected = central_next(simulator, swap=False)
+        simulator.step()
+        assert [robot.present for robot in simulator.robots] == expected
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_faults_change_timing_not_decisions(seed):
+    faulty = NetworkFaults(loss=0.3, delay_min=0, delay_max=2, duplicate=0.2, reorder=0.3)
+    clean = RoundsSimulator(random_scenario(seed, swap=True))
+    noisy = RoundsSimulator(random_scenario(seed, swap=True, faults=faulty).with_changes(max_ticks=10**5))
+    for _ in range(25):
+        clean.step()
+        noisy.step()
+        assert [robot.present for robot in noisy.robots] == [robot.present for robot in clean.robots]
+    assert noisy.referee.collisions == [] and clean.referee.collisions == []
+    assert noisy.tick >= clean.tick == 25
+    if noisy.stats["tries"] > 100:
+        assert noisy.stats["retransmissions"] > 0 and noisy.stats["extra_copies"] > 0
+        assert sum(sum(robot.dropped.values()) for robot in noisy.robots) > 0  # second copies dropped
+
+
+def test_a_cut_link_abandons_steps_and_nobody_moves():
+    scenario = random_scenario(5, swap=True, faults=NetworkFaults(loss=1.0)).with_changes(max_ticks=5)
+    result = RoundsSimulator(scenario).run()
+    assert result.network["abandoned_steps"] == 5
+    assert all(set(robot.path) == {robot.start} for robot in result.robots)
+
+
+def test_messages_round_trip_the_codec():
+    for message in (
+        BeaconMessage(3, 9, 4, (1, 2), (5, 6), 7, 8),
+        InheritMessage(3, 10, 4, (1, 3)),
+        AnswerMessage(3, 11, 4, True),
+        ReserveMessage(3, 12, 4, (2, 2)),
+        PullMessage(3, 13, 4, (1, 2)),
+    ):
+        assert decode(encode(message)) == message
+
+
+def test_duplicates_and_stale_messages_are_dropped():
+    flat = FlatMap(Grid(1, 3))
+    robot = PibtRobot(0, 0, 2, flat)
+    robot.begin_step(2)
+    reserve = ReserveMessage(1, 5, 2, (0, 1))
+    robot.receive(reserve)
+    robot.receive(reserve)
+    robot.receive(ReserveMessage(1, 6, 1, (0, 2)))
+    assert robot.dropped == {"duplicate": 1, "stale": 1}
+    assert robot.start() and robot.target == 0  # (0, 1) is reserved: it stays
+
+
+def test_radius_below_two_is_refused():
+    with pytest.raises(ValueError, match="radius 1"):
+        PibtRobot(0, 0, 1, FlatMap(Grid(1, 2)), radius=1)
