@@ -29,7 +29,7 @@ False
 
 from __future__ import annotations
 
-from collections.abc import Container, Sequence
+from collections.abc import Callable, Container, Sequence
 
 from mrmp.core.heading import Heading, right_turns
 
@@ -41,17 +41,27 @@ def sorted_candidates(
     neighbours: Sequence[tuple[int, ...]],
     here: int,
     distances: Sequence[float],
+    noise: Callable[[], float] | None = None,
 ) -> list[int]:
     """A robot's candidate cells at ``here``: its free neighbours, then ``here``, nearest to its goal first.
 
-    The sort is stable, so equally near cells keep the order NORTH, EAST,
-    SOUTH, WEST, then staying (as in the reference implementations).
+    Without ``noise`` the sort is stable, so equally near cells keep the order
+    NORTH, EAST, SOUTH, WEST, then staying. With ``noise`` (a random number in
+    [0, 1) per call, as pypibt shuffles candidates before sorting) equally
+    near cells come in random order; distances are whole moves, so the noise
+    never reorders cells at different distances.
 
     >>> sorted_candidates([(1,), (0, 2), (1,)], 1, [2, 1, 0])
     [2, 1, 0]
+    >>> import random
+    >>> sorted(sorted_candidates([(1, 2), (0,), (0,)], 0, [1, 0, 0], random.Random(3).random)[:2])
+    [1, 2]
     """
     candidates = [*neighbours[here], here]
-    candidates.sort(key=distances.__getitem__)
+    if noise is None:
+        candidates.sort(key=distances.__getitem__)
+    else:
+        candidates.sort(key=lambda cell: distances[cell] + noise())
     return candidates
 
 
@@ -61,6 +71,7 @@ def turn_aware_candidates(
     distances: Sequence[float],
     heading: Heading,
     y_size: int,
+    noise: Callable[[], float] | None = None,
 ) -> list[int]:
     """Like :func:`sorted_candidates`, with fewer right turns first among equally near cells.
 
@@ -77,12 +88,13 @@ def turn_aware_candidates(
     [2, 4, 1, 0]
     """
 
-    def key(cell: int) -> tuple[float, int]:
+    def key(cell: int) -> tuple[float, int, float]:
+        tie = noise() if noise is not None else 0.0
         if cell == here:
-            return distances[cell], 0
+            return distances[cell], 0, tie
         hx, hy = divmod(here, y_size)
         cx, cy = divmod(cell, y_size)
-        return distances[cell], right_turns(heading, Heading.between((hx, hy), (cx, cy)))
+        return distances[cell], right_turns(heading, Heading.between((hx, hy), (cx, cy))), tie
 
     candidates = [*neighbours[here], here]
     candidates.sort(key=key)

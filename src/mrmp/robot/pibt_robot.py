@@ -72,6 +72,7 @@ and steps into the bay.
 
 from __future__ import annotations
 
+import random
 from collections import Counter
 from dataclasses import dataclass
 
@@ -139,6 +140,10 @@ class PibtRobot:
         Use the swap technique (LaCAM* engineering, Okumura AAMAS 2024).
     heading_aware:
         Among equally near candidate cells, prefer fewer right turns.
+    rng:
+        Breaks the remaining ties between equally near cells at random (as
+        pypibt does; without it PIBT often cycles forever in crowds); None
+        keeps the neighbour order, which makes decisions reproducible by hand.
     """
 
     def __init__(
@@ -153,6 +158,7 @@ class PibtRobot:
         radius: int = MIN_RADIUS,
         swap: bool = True,
         heading_aware: bool = False,
+        rng: random.Random | None = None,
     ) -> None:
         if radius < MIN_RADIUS:
             raise ValueError(f"radius {radius} is below {MIN_RADIUS}: robots two cells apart could take the same cell")
@@ -165,6 +171,7 @@ class PibtRobot:
         self.radius = radius
         self.swap = swap
         self.heading_aware = heading_aware
+        self._noise = rng.random if rng is not None else None
         self.elapsed = 0
         self.step = 0
         self.seq = 0
@@ -310,9 +317,11 @@ class PibtRobot:
         flat = self.flat
         distances = flat.distances(self.goal)
         if self.heading_aware:
-            candidates = turn_aware_candidates(flat.neighbours, self.present, distances, self.heading, flat.y_size)
+            candidates = turn_aware_candidates(
+                flat.neighbours, self.present, distances, self.heading, flat.y_size, self._noise
+            )
         else:
-            candidates = sorted_candidates(flat.neighbours, self.present, distances)
+            candidates = sorted_candidates(flat.neighbours, self.present, distances, self._noise)
         self._pulled = None
         if self.swap:
             self._pulled = self._swap_partner(candidates, distances)

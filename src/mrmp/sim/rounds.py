@@ -97,9 +97,14 @@ class RoundsSimulator:
     scenario:
         What to run. Its policy options give the radio radius (``radius``),
         the swap technique (``swap``) and turn-aware ordering (``heading_aware``).
+    random_ties:
+        Give each robot a random generator (seeded with the scenario's seed and
+        its index) to break ties between equally near cells; ``False`` keeps
+        the neighbour order, as :class:`mrmp.centralized.pibt_step.PIBT`
+        without ``rng`` does.
     """
 
-    def __init__(self, scenario: Scenario) -> None:
+    def __init__(self, scenario: Scenario, random_ties: bool = True) -> None:
         self.scenario = scenario
         options = scenario.policy
         grid = scenario.grid
@@ -121,6 +126,7 @@ class RoundsSimulator:
                     radius=options.radius,
                     swap=options.swap,
                     heading_aware=options.heading_aware,
+                    rng=random.Random(scenario.seed * 7919 + index) if random_ties else None,
                 )
             )
         self.referee = Referee(grid, [spec.id for spec in scenario.robots])
