@@ -19,7 +19,7 @@ from mrmp.core.errors import InputError, MrmpError, Problem
 from mrmp.core.result import RunResult
 from mrmp.core.scenario import RESOLUTIONS, NetworkFaults, PolicyOptions, Scenario, scenario_problems
 from mrmp.io import load_movingai_scenario, load_scenario, validate_file, write_result_json
-from mrmp.policies.registry import POLICY_NAMES
+from mrmp.policies.registry import POLICY_NAMES, ROUND_POLICIES
 from mrmp.sim.simulator import simulate
 
 app = typer.Typer(
@@ -74,7 +74,9 @@ def _load(
 
 def _apply_options(scenario: Scenario, **options: object) -> Scenario:
     policy = scenario.policy
-    policy_changes = {key: options[key] for key in ("name", "resolve", "heading_aware") if options.get(key) is not None}
+    policy_changes = {
+        key: options[key] for key in ("name", "resolve", "heading_aware", "radius", "swap") if options.get(key) is not None
+    }
     if policy_changes:
         policy = PolicyOptions(**{**policy.__dict__, **policy_changes})
     network = scenario.network
@@ -243,6 +245,8 @@ def run(
     policy: Annotated[Optional[str], typer.Option(help=f"Decision rule: {', '.join(POLICY_NAMES)}.")] = None,
     resolve: Annotated[Optional[str], typer.Option(help=f"Conflict resolution: {', '.join(RESOLUTIONS)}.")] = None,
     heading_aware: Annotated[Optional[bool], typer.Option("--heading-aware/--no-heading-aware", help="Charge turns when planning.")] = None,
+    radius: Annotated[Optional[int], typer.Option(help="pibt: how far a robot's beacon reaches, in cells (at least 2).")] = None,
+    swap: Annotated[Optional[bool], typer.Option("--swap/--no-swap", help="pibt: the swap technique for corridors.")] = None,
     unsafe: Annotated[bool, typer.Option("--unsafe", help="Turn the safety layer off: the policy as written.")] = False,
     lifelong: Annotated[bool, typer.Option("--lifelong", help="A robot that reaches its goal gets a new one (seeded); report throughput.")] = False,
     max_ticks: Annotated[Optional[int], typer.Option(help="Stop after this many ticks.")] = None,
@@ -273,6 +277,8 @@ def run(
             name=policy,
             resolve=resolve,
             heading_aware=heading_aware,
+            radius=radius,
+            swap=swap,
             loss=loss,
             delay=delay,
             duplicate=duplicate,
@@ -284,6 +290,10 @@ def run(
         )
         if scenario.lifelong and (live or planner is not None):
             raise InputError(Problem("--lifelong", "lifelong runs are simulated with a decentralized policy (not --live, not --planner)"))
+        if live and scenario.policy.name in ROUND_POLICIES:
+            raise InputError(
+                Problem("--policy", f"{scenario.policy.name} runs in the simulator's synchronous rounds only, not --live yet")
+            )
         if animate is not None and animate.suffix.lower() not in (".gif", ".svg"):
             raise InputError(Problem("--animate", f"unsupported suffix {animate.suffix!r}; use .gif or .svg"))
         plan = None

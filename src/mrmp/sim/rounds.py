@@ -152,9 +152,14 @@ class RoundsSimulator:
         self._settled: set[int] = set()
 
     def _default_max_ticks(self) -> int:
+        """Room for PIBT's steps (as :func:`~mrmp.sim.metrics.default_max_ticks`); over a slow or lossy
+        network, times the ticks a round trip can take with its retries, times the robots (the roots of
+        a group decide one after the other, each waiting for its rounds)."""
         ticks = default_max_ticks(self.scenario.with_changes(safety=False), self.lengths)
-        if not self.scenario.worst_faults().is_perfect:
-            ticks = int(ticks * network_slowdown(self.scenario.with_changes(safety=True)))
+        worst = self.scenario.worst_faults()
+        if worst.delay_max or worst.loss:
+            slowdown = network_slowdown(self.scenario.with_changes(safety=True))
+            ticks = int(ticks * slowdown * max(1, len(self.robots))) if worst.delay_max else int(ticks * slowdown)
         return ticks
 
     # -- the run ---------------------------------------------------------------------
