@@ -141,9 +141,11 @@ class PibtRobot:
     heading_aware:
         Among equally near candidate cells, prefer fewer right turns.
     rng:
-        Breaks the remaining ties between equally near cells at random (as
-        pypibt does; without it PIBT often cycles forever in crowds); None
-        keeps the neighbour order, which makes decisions reproducible by hand.
+        Turns on tie-breaking between equally near cells: dead ends and
+        occupied cells last (:func:`~mrmp.policies.pibt_rules.tie_penalty`),
+        then at random, as pypibt does (without it PIBT often cycles forever in
+        crowds). None keeps the plain neighbour order of the central generator,
+        which makes decisions reproducible by hand.
     """
 
     def __init__(
@@ -321,7 +323,8 @@ class PibtRobot:
                 flat.neighbours, self.present, distances, self.heading, flat.y_size, self._noise
             )
         else:
-            candidates = sorted_candidates(flat.neighbours, self.present, distances, self._noise)
+            occupied = self._occupants if self._noise is not None else None
+            candidates = sorted_candidates(flat.neighbours, self.present, distances, self._noise, occupied)
         self._pulled = None
         if self.swap:
             self._pulled = self._swap_partner(candidates, distances)

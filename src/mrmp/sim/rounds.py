@@ -37,7 +37,7 @@ Examples
 ...                 policy=PolicyOptions(name="pibt"))
 >>> result = RoundsSimulator(swap).run()
 >>> result.success, result.makespan, result.sum_of_costs, result.lower_bound
-(True, 5, 10, 8)
+(True, 9, 13, 8)
 """
 
 from __future__ import annotations
@@ -99,8 +99,9 @@ class RoundsSimulator:
         the swap technique (``swap``) and turn-aware ordering (``heading_aware``).
     random_ties:
         Give each robot a random generator (seeded with the scenario's seed and
-        its index) to break ties between equally near cells; ``False`` keeps
-        the neighbour order, as :class:`mrmp.centralized.pibt_step.PIBT`
+        its index) and tie penalties to order equally near cells
+        (:class:`~mrmp.robot.pibt_robot.PibtRobot`'s ``rng``); ``False`` keeps
+        the plain neighbour order, as :class:`mrmp.centralized.pibt_step.PIBT`
         without ``rng`` does.
     """
 

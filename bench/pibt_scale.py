@@ -1,0 +1,151 @@
+"""Decentralized PIBT at scale: success, quality, speed and messages, per map and number of robots.
+
+For each map and N, the first N agents of each of the map's ``.scen`` files
+(``-random-*.scen`` next to the map; maps without one get seeded random
+instances) run with policy ``pibt`` in the synchronous-round simulator, and
+the thesis scenarios run too. One line per (map, N), printed as soon as it is
+measured:
+
+* success: share of instances where every robot stood on its goal together;
+* SoC/LB: sum of costs over the sum of shortest path lengths (mean over the
+  solved instances); makespan (mean);
+* ms/step: wall time per simulated step, messages included;
+* table ms: distance-table time per robot;
+* msg/robot/step: messages (one per recipient) per robot per step;
+* LaCAM C++: the first-solution SoC/LB of the C++ LaCAM reference on
+  ``-random-1`` where the issue quotes it (for comparison; not measured here).
+
+Every line is also appended to ``--out`` (JSON lines) as it is measured.
+
+Usage: python bench/pibt_scale.py [--maps DIR] [--only random-32-32-20,empty-32-32] [--out FILE]
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import random
+import sys
+from pathlib import Path
+from statistics import mean
+
+from mrmp.core import PolicyOptions, RobotSpec, Scenario
+from mrmp.core.grid import connected_regions
+from mrmp.io import load_movingai_scenario, load_scenario
+from mrmp.io.movingai import read_map
+from mrmp.sim.rounds import RoundsSimulator
+
+ROOT = Path(__file__).resolve().parents[1]
+AGENTS = {
+    "random-32-32-20": [50, 100, 200],
+    "empty-32-32": [50, 100, 200, 400],
+    "random-32-32-10": [50, 100, 200],
+    "maze-32-32-2": [25, 50, 100],
+    "room-32-32-4": [25, 50, 100],
+    "warehouse-10-20-10-2-1": [100, 200, 400],
+    "random-64-64-10": [200, 500, 1000],
+    "random-64-64-20": [200, 500],
+    "empty-48-48": [200, 500],
+    "warehouse-20-40-10-2-1": [200, 500],
+    "den520d": [100, 500],
+    "Berlin_1_256": [100, 500],
+}
+LACAM_CPP = {
+    ("random-32-32-20", 50): 1.41,
+    ("random-32-32-20", 100): 1.44,
+    ("random-32-32-20", 200): 2.01,
+    ("empty-32-32", 50): 1.22,
+    ("empty-32-32", 100): 1.29,
+    ("empty-32-32", 200): 1.52,
+    ("empty-32-32", 400): 1.94,
+}
+RANDOM_INSTANCES = 2
+
+
+def random_instance(map_path: Path, agents: int, seed: int) -> Scenario:
+    """``agents`` seeded random starts and goals in the map's largest connected region."""
+    grid = read_map(map_path)
+    _, regions = connected_regions(grid, grid.free_cells())
+    region = max(regions, key=len)
+    rng = random.Random(seed)
+    starts, goals = rng.sample(region, agents), rng.sample(region, agents)
+    robots = tuple(RobotSpec(str(i), start, goal) for i, (start, goal) in enumerate(zip(starts, goals)))
+    return Scenario(grid, robots, name=f"{map_path.stem}-seed-{seed}", seed=seed)
+
+
+def instances(maps: Path, name: str, agents: int) -> list[Scenario]:
+    map_path = maps / f"{name}.map"
+    scens = sorted(maps.glob(f"{name}-random-*.scen"))
+    if scens:
+        return [load_movingai_scenario(map_path, scen, agents) for scen in scens]
+    return [random_instance(map_path, agents, seed) for seed in range(RANDOM_INSTANCES)]
+
+
+def measure(label: str, agents: int, scenarios: list[Scenario], out: Path | None) -> None:
+    runs = []
+    for scenario in scenarios:
+        result = RoundsSimulator(scenario.with_changes(policy=PolicyOptions(name="pibt"))).run()
+        if result.collisions:
+            raise SystemExit(f"{label} N={agents}: the referee found collisions: {result.collisions[:3]}")
+        steps = max(1, result.network["steps"])
+        runs.append(
+            {
+                "success": result.success,
+                "soc_lb": result.sum_of_costs / result.lower_bound if result.success and result.lower_bound else None,
+                "makespan": result.makespan if result.success else None,
+                "ms_per_step": 1000 * result.wall_time_s / steps,
+                "table_ms": 1000 * (result.planning_time_s or 0.0) / max(1, result.network["distance_tables"]),
+                "messages_per_robot_step": result.network["messages"] / (agents * steps),
+            }
+        )
+    solved = [run for run in runs if run["success"]]
+    row = {
+        "map": label,
+        "agents": agents,
+        "instances": len(runs),
+        "success": len(solved) / len(runs),
+        "soc_lb": mean(run["soc_lb"] for run in solved) if solved else None,
+        "makespan": mean(run["makespan"] for run in solved) if solved else None,
+        "ms_per_step": mean(run["ms_per_step"] for run in runs),
+        "table_ms": mean(run["table_ms"] for run in runs),
+        "messages_per_robot_step": mean(run["messages_per_robot_step"] for run in runs),
+        "lacam_cpp_soc_lb": LACAM_CPP.get((label, agents)),
+    }
+    quality = f"{row['soc_lb']:.3f}" if row["soc_lb"] is not None else "-"
+    makespan = f"{row['makespan']:.0f}" if row["makespan"] is not None else "-"
+    reference = f"{row['lacam_cpp_soc_lb']:.2f}" if row["lacam_cpp_soc_lb"] is not None else ""
+    print(
+        f"{label:<24} {agents:>5} {row['instances']:>4} {100 * row['success']:>7.0f}% {quality:>7} {makespan:>8}"
+        f" {row['ms_per_step']:>8.2f} {row['table_ms']:>8.3f} {row['messages_per_robot_step']:>8.2f} {reference:>9}",
+        flush=True,
+    )
+    if out is not None:
+        with out.open("a") as stream:
+            stream.write(json.dumps(row) + "\n")
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--maps", type=Path, default=ROOT / "maps", help="folder of .map and .scen files")
+    parser.add_argument("--only", default="", help="comma-separated map names (default: all)")
+    parser.add_argument("--out", type=Path, default=None, help="append one JSON line per row to this file")
+    arguments = parser.parse_args()
+    only = {name for name in arguments.only.split(",") if name}
+    print(
+        f"{'map':<24} {'N':>5} {'inst':>4} {'success':>8} {'SoC/LB':>7} {'makespan':>8}"
+        f" {'ms/step':>8} {'table ms':>8} {'msg/r/s':>8} {'LaCAM C++':>9}"
+    )
+    if not only:
+        for path in sorted((ROOT / "examples").glob("thesis-*.yaml")):
+            scenario = load_scenario(path)
+            measure(path.stem, len(scenario.robots), [scenario], arguments.out)
+    for name, counts in AGENTS.items():
+        if (only and name not in only) or not (arguments.maps / f"{name}.map").exists():
+            continue
+        for agents in counts:
+            measure(name, agents, instances(arguments.maps, name, agents), arguments.out)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
