@@ -14,13 +14,14 @@ process shares one :class:`FlatMap`; in live mode each robot has its own.
 Examples
 --------
 >>> from mrmp.core.grid import Grid
->>> flat = FlatMap(Grid.from_rows(["...", ".#."]))
+>>> flat = FlatMap(Grid.from_rows(["...", ".#."]))   # (0, 1) is blocked
 >>> flat.index((1, 2)), flat.cell(5)
 (5, (1, 2))
 >>> flat.neighbours[flat.index((0, 0))]
-(3, 1)
->>> flat.distances(flat.index((1, 2)))[flat.index((1, 0))]
-4.0
+(3,)
+>>> to_corner = flat.distances(flat.index((1, 2)))
+>>> to_corner[flat.index((0, 0))], to_corner[flat.index((0, 1))]
+(3.0, inf)
 >>> flat.tables_computed
 1
 """

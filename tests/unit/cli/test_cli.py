@@ -159,7 +159,7 @@ def test_compare_prints_every_method(tmp_path):
     result = invoke("compare", EXAMPLES / "thesis-cross.yaml", "--json", out)
     assert result.exit_code == 0, result.output
     rows = json.loads(out.read_text())
-    assert [row["method"] for row in rows] == ["thesis", "astar", "cbs", "pp", "lacam"]
+    assert [row["method"] for row in rows] == ["thesis", "astar", "pibt", "cbs", "pp", "lacam"]
     assert all(row["success"] for row in rows)
     cbs = next(row for row in rows if row["method"] == "cbs")
     assert cbs["sum_of_costs"] == 16 == cbs["lower_bound"]  # optimal: the lower bound is reached

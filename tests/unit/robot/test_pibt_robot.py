@@ -107,3 +107,26 @@ def test_duplicates_and_stale_messages_are_dropped():
 def test_radius_below_two_is_refused():
     with pytest.raises(ValueError, match="radius 1"):
         PibtRobot(0, 0, 1, FlatMap(Grid(1, 2)), radius=1)
+
+
+def test_heading_aware_robot_goes_straight_among_equal_cells():
+    from mrmp.core.heading import Heading
+
+    scenario = Scenario(
+        Grid(4, 4),
+        (RobotSpec("A", (0, 0), (3, 3), heading=Heading.EAST),),
+        policy=PolicyOptions(name="pibt", heading_aware=True),
+    )
+    result = RoundsSimulator(scenario).run()
+    assert result.success and result.robots[0].path[1] == (0, 1)  # EAST first: no turn
+    plain = RoundsSimulator(scenario.with_changes(policy=PolicyOptions(name="pibt")), random_ties=False).run()
+    assert plain.robots[0].path[1] == (1, 0)  # NORTH first in the plain order: a turn
+    assert result.robots[0].turns < plain.robots[0].turns
+
+
+def test_lifelong_pibt_keeps_reaching_new_goals():
+    scenario = random_scenario(11, swap=True).with_changes(lifelong=True, max_ticks=120)
+    result = RoundsSimulator(scenario).run()
+    assert result.stop_reason == "time up" and result.collisions == []
+    assert sum(robot.goals_reached for robot in result.robots) > 2 * len(result.robots)
+    assert result.throughput > 0
