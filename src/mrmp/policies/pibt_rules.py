@@ -41,8 +41,9 @@ def tie_penalty(neighbours: Sequence[tuple[int, ...]], cell: int, here: int, occ
     """What, among equally near cells, makes ``cell`` a worse choice: less than one move in all.
 
     A dead end (a cell with one neighbour) costs 0.5: a robot pushed into one
-    blocks it for whoever needs it, and must come out the same way. A cell
-    another robot stands on costs 0.25: taking it pushes that robot.
+    blocks it for whoever needs it, and must come out the same way. A cell in
+    ``occupied`` costs 0.25 (the PIBT robot passes the cells where a robot
+    stands on its own goal: taking one pushes a robot that has arrived).
 
     >>> tie_penalty([(1,), (0, 2), (1,)], 0, 1, occupied={0})
     0.75
@@ -66,8 +67,8 @@ def sorted_candidates(
     With ``occupied`` None and no ``noise`` the sort is stable, so equally near
     cells keep the order NORTH, EAST, SOUTH, WEST, then staying (as in the
     reference implementations, and in :class:`mrmp.centralized.pibt_step.PIBT`).
-    Given ``occupied`` (cells other robots stand on), equally near cells are
-    ranked by :func:`tie_penalty`; ``noise`` (a random number in [0, 1) per
+    Given ``occupied`` (cells to avoid, see :func:`tie_penalty`), equally near
+    cells are ranked by :func:`tie_penalty`; ``noise`` (a random number in [0, 1) per
     call) breaks the remaining ties at random, as pypibt does by shuffling.
     Penalty and noise add less than one to a distance counted in whole moves,
     so a nearer cell always comes first and PIBT's progress argument holds.
