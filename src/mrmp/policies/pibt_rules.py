@@ -37,56 +37,33 @@ NO_CELL = -1
 """No cell (a walk that found no way on)."""
 
 
-def tie_penalty(neighbours: Sequence[tuple[int, ...]], cell: int, here: int, occupied: Container[int]) -> float:
-    """What, among equally near cells, makes ``cell`` a worse choice: less than one move in all.
-
-    A dead end (a cell with one neighbour) costs 0.5: a robot pushed into one
-    blocks it for whoever needs it, and must come out the same way. A cell in
-    ``occupied`` costs 0.25 (the PIBT robot passes the cells where a robot
-    stands on its own goal: taking one pushes a robot that has arrived).
-
-    >>> tie_penalty([(1,), (0, 2), (1,)], 0, 1, occupied={0})
-    0.75
-    >>> tie_penalty([(1,), (0, 2), (1,)], 1, 1, occupied={1})
-    0.0
-    """
-    if cell == here:
-        return 0.0
-    return (0.5 if len(neighbours[cell]) == 1 else 0.0) + (0.25 if cell in occupied else 0.0)
-
-
 def sorted_candidates(
     neighbours: Sequence[tuple[int, ...]],
     here: int,
     distances: Sequence[float],
     noise: Callable[[], float] | None = None,
-    occupied: Container[int] | None = None,
 ) -> list[int]:
     """A robot's candidate cells at ``here``: its free neighbours, then ``here``, nearest to its goal first.
 
-    With ``occupied`` None and no ``noise`` the sort is stable, so equally near
-    cells keep the order NORTH, EAST, SOUTH, WEST, then staying (as in the
-    reference implementations, and in :class:`mrmp.centralized.pibt_step.PIBT`).
-    Given ``occupied`` (cells to avoid, see :func:`tie_penalty`), equally near
-    cells are ranked by :func:`tie_penalty`; ``noise`` (a random number in [0, 1) per
-    call) breaks the remaining ties at random, as pypibt does by shuffling.
-    Penalty and noise add less than one to a distance counted in whole moves,
-    so a nearer cell always comes first and PIBT's progress argument holds.
+    Without ``noise`` the sort is stable, so equally near cells keep the order
+    NORTH, EAST, SOUTH, WEST, then staying (as in the reference
+    implementations, and in :class:`mrmp.centralized.pibt_step.PIBT`). With
+    ``noise`` (a random number in [0, 1) per call, as pypibt shuffles
+    candidates before sorting) equally near cells come in random order; the
+    noise adds less than one to a distance counted in whole moves, so a nearer
+    cell always comes first and PIBT's progress argument holds.
 
     >>> sorted_candidates([(1,), (0, 2), (1,)], 1, [2, 1, 0])
     [2, 1, 0]
-    >>> sorted_candidates([(1, 2, 3), (0,), (0, 3), (0, 2)], 0, [1, 0, 0, 0], occupied={2})
-    [3, 2, 1, 0]
+    >>> import random
+    >>> sorted(sorted_candidates([(1, 2), (0,), (0,)], 0, [1, 0, 0], random.Random(3).random)[:2])
+    [1, 2]
     """
     candidates = [*neighbours[here], here]
-    if noise is None and occupied is None:
+    if noise is None:
         candidates.sort(key=distances.__getitem__)
-    elif noise is None:
-        candidates.sort(key=lambda cell: distances[cell] + tie_penalty(neighbours, cell, here, occupied or ()))
     else:
-        candidates.sort(
-            key=lambda cell: distances[cell] + tie_penalty(neighbours, cell, here, occupied or ()) + 0.2 * noise()
-        )
+        candidates.sort(key=lambda cell: distances[cell] + noise())
     return candidates
 
 

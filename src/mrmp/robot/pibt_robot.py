@@ -141,12 +141,10 @@ class PibtRobot:
     heading_aware:
         Among equally near candidate cells, prefer fewer right turns.
     rng:
-        Turns on tie-breaking between equally near cells: dead ends, then cells
-        where a robot stands on its own goal, last
-        (:func:`~mrmp.policies.pibt_rules.tie_penalty`),
-        then at random, as pypibt does (without it PIBT often cycles forever in
-        crowds). None keeps the plain neighbour order of the central generator,
-        which makes decisions reproducible by hand.
+        Breaks ties between equally near cells at random, as pypibt does
+        (without it PIBT often cycles forever in crowds). None keeps the plain
+        neighbour order of the central generator, which makes decisions
+        reproducible by hand.
     """
 
     def __init__(
@@ -324,8 +322,7 @@ class PibtRobot:
                 flat.neighbours, self.present, distances, self.heading, flat.y_size, self._noise
             )
         else:
-            occupied = _Settled(self._occupants, self._goals) if self._noise is not None else None
-            candidates = sorted_candidates(flat.neighbours, self.present, distances, self._noise, occupied)
+            candidates = sorted_candidates(flat.neighbours, self.present, distances, self._noise)
         self._pulled = None
         if self.swap:
             self._pulled = self._swap_partner(candidates, distances)

@@ -99,7 +99,7 @@ class RoundsSimulator:
         the swap technique (``swap``) and turn-aware ordering (``heading_aware``).
     random_ties:
         Give each robot a random generator (seeded with the scenario's seed and
-        its index) and tie penalties to order equally near cells
+        its index) to break ties between equally near cells
         (:class:`~mrmp.robot.pibt_robot.PibtRobot`'s ``rng``); ``False`` keeps
         the plain neighbour order, as :class:`mrmp.centralized.pibt_step.PIBT`
         without ``rng`` does.
