@@ -66,7 +66,7 @@ import numpy as np
 
 from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
-from mrmp.policies.pibt_rules import swap_possible, swap_required
+from mrmp.policies.pibt_rules import sorted_candidates, swap_possible, swap_required
 from mrmp.search.distance import DistanceTable, distance_table
 
 __all__ = [
@@ -200,7 +200,7 @@ class PIBT:
     [0, 1]
     """
 
-    __slots__ = ("_candidates", "_distances", "_goals", "_neighbours", "_occ_next", "_occ_now", "_random", "swap")
+    __slots__ = ("_distances", "_goals", "_neighbours", "_occ_next", "_occ_now", "_random", "swap")
 
     def __init__(
         self,
@@ -214,7 +214,6 @@ class PIBT:
         if len(distances) != len(goals):
             raise ValueError(f"{len(distances)} distance lists for {len(goals)} goals")
         self._neighbours = list(neighbours)
-        self._candidates = [(*row, index) for index, row in enumerate(self._neighbours)]
         self._distances = list(distances)
         self._goals = list(goals)
         self._occ_now = [NO_AGENT] * len(self._neighbours)
@@ -330,13 +329,7 @@ class PIBT:
 
     def _sorted_candidates(self, robot: int, current: Sequence[int], target: list[int]) -> tuple[list[int], int]:
         """Robot's candidate cells, best first, and the robot to pull (or ``NO_AGENT``)."""
-        candidates = list(self._candidates[current[robot]])
-        dist = self._distances[robot]
-        noise = self._random
-        if noise is None:
-            candidates.sort(key=dist.__getitem__)
-        else:
-            candidates.sort(key=lambda cell: dist[cell] + noise())
+        candidates = sorted_candidates(self._neighbours, current[robot], self._distances[robot], self._random)
         pulled = NO_AGENT
         if self.swap:
             pulled = self._swap_agent(robot, candidates, current, target)
