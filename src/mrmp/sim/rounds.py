@@ -55,7 +55,7 @@ from mrmp.protocol.codec import encode
 from mrmp.protocol.messages import AnswerMessage, BeaconMessage, InheritMessage, PullMessage, ReserveMessage
 from mrmp.robot.pibt_robot import RESERVE_RADIUS, PibtRobot, Transmission
 from mrmp.search.flat_map import FlatMap
-from mrmp.sim.goals import goal_random, new_goal
+from mrmp.sim.goals import GoalBook
 from mrmp.sim.metrics import default_max_ticks, network_slowdown, shortest_steps
 from mrmp.sim.referee import Referee
 
@@ -148,9 +148,7 @@ class RoundsSimulator:
         self._occupant: dict[int, int] = {}
         self._group_of: list[int] = []
         self.stats: Counter[str] = Counter()
-        self._goal_random = goal_random(scenario.seed)
-        self._free_cells = grid.free_cells() if scenario.lifelong else []
-        self._settled: set[int] = set()
+        self._goals = GoalBook(scenario.seed, grid.free_cells() if scenario.lifelong else [])
 
     def _default_max_ticks(self) -> int:
         """Room for PIBT's steps (as :func:`~mrmp.sim.metrics.default_max_ticks`); over a slow or lossy
@@ -242,21 +240,16 @@ class RoundsSimulator:
     def _count_goals(self) -> None:
         """Count goals reached; in a lifelong run, hand each such robot a new goal (drawn with the seed)."""
         flat = self.flat
-        for robot in self.robots:
-            if not robot.at_goal:
-                self._settled.discard(robot.index)
-                continue
-            if robot.index in self._settled:
-                continue
-            self._results[robot.index].goals_reached += 1
-            self._settled.add(robot.index)
+        robots = self.robots
+        for index in self._goals.arrivals(robot.at_goal for robot in robots):
+            self._results[index].goals_reached += 1
             if self.scenario.lifelong:
-                taken = {flat.cell(other.goal) for other in self.robots}
-                goal = new_goal(self._goal_random, self._free_cells, taken, flat.cell(robot.present))
+                robot = robots[index]
+                taken = {flat.cell(other.goal) for other in robots}
+                goal = self._goals.next_goal(index, taken, flat.cell(robot.present))
                 if goal is not None:
                     robot.goal = flat.index(goal)
                     robot.elapsed = 0
-                    self._settled.discard(robot.index)
 
     # -- rounds ------------------------------------------------------------------------
 

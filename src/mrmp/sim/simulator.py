@@ -45,7 +45,7 @@ from mrmp.policies.registry import ROUND_POLICIES, make_policy
 from mrmp.protocol.codec import DecodeError, decode, encode
 from mrmp.protocol.messages import Message
 from mrmp.robot.robot import Outgoing, Robot
-from mrmp.sim.goals import goal_random, new_goal
+from mrmp.sim.goals import GoalBook
 from mrmp.sim.metrics import default_max_ticks, network_slowdown, shortest_steps
 from mrmp.sim.network import SimulatedNetwork
 from mrmp.sim.referee import Referee
@@ -124,9 +124,7 @@ class LockstepSimulator:
         self._recurrences: Counter[tuple[tuple[Cell, ...], tuple[Heading, ...]]] = Counter()
         self._still_since = 0
         self._everyone = range(len(self.robots))
-        self._settled: set[int] = set()
-        self._goal_random = goal_random(scenario.seed)
-        self._free_cells = grid.free_cells() if scenario.lifelong else []
+        self._goals = GoalBook(scenario.seed, grid.free_cells() if scenario.lifelong else [])
 
     def run(self) -> RunResult:
         """Run to the end and return the result (partial on Ctrl-C)."""
@@ -233,19 +231,14 @@ class LockstepSimulator:
         New goals are drawn, with the run's seed, among free cells that are
         nobody's goal and not the robot's own cell, robots taken in index order.
         """
-        for robot in self.robots:
-            if not robot.arrived:
-                self._settled.discard(robot.index)
-                continue
-            if robot.index in self._settled:
-                continue  # still on the goal it was already counted for
-            self._results[robot.index].goals_reached += 1
-            self._settled.add(robot.index)
+        robots = self.robots
+        for index in self._goals.arrivals(robot.arrived for robot in robots):
+            self._results[index].goals_reached += 1
             if self.scenario.lifelong:
-                goal = new_goal(self._goal_random, self._free_cells, {other.goal for other in self.robots}, robot.present)
+                robot = robots[index]
+                goal = self._goals.next_goal(index, {other.goal for other in robots}, robot.present)
                 if goal is not None:
                     robot.goal = goal
-                    self._settled.discard(robot.index)
 
     def _stuck(self) -> str | None:
         configuration = (tuple(robot.present for robot in self.robots), tuple(robot.heading for robot in self.robots))
