@@ -11,12 +11,25 @@ on it, with the improvements below):
 1. take the node of least ``f`` (ties: fewer conflicts, then the older node,
    so the search is deterministic);
 2. pick a conflict (the first in time, or see the improvements): a *vertex* conflict (two robots in one cell
-   at tick ``t``) or an *edge* conflict (two robots swapping cells at tick
-   ``t``); robots that have arrived stay on their goals, so a robot crossing a
+   at tick ``t``), an *edge* conflict (two robots swapping cells at tick
+   ``t``) or a *rotation* conflict (three or more robots on a cycle of cells,
+   each entering at tick ``t`` the cell the next one leaves); robots that have
+   arrived stay on their goals, so a robot crossing a
    parked one is a vertex conflict at a tick after the parked robot's arrival;
 3. no conflict: the node's paths are an optimal plan; otherwise split the node
-   into two children, each forbidding the conflict to one of the two robots
-   (vertex ``(cell, t)`` or edge ``(u, v, t)``), and replan that robot.
+   into children, each forbidding the conflict to one of its robots (vertex
+   ``(cell, t)`` or edge ``(u, v, t)``; for a rotation, one child per robot
+   on the cycle, forbidding it its move ``u -> v`` at ``t``), and replan that
+   robot.
+
+**Rotations** are conflicts because the plans are executed by robots that
+move one at a time, each entering a cell only once its occupant has left
+(:mod:`mrmp.centralized.dependencies`): on a cycle nobody can start. The split
+is sound and complete in the usual sense: a plan without that rotation omits
+the move of at least one of its robots at ``t``, so it satisfies one of the
+children's constraints. CBS therefore returns a plan of least sum of costs
+*among rotation-free plans* (which may cost more than the classic optimum,
+where rotations are free).
 
 The low level breaks ties between paths of equal length by the fewest
 conflicts with the other robots' current paths (the conflict-avoidance table
@@ -28,7 +41,8 @@ of Standley 2010).
   Betzalel & Shimony, "ICBS: Improved Conflict-Based Search Algorithm for
   Multi-Agent Pathfinding", IJCAI 2015): split a *cardinal* conflict (every
   cheapest path of both robots has it, read off their multi-valued decision
-  diagrams, :func:`mdd_layers`) before a semi-cardinal one, before the rest;
+  diagrams, :func:`mdd_layers`) before a semi-cardinal one, before the rest
+  (rotation conflicts are counted with the rest);
 * the *conflict-graph heuristic* (Felner, Li, Boyarski, Ma, Cohen, Kumar &
   Koenig, "Adding Heuristics to Conflict-Based Search for Multi-Agent Path
   Finding", ICAPS 2018): robots joined by a cardinal conflict form a graph, and
@@ -57,10 +71,11 @@ with status ``"limit"`` and a message naming the limit. CBS cannot in general
 prove that an instance has no solution before its limits: an unsolvable
 instance normally ends with ``"limit"``. It reports ``"infeasible"`` only when
 it has a proof: a robot's goal is not connected to its start; a connected
-region without cycles is filled with robots of which one is not on its goal
-(no robot there can ever move, for example two robots swapping in a 1x2
-corridor); or the whole constraint tree was exhausted (every low-level search
-is exhaustive, so this proves no plan exists).
+region is filled with robots of which one is not on its goal (no robot there
+can ever move without a rotation, for example two robots swapping in a 1x2
+corridor, or four robots on a 2x2 block); or the whole constraint tree was
+exhausted (every low-level search is exhaustive, so this proves no
+rotation-free plan exists).
 
 ``nodes`` in the result counts the constraint-tree nodes generated (the root
 included).
@@ -88,6 +103,7 @@ import time
 from collections.abc import Sequence
 from dataclasses import dataclass
 
+from mrmp.centralized.dependencies import rotations_at
 from mrmp.centralized.plan import (
     MapfProblem,
     PlanningResult,
@@ -131,8 +147,12 @@ forbids moving ``u -> v`` arriving at tick ``t``."""
 class Conflict:
     """A collision between robots ``first`` and ``second`` (indices) at tick ``tick``.
 
-    ``kind`` is ``"vertex"`` (both on ``cells[0]``) or ``"edge"`` (``first``
-    moves ``cells[0] -> cells[1]`` while ``second`` moves back).
+    ``kind`` is ``"vertex"`` (both on ``cells[0]``), ``"edge"`` (``first``
+    moves ``cells[0] -> cells[1]`` while ``second`` moves back) or
+    ``"rotation"``: the robots of ``robots`` (``first`` and ``second`` are the
+    first two) each move at ``tick`` from their cell in ``cells`` to the next
+    one (the last into ``cells[0]``); see
+    :func:`mrmp.centralized.dependencies.find_rotations`.
     """
 
     kind: str
@@ -140,19 +160,24 @@ class Conflict:
     second: int
     cells: tuple[Cell, ...]
     tick: int
+    robots: tuple[int, ...] = ()
 
 
-def all_conflicts(paths: Sequence[Sequence[Cell]]) -> list[Conflict]:
+def all_conflicts(paths: Sequence[Sequence[Cell]], *, rotations: bool = False) -> list[Conflict]:
     """Every conflict among ``paths``, in tick order.
 
     Robots stay on their last cell after their path ends. At one tick, vertex
-    conflicts come before edge conflicts, and pairs go in robot order. Three
-    robots in one cell give two vertex conflicts, each with the first of them.
+    conflicts come before edge conflicts, then rotations, and pairs go in
+    robot order. Three robots in one cell give two vertex conflicts, each with
+    the first of them.
 
     Parameters
     ----------
     paths:
         One path per robot, one cell per tick.
+    rotations:
+        Also report rotations of three or more robots (kind ``"rotation"``),
+        which the classic MAPF model allows.
 
     Returns
     -------
@@ -165,6 +190,10 @@ def all_conflicts(paths: Sequence[Sequence[Cell]]) -> list[Conflict]:
     [('edge', 0, 1, 1)]
     >>> all_conflicts([[(0, 0), (0, 1), (0, 2)], [(0, 2)]])[0].kind
     'vertex'
+    >>> block = [(0, 0), (0, 1), (1, 1), (1, 0)]
+    >>> turning = [[block[i], block[(i + 1) % 4]] for i in range(4)]
+    >>> all_conflicts(turning), [(c.kind, c.robots, c.tick) for c in all_conflicts(turning, rotations=True)]
+    ([], [('rotation', (0, 1, 2, 3), 1)])
     """
     length = max((len(path) for path in paths), default=0)
     found: list[Conflict] = []
@@ -187,6 +216,10 @@ def all_conflicts(paths: Sequence[Sequence[Cell]]) -> list[Conflict]:
                 other = moves.get((target, source))
                 if other is not None and other > index:
                     found.append(Conflict("edge", index, other, (source, target), tick))
+            if rotations:
+                for cycle in rotations_at(tick, previous, current, min_robots=3):
+                    robots = cycle.robots
+                    found.append(Conflict("rotation", robots[0], robots[1], cycle.cells, tick, robots))
         previous = current
     return found
 
@@ -210,12 +243,15 @@ def infeasibility_proof(problem: MapfProblem) -> str | None:
     """A reason the instance has no solution, when a cheap proof exists; else ``None``.
 
     Two proofs are tried: a robot whose goal is in another connected region
-    than its start; and a connected region without cycles (a tree of cells)
-    whose every cell holds a robot, one of them not on its goal: no robot
-    there can ever move (4-connected cycles are needed for robots to rotate).
+    than its start; and a connected region whose every cell holds a robot,
+    one of them not on its goal: no robot there can ever move, since a move
+    needs a free cell at the head of its chain of followers, and with none the
+    only moves left are rotations (which robots moving one at a time cannot
+    execute, :mod:`mrmp.centralized.dependencies`) or, on a region without
+    cycles, nothing at all.
 
     >>> infeasibility_proof(as_problem(Grid(1, 2), [(0, 0), (0, 1)], [(0, 1), (0, 0)]))
-    'robots fill the cycle-free region of 2 cells around (0, 0) and cannot move'
+    'robots fill the region of 2 cells around (0, 0) and cannot move (only a rotation would move them)'
     >>> infeasibility_proof(as_problem(Grid(2, 2), [(0, 0), (0, 1)], [(0, 1), (0, 0)])) is None
     True
     """
@@ -231,9 +267,11 @@ def infeasibility_proof(problem: MapfProblem) -> str | None:
         region = regions[label]
         if len(members) != len(region):
             continue
-        edges = sum(len(grid.neighbours(cell)) for cell in region) // 2
-        if edges == len(region) - 1 and any(problem.starts[i] != problem.goals[i] for i in members):
-            return f"robots fill the cycle-free region of {len(region)} cells around {region[0]} and cannot move"
+        if any(problem.starts[i] != problem.goals[i] for i in members):
+            return (
+                f"robots fill the region of {len(region)} cells around {region[0]} and cannot move "
+                "(only a rotation would move them)"
+            )
     return None
 
 
@@ -410,7 +448,7 @@ def cbs(
     heading_aware: bool = False,
     improved: bool = True,
 ) -> PlanningResult:
-    """Plan every robot with Conflict-Based Search (Sharon et al. 2015): least sum of costs.
+    """Plan every robot with Conflict-Based Search (Sharon et al. 2015): least sum of costs without rotations.
 
     Parameters
     ----------
@@ -435,7 +473,8 @@ def cbs(
     Returns
     -------
     PlanningResult
-        ``"solved"`` with optimal paths; ``"limit"`` when a limit was reached
+        ``"solved"`` with paths of least sum of costs among rotation-free
+        plans (see the module docstring); ``"limit"`` when a limit was reached
         (the message names it); ``"infeasible"`` with a proof in the message
         (see the module docstring). ``nodes`` counts generated nodes.
 
@@ -526,7 +565,10 @@ def cbs(
             pair = (conflict.first, conflict.second)
             if pair in cardinal_pairs:
                 continue
-            kind = 2 - forced(node, conflict.first, conflict) - forced(node, conflict.second, conflict)
+            if conflict.kind == "rotation":
+                kind = 2  # not a pair: never cardinal, never in the conflict graph
+            else:
+                kind = 2 - forced(node, conflict.first, conflict) - forced(node, conflict.second, conflict)
             if kind == 0:
                 cardinal_pairs.add(pair)
             if best is None or kind < best[0]:
@@ -548,7 +590,8 @@ def cbs(
         root_headings[index] = found.headings
     paths = tuple(path for path in root_paths if path is not None)
     cost = sum(len(path) - 1 for path in paths)
-    root = _Node(cost, cost, all_conflicts(paths), 0, (empty,) * count, paths, tuple(root_headings), [None] * count)
+    root_conflicts = all_conflicts(paths, rotations=True)
+    root = _Node(cost, cost, root_conflicts, 0, (empty,) * count, paths, tuple(root_headings), [None] * count)
     nodes = 1
     open_list: list[tuple[tuple[int, int, int], _Node]] = [(root.key(), root)]
 
@@ -570,6 +613,12 @@ def cbs(
         if conflict.kind == "vertex":
             cell = conflict.cells[0]
             splits = ((conflict.first, ("v", cell, conflict.tick)), (conflict.second, ("v", cell, conflict.tick)))
+        elif conflict.kind == "rotation":
+            cycle = conflict.cells
+            splits = tuple(
+                (robot, ("e", cycle[k], cycle[(k + 1) % len(cycle)], conflict.tick))
+                for k, robot in enumerate(conflict.robots)
+            )
         else:
             source, target = conflict.cells
             splits = (
@@ -590,7 +639,7 @@ def cbs(
                 continue
             child_paths = node.paths[:robot] + (found.path,) + node.paths[robot + 1 :]
             child_headings = node.headings[:robot] + (found.headings,) + node.headings[robot + 1 :]
-            child_conflicts = all_conflicts(child_paths)
+            child_conflicts = all_conflicts(child_paths, rotations=True)
             cost = node.cost - (len(node.paths[robot]) - 1) + (len(found.path) - 1)
             if improved and cost == node.cost and len(child_conflicts) < len(node.conflicts):
                 # bypass (Boyarski et al. 2015): the new path is as cheap and also respects the

@@ -1,12 +1,27 @@
-"""The Action Dependency Graph of a plan (Hönig et al., RA-L 2019).
+"""The Action Dependency Graph of a plan (Hönig et al., RA-L 2019), and the rotations that break it.
 
 Each robot's path (one cell per tick) becomes its *moves*: the cells it enters,
 in order. Move ``k`` of robot ``i`` entering cell ``c`` at tick ``t`` depends on
 every other robot ``j`` that stood on ``c`` at some tick before ``t``: ``i`` may
 enter ``c`` only once ``j`` has completed the move by which it left ``c`` after
 its last visit before ``t`` (``j``'s progress, the count of its completed moves,
-is then larger than that move's index). In a collision-free plan every such
-move exists, and the graph is acyclic (edges point from earlier to later ticks).
+is then larger than that move's index).
+
+In a collision-free plan every such move exists and comes at tick ``t`` or
+before, so a dependency points to an earlier tick or, when ``i`` *follows*
+``j`` (``j`` leaves ``c`` at the very tick ``i`` enters it), to the same tick.
+The graph is therefore acyclic **unless the plan contains a rotation**: robots
+on a cycle of cells that each move, at one tick, into the cell the next one
+leaves (allowed by the classic MAPF model, which forbids only vertex and swap
+conflicts; Stern et al., SoCS 2019). Each of those moves waits for the next
+robot's move, around the cycle: robots that move one at a time, each body
+covering both cells while it moves, can never start. :func:`find_rotations`
+lists the rotations of a plan; :func:`action_dependencies` checks the whole
+graph by a dry run of the execution and raises :class:`PlanDeadlockError`,
+naming the robots, ticks and cells, instead of handing the robots a plan on
+which they would wait for ever. mrmp's central planners produce rotation-free
+plans (see :mod:`mrmp.centralized.cbs`, :mod:`mrmp.centralized.prioritized`,
+:mod:`mrmp.centralized.lacam`).
 
 Examples
 --------
@@ -17,13 +32,162 @@ Examples
 {0: [(1, 1)], 1: [(1, 2)]}
 >>> needs[1]
 {}
+
+Four robots turning round a 2x2 block in one tick cannot be executed:
+
+>>> block = [(0, 0), (0, 1), (1, 1), (1, 0)]
+>>> rotation = [[block[i], block[(i + 1) % 4]] for i in range(4)]
+>>> find_rotations(rotation)
+[Rotation(tick=1, robots=(0, 1, 2, 3), cells=((0, 0), (0, 1), (1, 1), (1, 0)))]
+>>> action_dependencies(rotation)
+Traceback (most recent call last):
+...
+mrmp.centralized.dependencies.PlanDeadlockError: the plan deadlocks when executed: robots 0, 1, 2, 3 wait for each other in a cycle at tick 1 (robot 0 enters (0, 1) after robot 1 leaves it, robot 1 enters (1, 1) after robot 2 leaves it, robot 2 enters (1, 0) after robot 3 leaves it, robot 3 enters (0, 0) after robot 0 leaves it): a rotation, which robots moving one at a time cannot execute
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
+from dataclasses import dataclass
 
 from mrmp.core.cell import Cell
+from mrmp.core.errors import MrmpError
+
+__all__ = [
+    "PlanDeadlockError",
+    "Rotation",
+    "action_dependencies",
+    "check_executable",
+    "find_rotations",
+    "plan_moves",
+    "rotations_at",
+]
+
+
+class PlanDeadlockError(MrmpError, ValueError):
+    """A plan whose Action Dependency Graph has a cycle: executing it, robots would wait for ever.
+
+    Attributes
+    ----------
+    robots:
+        The robots (indices in plan order) waiting for each other, in cycle
+        order: each waits for the next one, the last for the first.
+    cells:
+        The cell each of them is waiting to enter.
+    ticks:
+        The tick of the plan at which each of them enters it.
+    """
+
+    def __init__(self, robots: Sequence[int], cells: Sequence[Cell], ticks: Sequence[int]) -> None:
+        self.robots = tuple(robots)
+        self.cells = tuple(cells)
+        self.ticks = tuple(ticks)
+        count = len(self.robots)
+        steps = ", ".join(
+            f"robot {self.robots[k]} enters {self.cells[k]} after robot {self.robots[(k + 1) % count]} leaves it"
+            for k in range(count)
+        )
+        same_tick = len(set(self.ticks)) == 1
+        when = f"at tick {self.ticks[0]}" if same_tick else f"at ticks {', '.join(map(str, self.ticks))}"
+        if not same_tick:
+            kind = "the plan collides"
+        elif count == 2:
+            kind = "a swap"
+        else:
+            kind = "a rotation, which robots moving one at a time cannot execute"
+        super().__init__(
+            f"the plan deadlocks when executed: robots {', '.join(map(str, self.robots))} wait for each other "
+            f"in a cycle {when} ({steps}): {kind}"
+        )
+
+
+@dataclass(frozen=True)
+class Rotation:
+    """Robots moving round a cycle of cells at one tick: ``robots[k]`` moves from ``cells[k]`` to ``cells[k + 1]``.
+
+    ``cells`` are the robots' cells at ``tick - 1`` (the last robot moves into
+    ``cells[0]``). Two robots form a swap; three or more (four at least on a
+    4-connected grid) a rotation proper. The robot of least index comes first.
+    """
+
+    tick: int
+    robots: tuple[int, ...]
+    cells: tuple[Cell, ...]
+
+
+def find_rotations(paths: Sequence[Sequence[Cell]], *, min_robots: int = 2) -> list[Rotation]:
+    """Every cycle of robots that move, at one tick, each into the cell the next one leaves.
+
+    Parameters
+    ----------
+    paths:
+        One path per robot, one cell per tick; a robot stays on its last cell
+        after its path ends.
+    min_robots:
+        The smallest cycle reported: 2 includes swaps (which are also
+        collisions), 3 only rotations proper.
+
+    Returns
+    -------
+    list of Rotation
+        In tick order, then by the least robot index of each cycle; empty
+        when the plan can be executed by robots moving one at a time.
+
+    Examples
+    --------
+    >>> find_rotations([[(0, 0), (0, 1)], [(0, 1), (0, 0)]])   # a swap
+    [Rotation(tick=1, robots=(0, 1), cells=((0, 0), (0, 1)))]
+    >>> find_rotations([[(0, 0), (0, 1)], [(0, 1), (0, 0)]], min_robots=3)
+    []
+    >>> find_rotations([[(0, 0), (0, 1)], [(0, 1), (0, 2)]])   # following is not a rotation
+    []
+    """
+    length = max((len(path) for path in paths), default=0)
+    found: list[Rotation] = []
+    for tick in range(1, length):
+        before = [path[min(tick - 1, len(path) - 1)] for path in paths]
+        after = [path[min(tick, len(path) - 1)] for path in paths]
+        found.extend(rotations_at(tick, before, after, min_robots=min_robots))
+    return found
+
+
+def rotations_at(tick: int, before: Sequence[Cell], after: Sequence[Cell], *, min_robots: int = 2) -> list[Rotation]:
+    """The rotations of one tick, from every robot's cell at ``tick - 1`` (``before``) and ``tick`` (``after``).
+
+    The moving robots form a functional graph (each points to the robot
+    whose cell it enters, if that one moves too); its cycles are the
+    rotations, ordered by their least robot.
+
+    >>> rotations_at(3, [(0, 0), (0, 1), (1, 1), (1, 0)], [(0, 1), (1, 1), (1, 0), (0, 0)])
+    [Rotation(tick=3, robots=(0, 1, 2, 3), cells=((0, 0), (0, 1), (1, 1), (1, 0)))]
+    """
+    movers = {before[robot]: robot for robot in range(len(before)) if before[robot] != after[robot]}
+    following = sorted(robot for robot in movers.values() if after[robot] in movers)
+    if len(following) < min_robots:
+        return []  # a robot on a cycle enters the cell of another moving robot
+    found: list[Rotation] = []
+    done: set[int] = set()
+    for first in following:
+        if first in done:
+            continue
+        chain: list[int] = []
+        position: dict[int, int] = {}
+        robot: int | None = first
+        while robot is not None and robot not in done and robot not in position:
+            position[robot] = len(chain)
+            chain.append(robot)
+            robot = movers.get(after[robot])
+        done.update(chain)
+        if robot is None or robot not in position:
+            continue
+        cycle = chain[position[robot] :]
+        if len(cycle) < min_robots:
+            continue
+        least = cycle.index(min(cycle))
+        cycle = cycle[least:] + cycle[:least]
+        found.append(Rotation(tick, tuple(cycle), tuple(before[member] for member in cycle)))
+    found.sort(key=lambda rotation: rotation.robots[0])
+    return found
 
 
 def plan_moves(path: Sequence[Cell]) -> tuple[list[Cell], list[int]]:
@@ -43,11 +207,16 @@ def plan_moves(path: Sequence[Cell]) -> tuple[list[Cell], list[int]]:
 def action_dependencies(paths: Sequence[Sequence[Cell]]) -> tuple[list[list[Cell]], list[dict[int, list[tuple[int, int]]]]]:
     """Every robot's moves and, per move, the ``(robot, progress)`` pairs it must wait for.
 
+    The graph is checked before it is returned (:func:`check_executable`).
+
     Raises
     ------
     ValueError
         If the plan makes a robot enter a cell another robot never leaves
         afterwards (the plan collides).
+    PlanDeadlockError
+        If the dependencies form a cycle (a rotation or swap, or a collision),
+        so that the robots following them would wait for each other for ever.
     """
     moves_and_ticks = [plan_moves(path) for path in paths]
     visits: dict[Cell, list[tuple[int, int]]] = {}
@@ -73,4 +242,81 @@ def action_dependencies(paths: Sequence[Sequence[Cell]]) -> tuple[list[list[Cell
                     raise ValueError(f"robot {robot} enters {cell} at tick {tick} but robot {other} never leaves it")
                 needs.setdefault(move, []).append((other, leaving + 1))
         dependencies.append(needs)
-    return [cells for cells, _ in moves_and_ticks], dependencies
+    moves = [cells for cells, _ in moves_and_ticks]
+    check_executable(moves, dependencies, [ticks for _, ticks in moves_and_ticks])
+    return moves, dependencies
+
+
+def check_executable(
+    moves: Sequence[Sequence[Cell]],
+    dependencies: Sequence[dict[int, list[tuple[int, int]]]],
+    ticks: Sequence[Sequence[int]] | None = None,
+) -> None:
+    """Dry-run the execution of an Action Dependency Graph; raise if some robot would wait for ever.
+
+    Each robot completes its moves in order, a move once every ``(robot,
+    progress)`` pair it needs is met (the rule of
+    :class:`~mrmp.policies.plan_following.PlanFollowingPolicy`). Every robot
+    blocked on a robot it waits for is woken when that robot progresses, so
+    the run takes time linear in the size of the graph (Kahn's topological
+    sort, 1962). Robots left short of their last move wait in a cycle; one
+    cycle is reported.
+
+    Parameters
+    ----------
+    moves, dependencies:
+        As returned by :func:`action_dependencies`.
+    ticks:
+        The plan's tick of every move (for the message; move numbers when
+        not given).
+
+    Raises
+    ------
+    PlanDeadlockError
+        Naming the robots of one cycle, the cells they wait to enter and the
+        ticks.
+
+    Examples
+    --------
+    >>> check_executable([[(0, 1)], [(0, 0)]], [{0: [(1, 1)]}, {}])
+    >>> check_executable([[(0, 1)], [(0, 0)]], [{0: [(1, 1)]}, {0: [(0, 1)]}], [[1], [1]])
+    Traceback (most recent call last):
+    ...
+    mrmp.centralized.dependencies.PlanDeadlockError: the plan deadlocks when executed: robots 0, 1 wait for each other in a cycle at tick 1 (robot 0 enters (0, 1) after robot 1 leaves it, robot 1 enters (0, 0) after robot 0 leaves it): a swap
+    """
+    count = len(moves)
+    progress = [0] * count
+    waiting: dict[tuple[int, int], list[int]] = {}
+    blocked_by: list[int] = [-1] * count
+    queue = list(range(count))
+    while queue:
+        robot = queue.pop()
+        needs = dependencies[robot]
+        total = len(moves[robot])
+        blocked_by[robot] = -1
+        while progress[robot] < total:
+            unmet = next(
+                ((other, wanted) for other, wanted in needs.get(progress[robot], ()) if progress[other] < wanted), None
+            )
+            if unmet is not None:
+                waiting.setdefault(unmet, []).append(robot)
+                blocked_by[robot] = unmet[0]
+                break
+            progress[robot] += 1
+            queue.extend(waiting.pop((robot, progress[robot]), ()))
+    stuck = [robot for robot in range(count) if progress[robot] < len(moves[robot])]
+    if not stuck:
+        return
+    seen: dict[int, int] = {}
+    chain: list[int] = []
+    robot = stuck[0]
+    while robot not in seen:
+        seen[robot] = len(chain)
+        chain.append(robot)
+        robot = blocked_by[robot]
+    cycle = chain[seen[robot] :]
+    least = cycle.index(min(cycle))
+    cycle = cycle[least:] + cycle[:least]
+    cells = [moves[member][progress[member]] for member in cycle]
+    at = [ticks[member][progress[member]] if ticks is not None else progress[member] + 1 for member in cycle]
+    raise PlanDeadlockError(cycle, cells, at)

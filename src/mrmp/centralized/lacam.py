@@ -22,6 +22,26 @@ plan (backtracked through parents). Because the low-level queues eventually
 enumerate every successor, the search is *complete*: when the stack empties
 without reaching the goal, no plan exists and the result is ``"infeasible"``.
 
+**Rotation-free plans.** The plans are executed by robots that move one at a
+time through the plan's Action Dependency Graph
+(:mod:`mrmp.centralized.dependencies`), on which a *rotation* -- robots on a
+cycle of cells each moving, at one tick, into the cell the next one leaves --
+deadlocks. PIBT therefore runs with ``rotations=False``
+(:class:`~mrmp.centralized.pibt_step.PIBT`): a robot never takes a cell whose
+occupant is followed, through the robots moving into one another's cells, back
+to itself (the cell of an ancestor in its own priority-inheritance chain, or
+a cycle closed through constrained robots), and constraints that form a
+rotation fail. Completeness holds in this model, the classic one without
+rotations (vertex, swap and cycle conflicts forbidden; Stern et al., SoCS
+2019): a rotation-free, collision-free successor ``Q'`` of a configuration
+``Q`` is reached by the low-level node that constrains every robot to its
+cell in ``Q'`` (the queue enumerates it at depth ``N``), and PIBT returns
+exactly ``Q'`` there, since its checks of the constraints reject only vertex,
+swap and rotation conflicts. Every rotation-free successor is thus generated
+eventually, so ``"infeasible"`` means that no rotation-free plan exists (for
+example when robots fill a 2x2 block and each wants the next cell: only a
+rotation moves anyone).
+
 This module follows the reference implementations of Kei18/lacam
 (``lacam/src/planner.cpp``) and Kei18/lacam3 (``hnode.cpp``, ``planner.cpp``):
 priorities start at ``dist(start, goal)`` scaled below 1, grow by one per step
@@ -143,7 +163,8 @@ def lacam(
 
     Time is counted in ticks: every robot moves to a neighbouring cell or waits
     in each tick; entry costs of cells and robot headings are ignored (LaCAM
-    has no turn model; the result carries no headings).
+    has no turn model; the result carries no headings). Plans never contain a
+    rotation (see the module docstring).
 
     Parameters
     ----------
@@ -182,9 +203,9 @@ def lacam(
         configurations generated (distinct configurations inserted in the
         search, the start included). When solved, ``paths`` holds one path per
         robot in robot order, all of equal length, ending with every robot
-        at its goal. ``"infeasible"`` when the search proved that no plan
-        exists (at once when a goal cannot be reached from its start);
-        ``"limit"`` when ``time_limit_s`` or ``max_nodes`` ran out first.
+        at its goal. ``"infeasible"`` when the search proved that no
+        rotation-free plan exists (at once when a goal cannot be reached
+        from its start); ``"limit"`` when ``time_limit_s`` or ``max_nodes`` ran out first.
 
     Raises
     ------
@@ -193,7 +214,8 @@ def lacam(
 
     Examples
     --------
-    Three robots rotate in a 2x2 grid, which takes one tick:
+    Three robots move round a 2x2 grid, each following the next into the free
+    cell, which takes one tick:
 
     >>> from mrmp.core.grid import Grid
     >>> cells = [(0, 0), (0, 1), (1, 1), (1, 0)]
@@ -223,7 +245,7 @@ def lacam(
     start_config = tuple(index_of(grid, cell) for cell in instance.starts)
     goal_config = tuple(index_of(grid, cell) for cell in instance.goals)
     rng = random.Random(seed) if seed is not None else None
-    pibt = PIBT(neighbours, distances, list(goal_config), swap=swap, rng=rng)
+    pibt = PIBT(neighbours, distances, list(goal_config), swap=swap, rng=rng, rotations=False)
     candidates = [(*row, cell) for cell, row in enumerate(neighbours)]
     scale = 1.0 / (unreachable + 1)
     robot_range = range(count)

@@ -9,6 +9,20 @@ cells at each tick, the reverse of their moves (no swaps) and their goals from
 the tick they arrive (they stay there). A robot also never settles on its goal
 before the last tick a higher-priority robot crosses it.
 
+**No rotations.** A robot may *follow* a higher-priority one (enter, at tick
+``t``, the cell that one leaves at ``t``), but never by a move that closes a
+cycle of such moves: robots on a cycle of cells, each entering the cell the
+next one leaves at the same tick, cannot be executed by robots moving one at a
+time (:mod:`mrmp.centralized.dependencies`). A cycle's last member in priority
+order is planned when every other member's path is known, so it suffices that
+each robot's search forbids the moves closing a cycle with the robots before
+it (the move entries of :class:`~mrmp.centralized.space_time_astar.Reservations`):
+such a move ``u -> v`` at tick ``t`` is one into the cell of a robot that
+leaves it at ``t`` while the chain of robots following one another from
+there ends by entering ``u``. Only those moves are removed (following stays
+allowed), so the plans are rotation-free and the method is no less complete
+than the classic one in any other respect: it remains incomplete.
+
 The method is fast but incomplete: a robot whose every way to its goal is cut
 by the robots before it (for example a higher-priority robot parks on the only
 corridor to its goal) cannot be planned, even when another order would work.
@@ -141,8 +155,8 @@ def prioritized(
         be planned around those before it; ``"limit"`` when the time limit was
         reached; ``"infeasible"`` when a cheap proof shows that no plan exists
         (:func:`~mrmp.centralized.cbs.infeasibility_proof`: a goal cut off from
-        its start, or robots filling a cycle-free region). ``nodes`` counts
-        low-level expansions.
+        its start, or robots filling a region). ``nodes`` counts low-level
+        expansions. Plans never contain a rotation (see the module docstring).
 
     Raises
     ------

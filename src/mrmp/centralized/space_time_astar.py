@@ -11,7 +11,17 @@ constraint-tree node of CBS) forbid:
   ``t - 1``) to ``v`` (tick ``t``); prioritized planning stores the reverse of
   every move of an earlier robot here, which forbids swaps;
 * a *parking* entry ``cell -> T``: ``cell`` is occupied at every tick from
-  ``T`` on (a robot that has arrived at its goal and stays there).
+  ``T`` on (a robot that has arrived at its goal and stays there);
+* a *move* entry ``(v, t) -> u``: another robot moves from ``u`` (tick
+  ``t - 1``) into ``v`` (tick ``t``). The robot must not make a move that
+  closes a *rotation* with them: ``u' -> v'`` at tick ``t`` is forbidden when
+  the robots entering cells at ``t`` form a chain from ``v'`` into ``u'``
+  (the occupant of ``v'`` moves on into the cell of the next, and so on, and
+  the last enters ``u'``). Robots on such a cycle, each entering the cell the
+  next one leaves at the same tick, can only be executed all at once; robots
+  moving one at a time, each waiting for the cell ahead to be vacated
+  (:mod:`mrmp.centralized.dependencies`), never start. Following a robot (entering
+  the cell it leaves at the same tick) is allowed otherwise.
 
 A path ends when the robot reaches its goal and may stay there forever: its
 arrival tick must come after every vertex entry on its goal (someone passing
@@ -108,12 +118,14 @@ class Reservations:
     (2, 1)
     """
 
-    __slots__ = ("_last_vertex", "edge", "last_time", "parked", "vertex")
+    __slots__ = ("_last_vertex", "edge", "entering", "last_time", "parked", "vertex")
 
     def __init__(self) -> None:
         self.vertex: set[tuple[Cell, int]] = set()
         self.edge: set[tuple[Cell, Cell, int]] = set()
         self.parked: dict[Cell, int] = {}
+        self.entering: dict[tuple[Cell, int], Cell] = {}
+        """Move entries: ``(cell, t) -> the cell at t - 1 of the robot entering cell at t``."""
         self._last_vertex: dict[Cell, int] = {}
         self.last_time = -1
         """The largest tick any entry mentions (-1 when empty)."""
@@ -157,12 +169,18 @@ class Reservations:
             self.parked[cell] = tick
         self.last_time = max(self.last_time, tick)
 
+    def record_move(self, source: Cell, target: Cell, tick: int) -> None:
+        """Record that another robot moves ``source -> target`` arriving at ``tick`` (a move entry)."""
+        self.entering[(target, tick)] = source
+        self.last_time = max(self.last_time, tick)
+
     def reserve_path(self, path: Sequence[Cell]) -> None:
         """Reserve a whole path of another robot, which then stays on its last cell forever.
 
         Adds a vertex entry per tick, an edge entry for the reverse of every
-        move (forbidding swaps) and a parking entry on the last cell from the
-        tick the path ends.
+        move (forbidding swaps), a move entry for every move (forbidding the
+        rotations that would close on it) and a parking entry on the last cell
+        from the tick the path ends.
         """
         last = len(path) - 1
         for tick in range(last):
@@ -170,8 +188,35 @@ class Reservations:
         for tick in range(1, last + 1):
             if path[tick] != path[tick - 1]:
                 self.forbid_edge(path[tick], path[tick - 1], tick)
+                self.record_move(path[tick - 1], path[tick], tick)
         if last >= 0:
             self.park(path[last], last)
+
+    def closes_rotation(self, source: Cell, target: Cell, tick: int) -> bool:
+        """Whether the move ``source -> target`` arriving at ``tick`` closes a cycle with the move entries.
+
+        Walks back from ``source``: the robot entering it at ``tick`` came from
+        some cell, the robot entering that one came from another, and so on;
+        the move closes a cycle when the walk reaches ``target`` (two robots:
+        a swap, which edge entries forbid as well).
+
+        >>> table = Reservations()
+        >>> table.reserve_path([(0, 0), (0, 1)])
+        >>> table.reserve_path([(0, 1), (1, 1)])
+        >>> table.reserve_path([(1, 1), (1, 0)])
+        >>> table.closes_rotation((1, 0), (0, 0), 1), table.closes_rotation((1, 0), (0, 0), 2)
+        (True, False)
+        """
+        entering = self.entering
+        cell = source
+        for _ in range(len(entering)):
+            previous = entering.get((cell, tick))
+            if previous is None:
+                return False
+            if previous == target:
+                return True
+            cell = previous
+        return False
 
     def blocks(self, cell: Cell, tick: int) -> bool:
         """Whether standing on ``cell`` at ``tick`` is forbidden."""
@@ -186,10 +231,13 @@ class Reservations:
         return self._last_vertex.get(cell, -1)
 
     def __len__(self) -> int:
-        return len(self.vertex) + len(self.edge) + len(self.parked)
+        return len(self.vertex) + len(self.edge) + len(self.parked) + len(self.entering)
 
     def __repr__(self) -> str:
-        return f"<Reservations {len(self.vertex)} vertex, {len(self.edge)} edge, {len(self.parked)} parked>"
+        return (
+            f"<Reservations {len(self.vertex)} vertex, {len(self.edge)} edge, {len(self.parked)} parked, "
+            f"{len(self.entering)} moves>"
+        )
 
 
 @dataclass(frozen=True)
@@ -321,7 +369,8 @@ def space_time_astar(
         no horizon (the search is still finite, see the module docstring).
     avoid:
         Soft reservations: among states of equal ``f``, fewer hits of these
-        entries go first (a conflict-avoidance table). Never changes the
+        entries go first (a conflict-avoidance table; moves closing a
+        rotation with its move entries count as hits). Never changes the
         arrival tick.
     deadline:
         A :func:`time.perf_counter` value after which the search gives up.
@@ -390,8 +439,10 @@ def space_time_astar(
     static_from = max(reservations.last_time, avoid.last_time if avoid is not None else -1) + 1
 
     vertex, edge, parked = reservations.vertex, reservations.edge, reservations.parked
+    entering, closes_rotation = reservations.entering, reservations.closes_rotation
     if avoid is not None:
         avoid_vertex, avoid_edge, avoid_parked = avoid.vertex, avoid.edge, avoid.parked
+        avoid_entering, avoid_closes_rotation = avoid.entering, avoid.closes_rotation
     neighbours = grid.neighbours
     inf = math.inf
 
@@ -440,6 +491,8 @@ def space_time_astar(
                 continue
             if next_cell != cell and (cell, next_cell, next_tick) in edge:
                 continue
+            if next_cell != cell and (cell, next_tick) in entering and closes_rotation(cell, next_cell, next_tick):
+                continue  # someone enters our cell as we leave it: no cycle of such moves
             next_key = (next_cell, next_facing, next_key_tick)
             if next_key in closed:
                 continue
@@ -451,6 +504,12 @@ def space_time_astar(
                 if (next_cell, next_tick) in avoid_vertex or avoid_parked.get(next_cell, inf) <= next_tick:
                     next_conflicts += 1
                 if next_cell != cell and (cell, next_cell, next_tick) in avoid_edge:
+                    next_conflicts += 1
+                if (
+                    next_cell != cell
+                    and (cell, next_tick) in avoid_entering
+                    and avoid_closes_rotation(cell, next_cell, next_tick)
+                ):
                     next_conflicts += 1
             rank = (next_tick, next_conflicts)
             previous = best.get(next_key)

@@ -8,8 +8,11 @@ moves by which other robots leave that cell earlier in the plan. A robot starts
 a move only when every robot it depends on reports (in its state messages, field
 ``progress``) that it has completed the move it depends on. Late robots and
 lost messages then only delay the fleet; the order of visits to every cell is
-the plan's, so the execution never collides and, the dependency graph being
-acyclic, never deadlocks.
+the plan's, so the execution never collides and, for a plan without rotations
+(robots on a cycle of cells each entering the next one's cell at one tick: every
+planner of :mod:`mrmp.centralized` returns such plans, and
+:func:`~mrmp.centralized.dependencies.action_dependencies` refuses any other), whose
+dependency graph is then acyclic, never deadlocks.
 
 The dependencies themselves are computed from the plan by
 :func:`mrmp.centralized.dependencies.action_dependencies`; this policy only

@@ -253,15 +253,51 @@ def test_first_conflict_finds_swaps_and_parked_robots() -> None:
     assert first_conflict([[(0, 0), (0, 1)], [(0, 1), (0, 2)]]) == (None, 0)  # following is allowed
 
 
-def test_infeasibility_proof_allows_rotation_on_cycles() -> None:
-    # a full 2x2 block can rotate: no proof of infeasibility
+def test_infeasibility_proof_of_a_full_block_that_could_only_rotate() -> None:
+    # a full 2x2 block could only rotate, which robots moving one at a time cannot execute
     grid = Grid(2, 2)
     starts = [(0, 0), (0, 1), (1, 1), (1, 0)]
     goals = [(0, 1), (1, 1), (1, 0), (0, 0)]
-    assert infeasibility_proof(as_problem(grid, starts, goals)) is None
-    result = cbs(grid, starts, goals)
-    assert_valid_plan(grid, result, starts, goals)
-    assert result.sum_of_costs() == 4
+    assert brute_force_sum_of_costs(grid, starts, goals) is None
+    assert "only a rotation would move them" in (infeasibility_proof(as_problem(grid, starts, goals)) or "")
+    assert cbs(grid, starts, goals).status == "infeasible"
+    # with a robot on its goal and a free cell, no proof: the others can move
+    assert infeasibility_proof(as_problem(grid, starts[:3], goals[:3])) is None
+
+
+@pytest.mark.parametrize("improved", [True, False])
+def test_cbs_splits_rotations_and_is_optimal_among_rotation_free_plans(improved: bool) -> None:
+    # the classic optimum (cost 4) turns the 2x2 block in one tick: a rotation conflict, split
+    # into one child per robot; the rotation-free optimum (6, from the brute force) remains
+    grid = Grid(2, 3)
+    block = [(0, 0), (0, 1), (1, 1), (1, 0)]
+    goals = block[1:] + block[:1]
+    result = cbs(grid, block, goals, improved=improved)
+    assert_valid_plan(grid, result, block, goals)
+    assert result.sum_of_costs() == brute_force_sum_of_costs(grid, block, goals) == 6
+    assert brute_force_sum_of_costs(grid, block, goals, rotations=True) == 4
+    rotations = all_conflicts([[cell, goal] for cell, goal in zip(block, goals)], rotations=True)
+    assert [(c.kind, c.robots, c.tick) for c in rotations] == [("rotation", (0, 1, 2, 3), 1)]
+    assert result.nodes > 1 + 4  # the root and at least one split into four children
+
+
+@settings(max_examples=40, derandomize=True, deadline=None)
+@given(st.integers(0, 10**6))
+def test_cbs_with_four_robots_is_optimal_among_rotation_free_plans(seed: int) -> None:
+    # four robots on small grids with cycles: rotations would often be cheapest
+    import random
+
+    rng = random.Random(seed)
+    grid = Grid(2, rng.choice([2, 3]), [])
+    free = grid.free_cells()
+    starts, goals = rng.sample(free, 4), rng.sample(free, 4)
+    optimum = brute_force_sum_of_costs(grid, starts, goals)
+    result = cbs(grid, starts, goals, max_nodes=5000, time_limit_s=10.0)
+    if optimum is None:
+        assert not result.solved
+    else:
+        assert_valid_plan(grid, result, starts, goals)
+        assert result.sum_of_costs() == optimum
 
 
 def test_planners_registry() -> None:

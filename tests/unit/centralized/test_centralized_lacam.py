@@ -1,8 +1,10 @@
 """LaCAM and its PIBT successor generator: tricky small cases, completeness, benchmarks.
 
-Every plan is judged by the referee (:func:`mrmp.sim.referee.check_paths`).
+Every plan is judged by the referee (:func:`mrmp.sim.referee.check_paths`)
+and must be free of rotations (:func:`mrmp.centralized.dependencies.find_rotations`).
 Feasibility of tiny instances is checked against a brute-force breadth-first
-search over joint configurations, written here independently of the planner.
+search over joint configurations (vertex, swap and rotation conflicts
+forbidden), written here independently of the planner.
 """
 
 from __future__ import annotations
@@ -17,6 +19,7 @@ import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
 
+from mrmp.centralized.dependencies import find_rotations
 from mrmp.centralized.lacam import lacam
 from mrmp.centralized.pibt_step import (
     NO_CELL,
@@ -57,14 +60,37 @@ def assert_valid(scenario: Scenario, result: PlanningResult) -> None:
         assert path[0] == robot.start and path[-1] == robot.goal
     if scenario.robots:
         assert check_paths(scenario.grid, {robot.id: path for robot, path in zip(scenario.robots, result.paths)}) == []
+    assert find_rotations(result.paths) == []
 
 
 def lower_bound(scenario: Scenario) -> int:
     return int(sum(distance_table(scenario.grid, robot.goal).distance(robot.start) for robot in scenario.robots))
 
 
+def moves_in_a_cycle(config: tuple[Cell, ...], nxt: tuple[Cell, ...]) -> bool:
+    """Whether some robots move round a cycle: each into the cell another one leaves, back to the first."""
+    who = {cell: robot for robot, cell in enumerate(config)}
+    for first in range(len(config)):
+        robot, steps = first, 0
+        while config[robot] != nxt[robot] and steps <= len(config):
+            robot = who.get(nxt[robot], -1)
+            if robot < 0:
+                break
+            if robot == first:
+                return True
+            steps += 1
+    return False
+
+
+def test_moves_in_a_cycle_oracle():
+    block = ((0, 0), (0, 1), (1, 1), (1, 0))
+    assert moves_in_a_cycle(block, block[1:] + block[:1])
+    assert not moves_in_a_cycle(block[:3], block[1:])  # three robots following into the free cell
+    assert not moves_in_a_cycle(block, block)
+
+
 def brute_force_feasible(scenario: Scenario) -> bool:
-    """Breadth-first search over joint configurations (vertex and swap collisions forbidden)."""
+    """Breadth-first search over joint configurations (vertex, swap and rotation conflicts forbidden)."""
     grid = scenario.grid
     start = tuple(robot.start for robot in scenario.robots)
     goal = tuple(robot.goal for robot in scenario.robots)
@@ -79,6 +105,8 @@ def brute_force_feasible(scenario: Scenario) -> bool:
             if nxt in seen or len(set(nxt)) < len(nxt):
                 continue
             if any(nxt[i] == config[j] and nxt[j] == config[i] for i in range(len(config)) for j in range(i)):
+                continue
+            if moves_in_a_cycle(config, nxt):
                 continue
             seen.add(nxt)
             queue.append(nxt)
@@ -112,21 +140,24 @@ def test_swap_in_corridor_with_bay_at_the_end(swap):
     assert_valid(scenario, lacam(scenario, swap=swap))
 
 
-def test_rotation_in_a_full_2x2_grid():
-    # Four robots on four cells: only a rotation moves anyone (following is allowed, swaps are not).
+@pytest.mark.parametrize("shift", [1, 2])
+def test_no_rotation_in_a_full_2x2_grid(shift):
+    # Four robots on four cells: only a rotation would move anyone, and rotations cannot be executed.
     cells = [(0, 0), (0, 1), (1, 1), (1, 0)]
-    scenario = scenario_of(["..", ".."], [(cells[i], cells[(i + 1) % 4]) for i in range(4)])
+    scenario = scenario_of(["..", ".."], [(cells[i], cells[(i + shift) % 4]) for i in range(4)])
     result = lacam(scenario)
-    assert_valid(scenario, result)
-    assert result.makespan() == 1
+    assert result.status == "infeasible", result.message
+    assert result.nodes == 1  # no successor but the start itself
 
 
-def test_two_steps_of_rotation_in_a_2x2_grid():
+def test_rotation_wanted_in_a_2x3_grid_goes_round_by_the_free_cells():
+    # The 2x2 block of robots wants to turn by one cell; the free column lets them go round in turn.
     cells = [(0, 0), (0, 1), (1, 1), (1, 0)]
-    scenario = scenario_of(["..", ".."], [(cells[i], cells[(i + 2) % 4]) for i in range(4)])
+    scenario = scenario_of(["...", "..."], [(cells[i], cells[(i + 1) % 4]) for i in range(4)])
+    assert brute_force_feasible(scenario)
     result = lacam(scenario)
     assert_valid(scenario, result)
-    assert result.makespan() == 2
+    assert result.makespan() > 1  # the one-tick plan is a rotation
 
 
 @pytest.mark.parametrize("shift", [1, 2, 3])
@@ -301,7 +332,36 @@ def test_pibt_backtracks_when_the_pushed_robot_is_stuck():
 def test_pibt_rotation_in_a_cycle():
     cells = [(0, 0), (0, 1), (1, 1), (1, 0)]
     goals = [cells[(i + 1) % 4] for i in range(4)]
-    assert pibt_step(Grid(2, 2), cells, goals) == goals
+    assert pibt_step(Grid(2, 2), cells, goals) == goals  # the classic model rotates
+
+
+def rotation_free_pibt(
+    grid: Grid, goals: list[Cell], swap: bool = False, rotations: bool = False, rng: random.Random | None = None
+) -> PIBT:
+    size = grid.x_size * grid.y_size
+    return PIBT(
+        flat_neighbours(grid),
+        [distance_list(distance_table(grid, goal), size) for goal in goals],
+        [index_of(grid, goal) for goal in goals],
+        swap=swap,
+        rng=rng,
+        rotations=rotations,
+    )
+
+
+def test_pibt_without_rotations_refuses_the_cycle():
+    grid = Grid(2, 2)
+    cells = [(0, 0), (0, 1), (1, 1), (1, 0)]
+    goals = [cells[(i + 1) % 4] for i in range(4)]
+    current = [index_of(grid, cell) for cell in cells]
+    pibt = rotation_free_pibt(grid, goals)
+    assert pibt.step(current, [0, 1, 2, 3]) == current  # the last robot may not close the cycle: all stay
+    rotation = {robot: index_of(grid, goal) for robot, goal in enumerate(goals)}
+    assert pibt.step(current, [0, 1, 2, 3], rotation) is None  # constraints forming a rotation fail
+    assert pibt.clean
+    # three robots: each follows the next into the free cell, a chain, not a cycle
+    three = rotation_free_pibt(grid, goals[:3])
+    assert three.step(current[:3], [0, 1, 2]) == [index_of(grid, goal) for goal in goals[:3]]
 
 
 def test_swap_technique_lets_robots_pass_in_a_dead_end_corridor():
@@ -390,3 +450,47 @@ def test_pibt_generator_leaves_no_trace_between_calls(case, swap):
     assert pibt.clean
     assert pibt.step(current, order) is not None
     assert pibt.clean
+
+
+@settings(max_examples=300, derandomize=True, deadline=None)
+@given(pibt_cases(), st.booleans(), st.sampled_from([None, 0, 7]))
+def test_pibt_without_rotations_is_rotation_free_and_respects_constraints(case, swap, seed):
+    grid, config, goals, constraints, priorities = case
+    if not config:
+        return
+    pibt = rotation_free_pibt(grid, goals, swap=swap, rng=random.Random(seed) if seed is not None else None)
+    current = [index_of(grid, cell) for cell in config]
+    order = sorted(range(len(config)), key=lambda robot: -priorities[robot])
+    fixed = {robot: index_of(grid, cell) for robot, cell in constraints.items()}
+    result = pibt.step(current, order, fixed)
+    assert pibt.clean
+    if not constraints:
+        assert result is not None  # unconstrained, staying is always possible
+    if result is None:
+        return
+    after = tuple(divmod(index, grid.y_size) for index in result)
+    for robot, cell in constraints.items():
+        assert after[robot] == cell
+    paths = {str(robot): [before, nxt] for robot, (before, nxt) in enumerate(zip(config, after))}
+    assert check_paths(grid, paths) == []
+    assert not moves_in_a_cycle(tuple(config), after)
+
+
+@settings(max_examples=200, derandomize=True, deadline=None)
+@given(pibt_cases(), st.booleans())
+def test_pibt_without_rotations_returns_every_rotation_free_configuration_it_is_given(case, swap):
+    # LaCAM's completeness rests on this: constraining every robot to a collision-free,
+    # rotation-free next configuration gives exactly that configuration (and a rotation fails).
+    grid, config, goals, _, priorities = case
+    if not config:
+        return
+    current = [index_of(grid, cell) for cell in config]
+    order = sorted(range(len(config)), key=lambda robot: -priorities[robot])
+    classic = rotation_free_pibt(grid, goals, swap=swap, rotations=True).step(current, order)
+    assert classic is not None
+    everyone = dict(enumerate(classic))
+    result = rotation_free_pibt(grid, goals, swap=swap).step(current, order, everyone)
+    if moves_in_a_cycle(tuple(config), tuple(divmod(index, grid.y_size) for index in classic)):
+        assert result is None
+    else:
+        assert result == classic

@@ -6,10 +6,14 @@
   waits, turns right or moves ahead); finishing is a free transition for a robot
   on its goal, after which it never moves. A tick costs the number of
   unfinished robots, so a plan costs the sum over robots of the first tick from
-  which each stays on its goal: the standard MAPF sum of costs. Shares no code
-  with mrmp's planners.
+  which each stays on its goal: the standard MAPF sum of costs. Joint moves
+  with a vertex or swap collision are skipped, and so are rotations (robots
+  moving round a cycle of cells at one tick) unless ``rotations=True``. Shares
+  no code with mrmp's planners.
+* :func:`moves_round_a_cycle`: whether one joint move contains a rotation.
 * :func:`assert_valid_plan`: the referee finds nothing, paths start at the
-  starts, end at the goals, are 4-connected and of equal length.
+  starts, end at the goals, are 4-connected, of equal length and without
+  rotations.
 """
 
 from __future__ import annotations
@@ -48,6 +52,22 @@ def _options(grid: Grid, cell: Cell, facing: int, heading_aware: bool) -> list[t
     return result
 
 
+def moves_round_a_cycle(before: Sequence[Cell], after: Sequence[Cell]) -> bool:
+    """Whether some robots each move into the cell another one leaves, round a cycle back to the first."""
+    occupant = {cell: robot for robot, cell in enumerate(before)}
+    for first in range(len(before)):
+        robot = first
+        for _ in range(len(before)):
+            if before[robot] == after[robot]:
+                break
+            robot = occupant.get(after[robot], -1)
+            if robot < 0:
+                break
+            if robot == first:
+                return True
+    return False
+
+
 def brute_force_sum_of_costs(
     grid: Grid,
     starts: Sequence[Cell],
@@ -55,6 +75,7 @@ def brute_force_sum_of_costs(
     *,
     heading_aware: bool = False,
     headings: Sequence[int] | None = None,
+    rotations: bool = False,
 ) -> int | None:
     """The optimal sum of costs by joint-state Dijkstra, or None if no plan exists."""
     count = len(starts)
@@ -89,7 +110,7 @@ def brute_force_sum_of_costs(
                 for i in range(count)
                 for j in range(i + 1, count)
             )
-            if swap:
+            if swap or (not rotations and moves_round_a_cycle(cells, targets)):
                 continue
             successors.append((cost + step, (targets, tuple(f for _, f in combo), finished)))
         for new_cost, new_state in successors:
@@ -115,6 +136,10 @@ def assert_valid_plan(grid: Grid, result: PlanningResult, starts: Sequence[Cell]
         for before, after in pairwise(path):
             assert abs(before[0] - after[0]) + abs(before[1] - after[1]) <= 1
             assert grid.is_free(after)
+    for tick in range(1, len(result.paths[0]) if result.paths else 0):
+        before = [path[tick - 1] for path in result.paths]
+        after = [path[tick] for path in result.paths]
+        assert not moves_round_a_cycle(before, after), f"a rotation at tick {tick}"
 
 
 def replay_headings(grid: Grid, result: PlanningResult, initial: Sequence[Heading]) -> None:
@@ -139,6 +164,25 @@ def replay_headings(grid: Grid, result: PlanningResult, initial: Sequence[Headin
 def test_brute_force_single_robot_is_its_distance() -> None:
     grid = Grid.from_rows(["...", ".@.", "..."])
     assert brute_force_sum_of_costs(grid, [(0, 0)], [(2, 2)]) == 4
+
+
+def test_brute_force_without_rotations_in_a_2x3_grid() -> None:
+    # four robots on a 2x2 block each want the next cell: one tick with a rotation; without, one
+    # of them steps into the free column so that the three others follow one another (cost 3),
+    # and it comes back round in two more ticks (cost 3): 6
+    block = [(0, 0), (0, 1), (1, 1), (1, 0)]
+    goals = block[1:] + block[:1]
+    assert brute_force_sum_of_costs(Grid(2, 3), block, goals, rotations=True) == 4
+    assert brute_force_sum_of_costs(Grid(2, 2), block, goals, rotations=True) == 4
+    assert brute_force_sum_of_costs(Grid(2, 2), block, goals) is None
+    assert brute_force_sum_of_costs(Grid(2, 3), block, goals) == 6
+
+
+def test_moves_round_a_cycle() -> None:
+    block = [(0, 0), (0, 1), (1, 1), (1, 0)]
+    assert moves_round_a_cycle(block, block[1:] + block[:1])
+    assert not moves_round_a_cycle(block[:3], block[1:])  # following into a free cell
+    assert not moves_round_a_cycle(block, block)
 
 
 def test_brute_force_swap_in_open_2x2_needs_a_detour() -> None:
