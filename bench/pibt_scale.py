@@ -16,21 +16,23 @@ measured:
   ``-random-1`` where the issue quotes it (for comparison; not measured here).
 
 Every line is also appended to ``--out`` (JSON lines) as it is measured.
+``--seeds K`` runs every instance with its seed (0 for ``.scen`` instances)
+and the K-1 following ones (the seed drives the robots' random tie-breaks;
+default 1), so "inst" counts instances times seeds.
 
-Usage: python bench/pibt_scale.py [--maps DIR] [--only random-32-32-20,empty-32-32] [--out FILE]
+Usage: python bench/pibt_scale.py [--maps DIR] [--only random-32-32-20,empty-32-32] [--seeds K] [--out FILE]
 """
 
 from __future__ import annotations
 
 import argparse
 import json
-import random
 import sys
 from pathlib import Path
 from statistics import mean
 
-from mrmp.core import PolicyOptions, RobotSpec, Scenario
-from mrmp.core.grid import connected_regions
+from mrmp.core import PolicyOptions, Scenario
+from mrmp.core.map_generators import random_instance as seeded_instance
 from mrmp.io import load_movingai_scenario, load_scenario
 from mrmp.io.movingai import read_map
 from mrmp.sim.rounds import RoundsSimulator
@@ -64,13 +66,7 @@ RANDOM_INSTANCES = 2
 
 def random_instance(map_path: Path, agents: int, seed: int) -> Scenario:
     """``agents`` seeded random starts and goals in the map's largest connected region."""
-    grid = read_map(map_path)
-    _, regions = connected_regions(grid, grid.free_cells())
-    region = max(regions, key=len)
-    rng = random.Random(seed)
-    starts, goals = rng.sample(region, agents), rng.sample(region, agents)
-    robots = tuple(RobotSpec(str(i), start, goal) for i, (start, goal) in enumerate(zip(starts, goals)))
-    return Scenario(grid, robots, name=f"{map_path.stem}-seed-{seed}", seed=seed)
+    return seeded_instance(read_map(map_path), agents, seed, name=f"{map_path.stem}-seed-{seed}")
 
 
 def instances(maps: Path, name: str, agents: int) -> list[Scenario]:
@@ -81,10 +77,11 @@ def instances(maps: Path, name: str, agents: int) -> list[Scenario]:
     return [random_instance(map_path, agents, seed) for seed in range(RANDOM_INSTANCES)]
 
 
-def measure(label: str, agents: int, scenarios: list[Scenario], out: Path | None) -> None:
+def measure(label: str, agents: int, scenarios: list[Scenario], out: Path | None, seeds: int = 1) -> None:
     runs = []
-    for scenario in scenarios:
-        result = RoundsSimulator(scenario.with_changes(policy=PolicyOptions(name="pibt"))).run()
+    for scenario, offset in ((scenario, offset) for scenario in scenarios for offset in range(seeds)):
+        run = scenario.with_changes(policy=PolicyOptions(name="pibt"), seed=scenario.seed + offset)
+        result = RoundsSimulator(run).run()
         if result.collisions:
             raise SystemExit(f"{label} N={agents}: the referee found collisions: {result.collisions[:3]}")
         steps = max(1, result.network["steps"])
@@ -129,7 +126,10 @@ def main() -> int:
     parser.add_argument("--maps", type=Path, default=ROOT / "maps", help="folder of .map and .scen files")
     parser.add_argument("--only", default="", help="comma-separated map names (default: all)")
     parser.add_argument("--out", type=Path, default=None, help="append one JSON line per row to this file")
+    parser.add_argument("--seeds", type=int, default=1, help="run every instance with its seed and the SEEDS-1 following")
     arguments = parser.parse_args()
+    if arguments.seeds < 1:
+        parser.error(f"--seeds must be at least 1, not {arguments.seeds}")
     only = {name for name in arguments.only.split(",") if name}
     print(
         f"{'map':<24} {'N':>5} {'inst':>4} {'success':>8} {'SoC/LB':>7} {'makespan':>8}"
@@ -138,12 +138,12 @@ def main() -> int:
     if not only:
         for path in sorted((ROOT / "examples").glob("thesis-*.yaml")):
             scenario = load_scenario(path)
-            measure(path.stem, len(scenario.robots), [scenario], arguments.out)
+            measure(path.stem, len(scenario.robots), [scenario], arguments.out, arguments.seeds)
     for name, counts in AGENTS.items():
         if (only and name not in only) or not (arguments.maps / f"{name}.map").exists():
             continue
         for agents in counts:
-            measure(name, agents, instances(arguments.maps, name, agents), arguments.out)
+            measure(name, agents, instances(arguments.maps, name, agents), arguments.out, arguments.seeds)
     return 0
 
 

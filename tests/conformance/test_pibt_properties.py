@@ -7,54 +7,22 @@
   2022) for graphs where every edge lies on a cycle, with priorities counting
   the steps since a robot last stood on its goal. The swap technique (which
   walks robots away from their goals) is off: the theorem covers plain PIBT.
+* With ``heading_aware`` (turns cost time), the same holds in the heading-aware cost:
+  within ``D * N`` steps, ``D`` the largest heading-aware cost to a goal.
 * On random maps of any shape, with the swap technique, it never collides.
 """
 
-import random
+import math
 
 import networkx as nx
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from map_strategies import FAULTS, any_worlds, biconnected_worlds, free_graph
+from reaching import assert_every_robot_reaches_its_goal
 
-from mrmp.core import Grid, NetworkFaults, PolicyOptions, RobotSpec, Scenario
-from mrmp.core.grid import connected_regions
+from mrmp.core import PolicyOptions, Scenario, Timing
 from mrmp.sim.rounds import RoundsSimulator
-
-FAULTS = st.builds(
-    NetworkFaults,
-    loss=st.sampled_from([0.0, 0.1, 0.3]),
-    delay_min=st.just(0),
-    delay_max=st.integers(0, 2),
-    duplicate=st.sampled_from([0.0, 0.2]),
-    reorder=st.sampled_from([0.0, 0.3]),
-)
-
-
-def free_graph(grid):
-    graph = nx.Graph()
-    for cell in grid.free_cells():
-        graph.add_node(cell)
-        graph.add_edges_from((cell, other) for other in grid.neighbours(cell))
-    return graph
-
-
-@st.composite
-def biconnected_worlds(draw):
-    """A random grid whose free cells form a biconnected graph, and robots at most one per three free cells."""
-    rng = random.Random(draw(st.integers(0, 10**6)))
-    x_size, y_size = draw(st.integers(2, 7)), draw(st.integers(3, 7))
-    blocked: set = set()
-    cells = [(x, y) for x in range(x_size) for y in range(y_size)]
-    for cell in rng.sample(cells, k=len(cells) // 4):  # block a cell only if the rest stays biconnected
-        graph = free_graph(Grid(x_size, y_size, blocked | {cell}))
-        if graph.number_of_nodes() >= 3 and nx.is_biconnected(graph):
-            blocked.add(cell)
-    grid = Grid(x_size, y_size, blocked)
-    free = grid.free_cells()
-    count = draw(st.integers(1, len(free) // 3))
-    starts, goals = rng.sample(free, count), rng.sample(free, count)
-    return grid, tuple(RobotSpec(f"r{i}", s, g) for i, (s, g) in enumerate(zip(starts, goals)))
 
 
 @pytest.mark.parametrize("examples", [pytest.param(60, id="default"), pytest.param(600, id="many", marks=pytest.mark.slow)])
@@ -69,29 +37,30 @@ def test_reaches_every_goal_within_the_bound_on_biconnected_maps(examples):
         )
         simulator = RoundsSimulator(scenario)
         bound = nx.diameter(free_graph(grid)) * len(robots)
-        reached = {robot.index for robot in simulator.robots if robot.at_goal}
-        for _ in range(bound):
-            simulator.step()
-            reached |= {robot.index for robot in simulator.robots if robot.at_goal}
-        assert simulator.referee.collisions == []
-        assert reached == set(range(len(robots))), f"not at their goals within {bound} steps: {set(range(len(robots))) - reached}"
+        assert_every_robot_reaches_its_goal(simulator, bound, "steps", lambda steps: steps)
 
     check()
 
 
-@st.composite
-def any_worlds(draw):
-    rng = random.Random(draw(st.integers(0, 10**6)))
-    x_size, y_size = draw(st.integers(1, 8)), draw(st.integers(2, 8))
-    cells = [(x, y) for x in range(x_size) for y in range(y_size)]
-    grid = Grid(x_size, y_size, rng.sample(cells, k=rng.randint(0, len(cells) // 3)))
-    _, regions = connected_regions(grid, grid.free_cells())
-    starts, goals = [], []
-    for region in regions:  # goals in the start's region: every robot could arrive
-        count = rng.randint(0, len(region) // 2)
-        starts += rng.sample(region, count)
-        goals += rng.sample(region, count)
-    return grid, tuple(RobotSpec(f"r{i}", s, g) for i, (s, g) in enumerate(zip(starts, goals)))
+@settings(max_examples=30, derandomize=True, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(world=biconnected_worlds(), faults=FAULTS, seed=st.integers(0, 1000), turn_time=st.sampled_from([0.25, 0.5, 1.0]))
+def test_heading_aware_reaches_every_goal_within_its_bound(world, faults, seed, turn_time):
+    """With turns costing time, the theorem holds in the heading-aware cost: the top robot's cost to
+    its goal drops by at least one cell per step, so ``D * N`` steps suffice, ``D`` the largest finite
+    heading-aware cost of any state to any robot's goal (in cells)."""
+    grid, robots = world
+    scenario = Scenario(
+        grid, robots, network=faults, policy=PolicyOptions(name="pibt", swap=False, heading_aware=True),
+        timing=Timing(1.0, turn_time), seed=seed, max_ticks=10**9,
+    )  # fmt: skip
+    simulator = RoundsSimulator(scenario)
+    flat = simulator.flat
+    largest = max(
+        max(value for value in flat.heading_distances(robot.goal, turn_time) if value != float("inf"))
+        for robot in simulator.robots
+    )
+    bound = math.ceil(largest) * len(robots)
+    assert_every_robot_reaches_its_goal(simulator, bound, "steps", lambda steps: steps)
 
 
 @settings(max_examples=80, derandomize=True, deadline=None, suppress_health_check=[HealthCheck.too_slow])

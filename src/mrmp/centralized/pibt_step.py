@@ -171,6 +171,20 @@ class PIBT:
         Breaks ties between equally distant candidate cells at random when
         given; otherwise ties keep the neighbour order (NORTH, EAST, SOUTH,
         WEST, then staying), so results are deterministic.
+    tie_penalties:
+        Rank equally distant cells by the tie penalties of
+        :func:`~mrmp.policies.pibt_rules.sorted_candidates` first (dead ends
+        last; cells of robots standing on their goals after free ones), as the
+        robots of policy ``pibt`` do with random ties.
+    rotations:
+        Whether a step may contain a *rotation*: robots on a cycle of cells
+        each moving into the cell the next one leaves (the classic MAPF model
+        allows it). With ``False`` a robot never takes a cell when the chain
+        of robots that follow one another from that cell's occupant leads
+        back to itself (for a robot planned by priority inheritance: the cell
+        of an ancestor in its own chain), and constraints that form such a
+        cycle fail; central plans are then executable by robots moving one at
+        a time (:mod:`mrmp.centralized.dependencies`).
 
     Notes
     -----
@@ -200,7 +214,18 @@ class PIBT:
     [0, 1]
     """
 
-    __slots__ = ("_distances", "_goals", "_neighbours", "_occ_next", "_occ_now", "_random", "swap")
+    __slots__ = (
+        "_distances",
+        "_goals",
+        "_neighbours",
+        "_occ_next",
+        "_occ_now",
+        "_random",
+        "_settled",
+        "rotations",
+        "swap",
+        "tie_penalties",
+    )
 
     def __init__(
         self,
@@ -210,6 +235,8 @@ class PIBT:
         *,
         swap: bool = False,
         rng: random.Random | None = None,
+        tie_penalties: bool = False,
+        rotations: bool = True,
     ) -> None:
         if len(distances) != len(goals):
             raise ValueError(f"{len(distances)} distance lists for {len(goals)} goals")
@@ -219,7 +246,10 @@ class PIBT:
         self._occ_now = [NO_AGENT] * len(self._neighbours)
         self._occ_next = [NO_AGENT] * len(self._neighbours)
         self._random = rng.random if rng is not None else None
+        self._settled: set[int] = set()
         self.swap = swap
+        self.tie_penalties = tie_penalties
+        self.rotations = rotations
 
     @property
     def clean(self) -> bool:
@@ -299,8 +329,10 @@ class PIBT:
         occ_now, occ_next = self._occ_now, self._occ_next
         count = len(current)
         success = True
+        goals = self._goals
         for robot in range(count):
             occ_now[current[robot]] = robot
+        self._settled = {current[robot] for robot in range(count) if current[robot] == goals[robot]}
         for robot in range(count):
             cell = target[robot]
             if cell == NO_CELL:
@@ -313,6 +345,10 @@ class PIBT:
                 success = False
                 break
             occ_next[cell] = robot
+        if success and not self.rotations:
+            success = not any(
+                self._in_cycle(robot, current, target) for robot in range(count) if target[robot] != NO_CELL
+            )
         if success:
             for robot in order:
                 if target[robot] == NO_CELL and not self._plan(robot, current, target):
@@ -329,7 +365,13 @@ class PIBT:
 
     def _sorted_candidates(self, robot: int, current: Sequence[int], target: list[int]) -> tuple[list[int], int]:
         """Robot's candidate cells, best first, and the robot to pull (or ``NO_AGENT``)."""
-        candidates = sorted_candidates(self._neighbours, current[robot], self._distances[robot], self._random)
+        candidates = sorted_candidates(
+            self._neighbours,
+            current[robot],
+            self._distances[robot],
+            self._random,
+            self._settled if self.tie_penalties else None,
+        )
         pulled = NO_AGENT
         if self.swap:
             pulled = self._swap_agent(robot, candidates, current, target)
@@ -358,6 +400,14 @@ class PIBT:
                 if occupant != NO_AGENT and target[occupant] == here:
                     k += 1  # the occupant moves into our cell: taking its cell would swap
                     continue
+                if (
+                    not self.rotations
+                    and occupant != NO_AGENT
+                    and occupant != robot
+                    and self._leads_to(occupant, robot, current, target)
+                ):
+                    k += 1  # the robots following from the occupant end in our cell: a rotation
+                    continue
                 occ_next[cell] = robot
                 target[robot] = cell
                 if occupant != NO_AGENT and occupant != robot and target[occupant] == NO_CELL:
@@ -384,19 +434,49 @@ class PIBT:
                     k += 1  # backtrack: the pushed robot could not leave
                     break
 
+    # -- rotations ------------------------------------------------------------------
+
+    def _leads_to(self, first: int, robot: int, current: Sequence[int], target: list[int]) -> bool:
+        """Whether following moves from ``first`` (each robot into the cell of the next) reach ``robot``.
+
+        ``robot`` taking ``first``'s cell would then close a rotation. The walk
+        stops at a robot that stays, has not decided, or moves into a free cell.
+        """
+        occ_now = self._occ_now
+        other, steps = first, len(current)
+        while other != NO_AGENT and steps > 0:
+            if other == robot:
+                return True
+            cell = target[other]
+            if cell == NO_CELL or cell == current[other]:
+                return False
+            other = occ_now[cell]
+            steps -= 1
+        return False
+
+    def _in_cycle(self, robot: int, current: Sequence[int], target: list[int]) -> bool:
+        """Whether ``robot``'s constrained move is part of a rotation among the constrained robots."""
+        cell = target[robot]
+        occupant = self._occ_now[cell]
+        return cell != current[robot] and occupant != NO_AGENT and self._leads_to(occupant, robot, current, target)
+
     # -- swap (LaCAM* engineering, Okumura AAMAS 2024) -----------------------------
 
     def _pull(self, robot: int, pulled: int, current: Sequence[int], target: list[int]) -> None:
         """Move ``pulled`` into the cell ``robot`` leaves, if both are still possible."""
         here = current[robot]
-        if target[pulled] == NO_CELL and self._occ_next[here] == NO_AGENT:
+        if (
+            target[pulled] == NO_CELL
+            and self._occ_next[here] == NO_AGENT
+            and (self.rotations or not self._leads_to(robot, pulled, current, target))
+        ):
             self._occ_next[here] = pulled
             target[pulled] = here
 
     def _swap_agent(self, robot: int, candidates: list[int], current: Sequence[int], target: list[int]) -> int:
         """``is_swap_required_and_possible``: the robot to pull behind ``robot``, or ``NO_AGENT``."""
         occ_now, neighbours, dists = self._occ_now, self._neighbours, self._distances
-        settled = self._settled()
+        settled = self._settled
         best = candidates[0]
         here = current[robot]
         other = occ_now[best]
@@ -419,23 +499,6 @@ class PIBT:
                 ):
                     return other
         return NO_AGENT
-
-    def _settled(self) -> _Settled:
-        return _Settled(self._occ_now, self._goals)
-
-
-class _Settled:
-    """The cells on which a robot stands on its own goal, read from the occupancy list."""
-
-    __slots__ = ("_goals", "_occupied")
-
-    def __init__(self, occupied: list[int], goals: list[int]) -> None:
-        self._occupied = occupied
-        self._goals = goals
-
-    def __contains__(self, cell: object) -> bool:
-        occupant = self._occupied[cell]  # type: ignore[index]
-        return occupant != NO_AGENT and self._goals[occupant] == cell
 
 
 def pibt_step(

@@ -35,6 +35,12 @@ from mrmp.core.heading import Heading, right_turns
 
 NO_CELL = -1
 """No cell (a walk that found no way on)."""
+DEAD_END_PENALTY = 0.5
+"""Added, among equally near cells, to a dead end (a cell with one free neighbour)."""
+SETTLED_PENALTY = 0.25
+"""Added, among equally near cells, to a cell where a robot stands on its own goal."""
+NOISE_SCALE = 0.2
+"""Scale of the random tie-break when tie penalties are on (penalties and noise stay below one move)."""
 
 
 def sorted_candidates(
@@ -42,6 +48,7 @@ def sorted_candidates(
     here: int,
     distances: Sequence[float],
     noise: Callable[[], float] | None = None,
+    settled: Container[int] | None = None,
 ) -> list[int]:
     """A robot's candidate cells at ``here``: its free neighbours, then ``here``, nearest to its goal first.
 
@@ -53,53 +60,100 @@ def sorted_candidates(
     noise adds less than one to a distance counted in whole moves, so a nearer
     cell always comes first and PIBT's progress argument holds.
 
+    Given ``settled`` (the cells where a robot stands on its own goal), *tie
+    penalties* rank equally near cells first: a dead end (one free neighbour)
+    comes after other cells, since a robot pushed into one blocks it and must
+    come back out the same way; and, unless the robot is within one move of
+    its own goal, a settled cell comes after a free one, since taking it pushes
+    a robot off its goal. Staying is never penalised. The exception near the
+    goal keeps two neighbours from trading places for ever: a robot next to its
+    goal must be free to push the robot sitting on it. Penalties plus noise
+    (scaled by :data:`NOISE_SCALE`) stay below one move, so the progress
+    argument holds.
+
     >>> sorted_candidates([(1,), (0, 2), (1,)], 1, [2, 1, 0])
     [2, 1, 0]
     >>> import random
     >>> sorted(sorted_candidates([(1, 2), (0,), (0,)], 0, [1, 0, 0], random.Random(3).random)[:2])
     [1, 2]
+    >>> star = [(1, 2, 3), (0,), (0, 3), (0, 2)]      # 1 is a dead end, 2 is settled
+    >>> sorted_candidates(star, 0, [2, 1, 1, 1], settled={2})
+    [3, 2, 1, 0]
+    >>> sorted_candidates(star, 0, [1, 0, 0, 0], settled={2})  # within one move of the goal: 2 is fair game
+    [2, 3, 1, 0]
     """
     candidates = [*neighbours[here], here]
-    if noise is None:
+    if settled is not None:
+        avoid_settled = distances[here] > 1
+
+        def key(cell: int) -> float:
+            value = distances[cell]
+            if cell != here:
+                if len(neighbours[cell]) == 1:
+                    value += DEAD_END_PENALTY
+                if avoid_settled and cell in settled:
+                    value += SETTLED_PENALTY
+            return value + NOISE_SCALE * noise() if noise is not None else value
+
+        candidates.sort(key=key)
+    elif noise is None:
         candidates.sort(key=distances.__getitem__)
     else:
         candidates.sort(key=lambda cell: distances[cell] + noise())
     return candidates
 
 
-def turn_aware_candidates(
+def heading_candidates(
     neighbours: Sequence[tuple[int, ...]],
     here: int,
-    distances: Sequence[float],
+    table: Sequence[float],
     heading: Heading,
     y_size: int,
+    turn_cost: float,
+    cell_costs: Sequence[float] | None = None,
     noise: Callable[[], float] | None = None,
 ) -> list[int]:
-    """Like :func:`sorted_candidates`, with fewer right turns first among equally near cells.
+    """PIBT's candidate order when turning costs time: by the heading-aware cost to the goal.
 
-    The robot turns only to the right (thesis section 3.5), so facing NORTH a
-    move WEST costs three turns. Distance to the goal stays the first key, so
-    PIBT's progress argument (the top robot always takes a cell nearer its
-    goal) is unchanged.
+    ``table`` is a heading-aware distance table
+    (:func:`mrmp.search.heading_distance.heading_distances`: entry ``4 * cell +
+    heading - 1``). A move into ``n`` in direction ``d`` while facing ``heading``
+    ranks by what the whole way costs through it: ``right_turns(heading, d) *
+    turn_cost + cost(n) + table[n, d]``; staying ranks by ``1 + table[here,
+    heading]`` (a tick of waiting, in cells). The best move's rank is exactly
+    ``table[here, heading]``, less than staying's, so the highest-priority robot,
+    which always gets its first candidate, moves along a cheapest heading-aware way
+    and its cost to the goal drops by at least one cell's cost per step: PIBT's
+    progress argument holds with distances measured in this cost. ``noise`` breaks
+    ties (it must stay below the smallest difference of two costs, as in
+    :func:`sorted_candidates`).
 
-    >>> grid = [(3, 1), (4, 2, 0), (5, 1), (4, 0), (5, 1, 3), (2, 4)]   # Grid(2, 3), flat x * 3 + y
-    >>> to_corner = [3, 2, 1, 2, 1, 0]                                  # goal (1, 2) = flat 5
-    >>> sorted_candidates(grid, 1, to_corner)                         # NORTH (x + 1) listed first
-    [4, 2, 1, 0]
-    >>> turn_aware_candidates(grid, 1, to_corner, Heading.EAST, 3)    # facing EAST: go EAST at once
-    [2, 4, 1, 0]
+    >>> from mrmp.core.grid import Grid
+    >>> from mrmp.search.flat_map import FlatMap
+    >>> from mrmp.search.heading_distance import heading_distances
+    >>> flat = FlatMap(Grid(2, 3))
+    >>> table = heading_distances(flat.grid, (1, 2), turn_cost=0.5)    # goal: the north-east corner
+    >>> [flat.cell(c) for c in heading_candidates(flat.neighbours, flat.index((0, 1)), table, Heading.EAST, 3, 0.5)]
+    [(0, 2), (1, 1), (0, 1), (0, 0)]
+    >>> [flat.cell(c) for c in heading_candidates(flat.neighbours, flat.index((0, 1)), table, Heading.NORTH, 3, 0.5)]
+    [(1, 1), (0, 1), (0, 2), (0, 0)]
+
+    Facing NORTH, going EAST first (one turn now, three later) costs more than waiting.
     """
 
-    def key(cell: int) -> tuple[float, int, float]:
+    def rank(cell: int) -> tuple[float, float]:
         tie = noise() if noise is not None else 0.0
         if cell == here:
-            return distances[cell], 0, tie
+            return round(1.0 + table[4 * here + heading - 1], 9), tie
         hx, hy = divmod(here, y_size)
         cx, cy = divmod(cell, y_size)
-        return distances[cell], right_turns(heading, Heading.between((hx, hy), (cx, cy))), tie
+        moving = Heading.between((hx, hy), (cx, cy))
+        entry = cell_costs[cell] if cell_costs is not None else 1.0
+        # rounded, so that equal costs summed in another order still tie
+        return round(right_turns(heading, moving) * turn_cost + entry + table[4 * cell + moving - 1], 9), tie
 
     candidates = [*neighbours[here], here]
-    candidates.sort(key=key)
+    candidates.sort(key=rank)
     return candidates
 
 

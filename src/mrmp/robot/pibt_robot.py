@@ -58,12 +58,12 @@ and steps into the bay.
 >>> b = PibtRobot(1, flat.index((0, 1)), flat.index((0, 0)), flat, tie=1)
 >>> beacons = a.begin_step(1) + b.begin_step(1)
 >>> for sent in beacons:
-...     (b if sent.message.sender == 0 else a).receive(sent.message)
+...     asks = (b if sent.message.sender == 0 else a).receive(sent.message)
 >>> sent = a.start()
 >>> [type(item.message).__name__ for item in sent]
 ['ReserveMessage', 'InheritMessage']
->>> for item in sent:
-...     b.receive(item.message)
+>>> [b.receive(item.message) for item in sent]   # the reservation informs; the inheritance asks
+[False, True]
 >>> [type(item.message).__name__ for item in b.act()]
 ['ReserveMessage', 'AnswerMessage']
 >>> flat.cell(b.target)
@@ -74,10 +74,10 @@ from __future__ import annotations
 
 import random
 from collections import Counter
-from dataclasses import dataclass
+from typing import NamedTuple
 
 from mrmp.core.heading import Heading
-from mrmp.policies.pibt_rules import sorted_candidates, swap_possible, swap_required, turn_aware_candidates
+from mrmp.policies.pibt_rules import heading_candidates, sorted_candidates, swap_possible, swap_required
 from mrmp.protocol.messages import (
     AnswerMessage,
     BeaconMessage,
@@ -96,27 +96,12 @@ RESERVE_RADIUS = 2
 """Reservations go to every robot within 2 cells: all that could want the cell, or push the sender."""
 
 
-@dataclass(frozen=True, slots=True)
-class Transmission:
+class Transmission(NamedTuple):
     """A message to send: to robot ``recipient``, or (``recipient`` None) to every robot within ``radius`` cells."""
 
     message: PibtMessage
     recipient: int | None = None
     radius: int = 0
-
-
-class _Settled:
-    """The cells, as far as the robot heard, on which a robot stands on its own goal."""
-
-    __slots__ = ("_goals", "_occupants")
-
-    def __init__(self, occupants: dict[int, int], goals: dict[int, int]) -> None:
-        self._occupants = occupants
-        self._goals = goals
-
-    def __contains__(self, cell: object) -> bool:
-        occupant = self._occupants.get(cell)  # type: ignore[call-overload]
-        return occupant is not None and self._goals.get(occupant) == cell
 
 
 class PibtRobot:
@@ -139,12 +124,22 @@ class PibtRobot:
     swap:
         Use the swap technique (LaCAM* engineering, Okumura AAMAS 2024).
     heading_aware:
-        Among equally near candidate cells, prefer fewer right turns.
+        Turning costs time: rank candidate cells by the heading-aware cost to the goal
+        (:meth:`~mrmp.search.flat_map.FlatMap.heading_distances`, right turns costing
+        ``turn_cost`` each; :func:`~mrmp.policies.pibt_rules.heading_candidates`).
+    turn_cost:
+        With ``heading_aware``: one right turn's cost in cells (``turn_time / cell_time``).
     rng:
         Breaks ties between equally near cells at random, as pypibt does
         (without it PIBT often cycles forever in crowds). None keeps the plain
         neighbour order of the central generator, which makes decisions
         reproducible by hand.
+    tie_penalties:
+        Rank equally near cells by the tie penalties of
+        :func:`~mrmp.policies.pibt_rules.sorted_candidates` (dead ends last;
+        cells of robots standing on their goals after free ones) before the
+        random tie-break (not with ``heading_aware``, which ranks by its own costs). None
+        (the default) turns them on exactly when ``rng`` is given.
     """
 
     def __init__(
@@ -159,7 +154,9 @@ class PibtRobot:
         radius: int = MIN_RADIUS,
         swap: bool = True,
         heading_aware: bool = False,
+        turn_cost: float = 0.5,
         rng: random.Random | None = None,
+        tie_penalties: bool | None = None,
     ) -> None:
         if radius < MIN_RADIUS:
             raise ValueError(f"radius {radius} is below {MIN_RADIUS}: robots two cells apart could take the same cell")
@@ -172,7 +169,9 @@ class PibtRobot:
         self.radius = radius
         self.swap = swap
         self.heading_aware = heading_aware
+        self.turn_cost = turn_cost
         self._noise = rng.random if rng is not None else None
+        self.tie_penalties = rng is not None if tie_penalties is None else tie_penalties
         self.elapsed = 0
         self.step = 0
         self.seq = 0
@@ -185,6 +184,9 @@ class PibtRobot:
         self._targets: dict[int, int] = {}
         self._seen: set[tuple[int, int]] = set()
         self._control: list[PibtMessage] = []
+        self._settled: set[int] = set()  # cells where, as far as the robot heard, a robot stands on its own goal
+        self._table_goal = -1  # the goal of ``_distances``
+        self._distances: list[float] = []
         # the robot's own PIBT call, while it runs
         self._candidates: list[int] = []
         self._next = 0
@@ -226,35 +228,78 @@ class PibtRobot:
         self._targets = {}
         self._seen = set()
         self._control = []
-        x, y = divmod(self.goal, self.flat.y_size)
-        px, py = divmod(self.present, self.flat.y_size)
-        beacon = BeaconMessage(self.index, self._seq(), step, (px, py), (x, y), self.elapsed, self.tie, self.heading)
+        self._settled = {self.present} if self.present == self.goal else set()
+        cells = self.flat.cells
+        self.seq += 1
+        beacon = BeaconMessage(
+            self.index, self.seq, step, cells[self.present], cells[self.goal], self.elapsed, self.tie, self.heading
+        )
         return [Transmission(beacon, None, self.radius)]
 
-    def receive(self, message: PibtMessage) -> None:
+    def receive(self, message: PibtMessage) -> bool:
         """Take in a message delivered this round; act on it in :meth:`act`.
 
         Messages of another step and second copies are dropped and counted.
+        Returns whether the message waits for :meth:`act` (a request or an
+        answer; beacons and reservations only inform), so that a driver may
+        skip :meth:`act` for robots that only heard beacons and reservations.
         """
         if message.step != self.step:
             self.dropped["stale"] += 1
-            return
+            return False
         key = (message.sender, message.seq)
-        if key in self._seen:
+        seen = self._seen
+        if key in seen:
             self.dropped["duplicate"] += 1
-            return
-        self._seen.add(key)
+            return False
+        seen.add(key)
+        return self.receive_once(message)
+
+    def receive_once(self, message: PibtMessage) -> bool:
+        """:meth:`receive` for a driver that delivers every message exactly once, in its step (a perfect network).
+
+        The same effect and answer, without the checks for stale messages and
+        second copies, which such a driver never delivers.
+        """
+        sender = message.sender
         kind = type(message)
         if kind is BeaconMessage:
-            flat = self.flat
-            self._occupants[flat.index(message.present)] = message.sender  # type: ignore[union-attr]
-            self._goals[message.sender] = flat.index(message.goal)  # type: ignore[union-attr]
-        elif kind is ReserveMessage:
-            cell = self.flat.index(message.cell)  # type: ignore[union-attr]
-            self._reserved[cell] = message.sender
-            self._targets[message.sender] = cell
-        else:
-            self._control.append(message)
+            y_size = self.flat.y_size
+            x, y = message.present  # type: ignore[union-attr]
+            cell = x * y_size + y
+            self._occupants[cell] = sender
+            x, y = message.goal  # type: ignore[union-attr]
+            goal = self._goals[sender] = x * y_size + y
+            if cell == goal:
+                self._settled.add(cell)
+            return False
+        if kind is ReserveMessage:
+            x, y = message.cell  # type: ignore[union-attr]
+            cell = x * self.flat.y_size + y
+            self._reserved[cell] = sender
+            self._targets[sender] = cell
+            return False
+        self._control.append(message)
+        return True
+
+    def receive_beacons(self, beacons: list[BeaconMessage]) -> None:
+        """Take in this step's beacons, each delivered exactly once (a perfect network), in one call.
+
+        The effect of one :meth:`receive` call per beacon, without the checks
+        for stale messages and second copies, which a perfect network never
+        delivers: the simulator delivers the beacon round this way.
+        """
+        occupants, goals, settled = self._occupants, self._goals, self._settled
+        y_size = self.flat.y_size
+        for message in beacons:
+            sender = message.sender
+            x, y = message.present
+            cell = x * y_size + y
+            occupants[cell] = sender
+            x, y = message.goal
+            goal = goals[sender] = x * y_size + y
+            if cell == goal:
+                settled.add(cell)
 
     def act(self) -> list[Transmission]:
         """Act on the requests and answers of this round; return what to send."""
@@ -300,7 +345,8 @@ class PibtRobot:
         """Move to the reserved cell (or stay, when undecided); update heading and priority; return the cell."""
         target = self.target if self.target is not None else self.present
         if target != self.present:
-            self.heading = Heading.between(self.flat.cell(self.present), self.flat.cell(target))
+            cells = self.flat.cells
+            self.heading = Heading.between(cells[self.present], cells[target])
         self.present = target
         self.elapsed = 0 if target == self.goal else self.elapsed + 1
         return target
@@ -311,18 +357,30 @@ class PibtRobot:
         self.target = cell
         self._reserved[cell] = self.index
         self._targets[self.index] = cell
-        x, y = divmod(cell, self.flat.y_size)
-        out.append(Transmission(ReserveMessage(self.index, self._seq(), self.step, (x, y)), None, RESERVE_RADIUS))
+        self.seq += 1
+        out.append(Transmission(ReserveMessage(self.index, self.seq, self.step, self.flat.cells[cell]), None, RESERVE_RADIUS))
 
     def _begin_call(self, out: list[Transmission]) -> None:
         flat = self.flat
-        distances = flat.distances(self.goal)
+        if self._table_goal != self.goal:  # the goal changes in lifelong runs
+            self._distances = flat.distances(self.goal)
+            self._table_goal = self.goal
+        distances = self._distances
         if self.heading_aware:
-            candidates = turn_aware_candidates(
-                flat.neighbours, self.present, distances, self.heading, flat.y_size, self._noise
+            candidates = heading_candidates(
+                flat.neighbours,
+                self.present,
+                flat.heading_distances(self.goal, self.turn_cost),
+                self.heading,
+                flat.y_size,
+                self.turn_cost,
+                flat.entry_costs,
+                self._noise,
             )
         else:
-            candidates = sorted_candidates(flat.neighbours, self.present, distances, self._noise)
+            candidates = sorted_candidates(
+                flat.neighbours, self.present, distances, self._noise, self._settled if self.tie_penalties else None
+            )
         self._pulled = None
         if self.swap:
             self._pulled = self._swap_partner(candidates, distances)
@@ -371,7 +429,7 @@ class PibtRobot:
         """``is_swap_required_and_possible`` on what the robot heard: the robot to pull, or None."""
         flat = self.flat
         neighbours, occupants, targets, goals = flat.neighbours, self._occupants, self._targets, self._goals
-        settled = _Settled(occupants, goals)
+        settled = self._settled
         here = self.present
         best = candidates[0]
         other = occupants.get(best)

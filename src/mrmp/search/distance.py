@@ -399,7 +399,9 @@ def _flat_grid(grid: SizedGridMap, cache: bool) -> _FlatGrid:
     with _GRIDS_LOCK:
         _GRIDS[grid] = flat
         while len(_GRIDS) > _GRID_CACHE_SIZE:
-            _GRIDS.popitem(last=False)
+            _, evicted = _GRIDS.popitem(last=False)
+            with evicted.lock:  # its tables point back at it: break the cycle, so it is freed at once
+                evicted.tables.clear()
     return flat
 
 

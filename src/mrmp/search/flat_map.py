@@ -5,7 +5,8 @@ Cells are flat indices ``x * y_size + y``; ``neighbours[i]`` lists the free
 gives, for one goal, the cost of reaching it from every flat cell (entry costs
 respected: breadth-first search, or label-correcting search with costs, see
 :mod:`mrmp.search.distance`), as a plain list for fast indexing, computed
-once per goal and kept. The time spent computing them is counted in
+once per goal and kept; :meth:`FlatMap.heading_distances` does the same for the
+heading-aware tables (turns cost time). The time spent computing them is counted in
 :attr:`FlatMap.table_seconds`.
 
 A table is a pure function of the map and the goal, so a fleet simulated in one
@@ -33,6 +34,7 @@ import time
 from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
 from mrmp.search.distance import distance_table
+from mrmp.search.heading_distance import heading_distances
 
 __all__ = ["FlatMap"]
 
@@ -40,7 +42,7 @@ __all__ = ["FlatMap"]
 class FlatMap:
     """A grid's flat form and its distance lists, computed on demand (module docstring)."""
 
-    __slots__ = ("_tables", "grid", "neighbours", "table_seconds", "y_size")
+    __slots__ = ("_heading_tables", "_tables", "cells", "entry_costs", "grid", "neighbours", "table_seconds", "y_size")
 
     def __init__(self, grid: Grid) -> None:
         self.grid = grid
@@ -51,7 +53,12 @@ class FlatMap:
             for x in range(grid.x_size)
             for y in range(y_size)
         ]
+        # the cell of every flat index (``cells[i] == cell(i)``), for lookups in hot loops
+        self.cells: list[Cell] = [(x, y) for x in range(grid.x_size) for y in range(y_size)]
+        # the entry cost of every flat cell, or None when every cell costs 1
+        self.entry_costs: list[float] | None = [grid.cost(cell) for cell in self.cells] if grid.costs() else None
         self._tables: dict[int, list[float]] = {}
+        self._heading_tables: dict[tuple[int, float], list[float]] = {}
         self.table_seconds = 0.0
 
     def index(self, cell: Cell) -> int:
@@ -60,8 +67,7 @@ class FlatMap:
 
     def cell(self, index: int) -> Cell:
         """The cell of flat index ``index``."""
-        x, y = divmod(index, self.y_size)
-        return (x, y)
+        return self.cells[index]
 
     def distances(self, goal: int) -> list[float]:
         """For every flat cell, the cost to reach the flat cell ``goal`` (``inf`` where it cannot)."""
@@ -73,7 +79,26 @@ class FlatMap:
             self._tables[goal] = table
         return table
 
+    def heading_distances(self, goal: int, turn_cost: float) -> list[float]:
+        """For every state (flat cell ``i``, heading ``h``), at ``4 * i + h - 1``, the heading-aware
+        cost to reach the flat cell ``goal`` when a right turn costs ``turn_cost``
+        (:func:`~mrmp.search.heading_distance.heading_distances`), computed once per goal and kept.
+
+        >>> from mrmp.core.grid import Grid
+        >>> flat = FlatMap(Grid(1, 3))
+        >>> flat.heading_distances(2, 0.5)[:4]    # from (0, 0) facing NORTH, EAST, SOUTH, WEST
+        [2.5, 2.0, 3.5, 3.0]
+        """
+        key = (goal, turn_cost)
+        table = self._heading_tables.get(key)
+        if table is None:
+            started = time.perf_counter()
+            table = heading_distances(self.grid, self.cell(goal), turn_cost)
+            self.table_seconds += time.perf_counter() - started
+            self._heading_tables[key] = table
+        return table
+
     @property
     def tables_computed(self) -> int:
-        """How many goals have a distance list."""
-        return len(self._tables)
+        """How many distance lists have been computed (per goal; heading-aware ones counted apart)."""
+        return len(self._tables) + len(self._heading_tables)

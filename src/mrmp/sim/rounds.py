@@ -42,10 +42,12 @@ Examples
 
 from __future__ import annotations
 
+import gc
 import random
 import time
 from collections import Counter
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from operator import attrgetter
 
 from mrmp.core.heading import right_turns
 from mrmp.core.faults import message_fates
@@ -63,6 +65,8 @@ __all__ = ["MAX_TRIES", "RoundsSimulator", "message_size"]
 
 MAX_TRIES = 64
 """Tries of one message before its link counts as cut and the step is abandoned."""
+NO_ROBOT = -1
+"""No robot on a cell."""
 
 _SIZES = {
     kind: len(encode(sample))
@@ -103,10 +107,22 @@ class RoundsSimulator:
         (:class:`~mrmp.robot.pibt_robot.PibtRobot`'s ``rng``); ``False`` keeps
         the plain neighbour order, as :class:`mrmp.centralized.pibt_step.PIBT`
         without ``rng`` does.
+    on_tick:
+        Called at the end of every tick with the tick and the robots' cells.
+    tie_penalties:
+        The robots' tie penalties (:class:`~mrmp.robot.pibt_robot.PibtRobot`);
+        None turns them on with ``random_ties``.
     """
 
-    def __init__(self, scenario: Scenario, random_ties: bool = True) -> None:
+    def __init__(
+        self,
+        scenario: Scenario,
+        random_ties: bool = True,
+        on_tick: Callable[[int, list[tuple[int, int]]], None] | None = None,
+        tie_penalties: bool | None = None,
+    ) -> None:
         self.scenario = scenario
+        self.on_tick = on_tick
         options = scenario.policy
         grid = scenario.grid
         self.flat = FlatMap(grid)
@@ -127,7 +143,9 @@ class RoundsSimulator:
                     radius=options.radius,
                     swap=options.swap,
                     heading_aware=options.heading_aware,
+                    turn_cost=scenario.timing.turn_time / scenario.timing.cell_time,
                     rng=random.Random(scenario.seed * 7919 + index) if random_ties else None,
+                    tie_penalties=tie_penalties,
                 )
             )
         self.referee = Referee(grid, [spec.id for spec in scenario.robots])
@@ -145,7 +163,8 @@ class RoundsSimulator:
         self._links = {(index_of[link.sender], index_of[link.recipient]): link.faults for link in scenario.links}
         self._perfect = scenario.network.is_perfect and not self._links
         self._near: dict[int, list[tuple[int, ...] | None]] = {}
-        self._occupant: dict[int, int] = {}
+        self._occupant: list[int] = []  # robot on every flat cell this step, NO_ROBOT where none
+        self._receivers = [robot.receive_once for robot in self.robots]  # the perfect network's deliveries
         self._group_of: list[int] = []
         self.stats: Counter[str] = Counter()
         self._goals = GoalBook(scenario.seed, grid.free_cells() if scenario.lifelong else [])
@@ -164,11 +183,19 @@ class RoundsSimulator:
     # -- the run ---------------------------------------------------------------------
 
     def run(self) -> RunResult:
-        """Run to the end and return the result (partial on Ctrl-C)."""
+        """Run to the end and return the result (partial on Ctrl-C).
+
+        Python's cyclic garbage collector is paused meanwhile (and restored
+        after): a step makes thousands of short-lived containers (the robots'
+        views, the messages) and no reference cycles, so reference counting
+        frees them all, and the collector's passes over them only cost time.
+        """
         started = time.perf_counter()
         robots = self.robots
         self.referee.check_start([spec.start for spec in self.scenario.robots])
         stop_reason = "time up" if self.scenario.lifelong else "tick limit"
+        collecting = gc.isenabled()
+        gc.disable()
         try:
             while self.tick < self.max_ticks:
                 if not self.scenario.lifelong and all(robot.at_goal for robot in robots):
@@ -180,6 +207,9 @@ class RoundsSimulator:
                     stop_reason = "all arrived"
         except KeyboardInterrupt:
             stop_reason = "interrupted"
+        finally:
+            if collecting:
+                gc.enable()
         return self._result(stop_reason, time.perf_counter() - started)
 
     def step(self) -> None:
@@ -187,18 +217,28 @@ class RoundsSimulator:
         self.step_count += 1
         step = self.step_count
         robots = self.robots
-        self._occupant = {robot.present: robot.index for robot in robots}
+        occupant = self._occupant = [NO_ROBOT] * len(self.flat.neighbours)
+        for robot in robots:
+            occupant[robot.present] = robot.index
         if not self._perfect:
             self._group_of = self._groups()
         outbox = [(robot.index, sent) for robot in robots for sent in robot.begin_step(step)]
         try:
-            extra = self._rounds(outbox)
+            extra = 0 if self._perfect and self._beacon_round(outbox) else self._rounds(outbox)
             group_time: Counter[int] = Counter()
-            for robot in sorted(robots, key=PibtRobot.priority.fget, reverse=True):  # type: ignore[arg-type]
-                if robot.target is None:
-                    spent = self._rounds([(robot.index, sent) for sent in robot.start()])
-                    if spent:
-                        group_time[self._group_of[robot.index]] += spent
+            # highest priority first: ``(elapsed, tie, -index)`` descending (a stable sort keeps index order)
+            order = sorted(robots, key=attrgetter("elapsed", "tie"), reverse=True)
+            rounds = self._rounds
+            if self._perfect:  # rounds take no time
+                for robot in order:
+                    if robot.target is None:
+                        rounds([(robot.index, sent) for sent in robot.start()])
+            else:
+                for robot in order:
+                    if robot.target is None:
+                        spent = rounds([(robot.index, sent) for sent in robot.start()])
+                        if spent:
+                            group_time[self._group_of[robot.index]] += spent
             extra += max(group_time.values(), default=0)
             abandoned = False
         except _CutLink:
@@ -217,25 +257,33 @@ class RoundsSimulator:
         self.tick += 1
         robots = self.robots
         flat = self.flat
+        cells = flat.cells
         timing = self.scenario.timing
         grid = self.scenario.grid
-        before = [flat.cell(robot.present) for robot in robots]
+        cost = grid.cost if grid.has_costs else None
+        cell_time, turn_time = timing.cell_time, timing.turn_time
+        results, durations = self._results, self._durations
+        before = [cells[robot.present] for robot in robots]
         for robot in robots:
-            result = self._results[robot.index]
+            index = robot.index
+            result = results[index]
             heading = robot.heading
-            duration = timing.cell_time
+            duration = cell_time
             if moves:
                 was = robot.present
                 robot.finish_step()
                 if robot.present != was:
                     turns = right_turns(heading, robot.heading)
                     result.turns += turns
-                    duration = turns * timing.turn_time + timing.cell_time * grid.cost(flat.cell(robot.present))
-            result.path.append(flat.cell(robot.present))
+                    entry = cell_time * cost(cells[robot.present]) if cost is not None else cell_time
+                    duration = turns * turn_time + entry
+            result.path.append(cells[robot.present])
             result.headings.append(robot.heading)
-            self._durations[robot.index].append(duration)
-        self.referee.check_tick(self.tick, before, [flat.cell(robot.present) for robot in robots])
+            durations[index].append(duration)
+        self.referee.check_tick(self.tick, before, [cells[robot.present] for robot in robots])
         self._count_goals()
+        if self.on_tick is not None:
+            self.on_tick(self.tick, [flat.cell(robot.present) for robot in robots])
 
     def _count_goals(self) -> None:
         """Count goals reached; in a lifelong run, hand each such robot a new goal (drawn with the seed)."""
@@ -254,30 +302,114 @@ class RoundsSimulator:
     # -- rounds ------------------------------------------------------------------------
 
     def _within(self, cell: int, radius: int) -> tuple[int, ...]:
-        """The flat cells within ``radius`` (Manhattan) of ``cell``, itself excluded."""
+        """The free flat cells within ``radius`` (Manhattan) of ``cell``, itself excluded (cached per cell)."""
         table = self._near.get(radius)
         if table is None:
             table = self._near[radius] = [None] * len(self.flat.neighbours)
         cells = table[cell]
         if cells is None:
-            grid = self.scenario.grid
-            x, y = self.flat.cell(cell)
-            cells = tuple(
-                self.flat.index((x + dx, y + dy))
-                for dx in range(-radius, radius + 1)
-                for dy in range(-radius + abs(dx), radius - abs(dx) + 1)
-                if (dx or dy) and grid.in_bounds((x + dx, y + dy))
-            )
-            table[cell] = cells
+            cells = table[cell] = self._cells_within(cell, radius)
         return cells
 
+    def _cells_within(self, cell: int, radius: int) -> tuple[int, ...]:
+        grid = self.scenario.grid
+        x, y = self.flat.cell(cell)
+        return tuple(
+            self.flat.index((x + dx, y + dy))
+            for dx in range(-radius, radius + 1)
+            for dy in range(-radius + abs(dx), radius - abs(dx) + 1)
+            if (dx or dy) and grid.in_bounds((x + dx, y + dy)) and grid.is_free((x + dx, y + dy))
+        )
+
     def _rounds(self, outbox: list[tuple[int, Transmission]]) -> int:
-        """Run rounds until no message is in flight; return the ticks they took."""
+        """Run rounds until no message is in flight; return the ticks they took.
+
+        A robot acts in a round when it was sent something in the round
+        before; robots that heard only beacons and reservations (which ask
+        nothing of them) are skipped, in the same order, so decisions and
+        counts are those of calling every recipient.
+        """
+        if not self._perfect:
+            return self._faulty_rounds(outbox)
+        robots = self.robots
+        receivers = self._receivers
+        results = self._results
+        occupant = self._occupant
+        near = self._near
+        sizes = _SIZES
+        rounds = 0
+        while outbox:
+            rounds += 1
+            acting: dict[int, None] = {}
+            ready: set[int] = set()
+            for sender, (message, recipient, radius) in outbox:
+                result = results[sender]
+                if recipient is not None:
+                    result.messages_sent += 1
+                    result.bytes_sent += sizes[type(message)]
+                    acting[recipient] = None
+                    if receivers[recipient](message):
+                        ready.add(recipient)
+                    continue
+                present = robots[sender].present
+                table = near.get(radius)
+                cells = table[present] if table is not None else None
+                if cells is None:
+                    cells = self._within(present, radius)
+                recipients = [other for cell in cells if (other := occupant[cell]) != NO_ROBOT]
+                result.messages_sent += len(recipients)
+                result.bytes_sent += sizes[type(message)] * len(recipients)
+                for recipient in recipients:
+                    acting[recipient] = None
+                    if receivers[recipient](message):
+                        ready.add(recipient)
+            if not ready:
+                break
+            outbox = [(index, sent) for index in acting if index in ready for sent in robots[index].act()]
+        self.stats["rounds"] += rounds
+        return 0
+
+    def _beacon_round(self, outbox: list[tuple[int, Transmission]]) -> bool:
+        """The beacon round over a perfect network, one call per recipient; False (nothing done) if it does not apply.
+
+        Applies when every robot broadcasts one beacon with the same radius:
+        "within the radius" is then symmetric, so the robots a robot hears are
+        those that hear it, and each robot's messages sent equal those it receives.
+        """
+        robots = self.robots
+        if len(outbox) != len(robots) or not outbox:
+            return False
+        radius = outbox[0][1].radius
+        beacons: list[BeaconMessage] = []
+        for index, (sender, (message, recipient, sent_radius)) in enumerate(outbox):
+            if sender != index or recipient is not None or sent_radius != radius or type(message) is not BeaconMessage:
+                return False
+            beacons.append(message)
+        occupant = self._occupant
+        results = self._results
+        size = _SIZES[BeaconMessage]
+        within = self._within
+        table = self._near.get(radius)
+        for robot in robots:
+            cells = table[robot.present] if table is not None else None
+            if cells is None:
+                cells = within(robot.present, radius)
+                table = self._near[radius]
+            heard = [beacons[other] for cell in cells if (other := occupant[cell]) != NO_ROBOT]
+            result = results[robot.index]
+            result.messages_sent += len(heard)
+            result.bytes_sent += size * len(heard)
+            if heard:
+                robot.receive_beacons(heard)
+        self.stats["rounds"] += 1
+        return True
+
+    def _faulty_rounds(self, outbox: list[tuple[int, Transmission]]) -> int:
+        """:meth:`_rounds` over faulty links: every try drawn by :meth:`_link`."""
         robots = self.robots
         results = self._results
         occupant = self._occupant
         stats = self.stats
-        perfect = self._perfect
         spent = 0
         while outbox:
             stats["rounds"] += 1
@@ -290,23 +422,20 @@ class RoundsSimulator:
                     recipients: Sequence[int] = (sent.recipient,)
                 else:
                     recipients = [
-                        occupant[cell]
+                        other
                         for cell in self._within(robots[sender].present, sent.radius)
-                        if cell in occupant
+                        if (other := occupant[cell]) != NO_ROBOT
                     ]
                 size = _SIZES[type(message)]
                 result = results[sender]
                 result.messages_sent += len(recipients)
                 result.bytes_sent += size * len(recipients)
                 for recipient in recipients:
-                    if perfect:
+                    latency, copies, held = self._link(sender, recipient)
+                    round_time = max(round_time, latency)
+                    for _ in range(copies - held):
                         robots[recipient].receive(message)  # type: ignore[arg-type]
-                    else:
-                        latency, copies, held = self._link(sender, recipient)
-                        round_time = max(round_time, latency)
-                        for _ in range(copies - held):
-                            robots[recipient].receive(message)  # type: ignore[arg-type]
-                        late.extend((recipient, message) for _ in range(held))
+                    late.extend((recipient, message) for _ in range(held))
                     acting[recipient] = None
             for recipient, message in late:  # copies held back arrive last in the round
                 robots[recipient].receive(message)  # type: ignore[arg-type]
@@ -367,8 +496,8 @@ class RoundsSimulator:
         occupant = self._occupant
         for robot in self.robots:
             for cell in self._within(robot.present, RESERVE_RADIUS):
-                other = occupant.get(cell)
-                if other is not None:
+                other = occupant[cell]
+                if other != NO_ROBOT:
                     parent[root(other)] = root(robot.index)
         return [root(index) for index in range(len(self.robots))]
 

@@ -28,10 +28,16 @@ def random_scenario(seed, swap, radius=2, faults=NetworkFaults()):
     return Scenario(grid, robots, network=faults, policy=PolicyOptions(name="pibt", radius=radius, swap=swap), seed=seed)
 
 
-def central_next(simulator, swap):
+def central_next(simulator, swap, tie_penalties=False):
     robots = simulator.robots
     flat = simulator.flat
-    pibt = PIBT(flat.neighbours, [flat.distances(robot.goal) for robot in robots], [robot.goal for robot in robots], swap=swap)
+    pibt = PIBT(
+        flat.neighbours,
+        [flat.distances(robot.goal) for robot in robots],
+        [robot.goal for robot in robots],
+        swap=swap,
+        tie_penalties=tie_penalties,
+    )
     order = [robot.index for robot in sorted(robots, key=lambda robot: robot.priority, reverse=True)]
     return pibt.step([robot.present for robot in robots], order)
 
@@ -56,6 +62,38 @@ def test_radius_two_without_swap_is_exact(seed):
         expected = central_next(simulator, swap=False)
         simulator.step()
         assert [robot.present for robot in simulator.robots] == expected
+
+
+@pytest.mark.parametrize(("swap", "radius"), [(False, 2), (False, 32), (True, 32)])  # swap walks may leave radius 2
+@pytest.mark.parametrize("seed", range(20))
+def test_tie_penalties_are_applied_alike_by_robots_and_central_pibt(seed, swap, radius):
+    simulator = RoundsSimulator(random_scenario(seed, swap, radius=radius), random_ties=False, tie_penalties=True)
+    for _ in range(30):
+        expected = central_next(simulator, swap, tie_penalties=True)
+        simulator.step()
+        assert [robot.present for robot in simulator.robots] == expected
+    assert simulator.referee.collisions == []
+
+
+def test_tie_penalties_change_decisions():
+    changed = 0
+    for seed in range(10):
+        simulator = RoundsSimulator(random_scenario(seed, swap=True), random_ties=False, tie_penalties=True)
+        for _ in range(15):
+            changed += central_next(simulator, True, tie_penalties=True) != central_next(simulator, True)
+            simulator.step()
+    assert changed > 0
+
+
+def test_a_robot_passes_by_a_robot_standing_on_its_goal():
+    # from (0, 0) to (2, 2): (1, 0) and (0, 1) are equally near; a robot stands on its goal (1, 0)
+    flat = FlatMap(Grid(3, 3))
+    for tie_penalties, expected in ((False, (1, 0)), (True, (0, 1))):
+        robot = PibtRobot(0, flat.index((0, 0)), flat.index((2, 2)), flat, tie_penalties=tie_penalties)
+        robot.begin_step(1)
+        assert not robot.receive(BeaconMessage(1, 1, 1, (1, 0), (1, 0), 0, 0))
+        robot.start()
+        assert flat.cell(robot.target) == expected  # the plain order (NORTH first) would push it off
 
 
 @pytest.mark.parametrize("seed", range(20))
@@ -130,3 +168,43 @@ def test_lifelong_pibt_keeps_reaching_new_goals():
     assert result.stop_reason == "time up" and result.collisions == []
     assert sum(robot.goals_reached for robot in result.robots) > 2 * len(result.robots)
     assert result.throughput > 0
+
+
+def test_a_run_leaves_no_garbage_cycles_and_restores_the_collector():
+    import gc
+
+    scenario = random_scenario(3, swap=True, faults=NetworkFaults(loss=0.2, delay_max=1, duplicate=0.1, reorder=0.2))
+    gc.collect()
+    result = RoundsSimulator(scenario.with_changes(max_ticks=10**4)).run()
+    assert gc.isenabled()
+    gc.set_debug(gc.DEBUG_SAVEALL)  # keep what the collector finds, to look at it
+    try:
+        gc.collect()
+        ours = [item for item in gc.garbage if type(item).__module__.startswith("mrmp")]
+    finally:
+        gc.set_debug(0)
+        gc.garbage.clear()
+    assert ours == []  # the collector was paused during the run: nothing of the run needed it
+    assert result.collisions == []
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_heading_aware_robot_alone_takes_a_cheapest_turning_way(seed):
+    """Alone, a heading-aware robot descends its heading-aware table: its time equals heading-aware A*'s cost."""
+    from mrmp.core.heading import HEADINGS
+    from mrmp.core.scenario import Timing
+    from mrmp.search import astar
+
+    rng = random.Random(seed)
+    base = random_scenario(seed, swap=False)
+    free = sorted(max(connected_regions(base.grid, base.grid.free_cells())[1], key=len))
+    start, goal = rng.sample(free, 2)
+    heading = rng.choice(HEADINGS)
+    timing = Timing(1.0, 0.5)
+    scenario = Scenario(
+        base.grid, (RobotSpec("A", start, goal, heading=heading),), timing=timing,
+        policy=PolicyOptions(name="pibt", heading_aware=True, swap=False), seed=seed,
+    )  # fmt: skip
+    result = RoundsSimulator(scenario).run()
+    assert result.success
+    assert result.robots[0].time_s == pytest.approx(astar(base.grid, start, goal, heading=heading, timing=timing).cost)
