@@ -28,25 +28,21 @@ ground truth) to the results folder, including on interruption.
 
 from __future__ import annotations
 
-import queue
-import random
-import threading
 import time
-from collections import Counter
 from collections.abc import Callable
-from dataclasses import dataclass, field
 from enum import Enum
-from typing import Any
 
 from mrmp.core.cell import Cell
 from mrmp.core.scenario import Scenario
 from mrmp.live.body import Body
-from mrmp.live.transport import FaultyTransport, Transport
+from mrmp.live.driver import AgentReport, AgentTiming, LiveDriver
+from mrmp.live.transport import Transport
 from mrmp.policies.base import Policy
 from mrmp.policies.registry import make_policy
 from mrmp.protocol.auth import Opener, Sealer
-from mrmp.protocol.messages import Message
 from mrmp.robot.robot import Outgoing, Robot
+
+__all__ = ["Agent", "AgentReport", "AgentTiming", "Phase"]
 
 
 class Phase(Enum):
@@ -58,80 +54,19 @@ class Phase(Enum):
     PAUSE = "stays this step; announces again after a pause"
 
 
-@dataclass(frozen=True)
-class AgentTiming:
-    """Real-time settings of a live robot, in seconds of wall-clock time."""
-
-    listen_time: float = 0.05
-    heartbeat: float = 0.2
-    claim_retry: float = 0.15
-    claim_timeout: float = 1.0
-    silence_timeout: float = 1.5
-    give_up_after: float = 3.0
-    linger: float = 0.6
-    poll: float = 0.004
-    timeout: float = 120.0
-    start_wait: float = 15.0
-
-
-@dataclass
-class AgentReport:
-    """What one robot did in a live run (written to ``agent-<index>.json``)."""
-
-    robot: str
-    index: int
-    start: Cell
-    goal: Cell
-    arrived: bool = False
-    arrival_time: float | None = None
-    stop_reason: str = "running"
-    started_at: float = 0.0
-    ended_at: float = 0.0
-    believed_path: list[tuple[float, Cell]] = field(default_factory=list)
-    turns: int = 0
-    steps: int = 0
-    messages_sent: int = 0
-    bytes_sent: int = 0
-    datagrams_sent: int = 0
-    messages_received: int = 0
-    rejected: dict[str, int] = field(default_factory=dict)
-    faults: dict[str, int] = field(default_factory=dict)
-    safety: dict[str, int] = field(default_factory=dict)
-    decision_latency: list[float] = field(default_factory=list)
-    silent_peers: list[int] = field(default_factory=list)
-    missed_lines: int = 0
-
-    def as_dict(self) -> dict[str, Any]:
-        """A JSON-ready copy."""
-        data = dict(self.__dict__)
-        data["start"], data["goal"] = list(self.start), list(self.goal)
-        data["believed_path"] = [[t, list(cell)] for t, cell in self.believed_path]
-        return data
-
-
-class Agent:
+class Agent(LiveDriver):
     """Runs one robot in real time (see the module docstring).
+
+    The parameters ``scenario``, ``index``, ``transport``, ``body``,
+    ``sealer``, ``opener``, ``timing`` and ``clock`` are those of
+    :class:`~mrmp.live.driver.LiveDriver`.
 
     Parameters
     ----------
-    scenario:
-        The whole scenario (every robot loads the same one).
-    index:
-        Which robot this process is.
-    transport:
-        Its transport, already connected.
-    body:
-        Its body, standing on the robot's start cell.
-    sealer, opener:
-        Its authenticated envelope, for sending and receiving.
-    timing:
-        Real-time settings.
     guarded:
         Whether the safety layer guards every move.
     seed:
         Seed of the driver's own randomness (pauses that break symmetry).
-    clock:
-        The clock (``time.monotonic``; shared by every process on a machine).
     policy:
         The robot's policy, when not the scenario's (for example its share of a central plan).
     """
@@ -150,18 +85,9 @@ class Agent:
         clock: Callable[[], float] = time.monotonic,
         policy: Policy | None = None,
     ) -> None:
-        spec = scenario.robots[index]
-        self.scenario = scenario
-        self.index = index
-        self.transport = transport
-        self.body = body
-        self.sealer = sealer
-        self.opener = opener
-        self.timing = timing
-        self.clock = clock
-        self.random = random.Random(seed * 1_000_003 + index)
-        self.robot = Robot(
-            spec,
+        super().__init__(scenario, index, transport, body, sealer, opener, timing, seed, clock)
+        self.robot: Robot = Robot(
+            scenario.robots[index],
             index,
             scenario.grid,
             policy if policy is not None else make_policy(scenario.policy, scenario.timing),
@@ -171,175 +97,70 @@ class Agent:
             retry_interval=timing.claim_retry,
             silence_timeout=timing.silence_timeout,
         )
-        self.report = AgentReport(spec.id, index, spec.start, spec.goal)
-        self.stop_requested = threading.Event()
-        self._inbox: queue.SimpleQueue[Message] = queue.SimpleQueue()
-        self._receiving = threading.Event()
-        self._lock = threading.Lock()
-        self._peers = len(scenario.robots) - 1
+        self._phase = Phase.LISTEN
+        self._next_decision = 0.0
+        self._decided_at = 0.0
 
-    # -- the receiving thread ----------------------------------------------------------
+    # -- what the driver reads of the brain --------------------------------------------------
 
-    def _receive_loop(self) -> None:
-        while self._receiving.is_set():
-            data = self.transport.receive(0.05)
-            if data is None:
-                continue
-            with self._lock:
-                message = self.opener.open(data)
-            if message is not None:
-                self._inbox.put(message)
+    def _present(self) -> Cell:
+        return self.robot.present
 
-    def _drain_inbox(self, now: float) -> None:
-        """Hand the brain every message the receiving thread queued, and send its answers."""
-        while True:
-            try:
-                message = self._inbox.get_nowait()
-            except queue.Empty:
-                return
-            self.report.messages_received += 1
-            self._send(self.robot.receive(message, now))
+    def _arrived(self) -> bool:
+        return self.robot.arrived
 
-    # -- sending ---------------------------------------------------------------------------
+    def _peers_heard(self) -> int:
+        return len(self.robot.belief.peers)
 
-    def _send(self, outgoing: list[Outgoing]) -> None:
-        report = self.report
-        for item in outgoing:
-            data = self.sealer.seal(item.message)
-            if item.recipients is None:
-                self.transport.send(data, None)
-                report.messages_sent += self._peers
-                report.bytes_sent += len(data) * self._peers
-                report.datagrams_sent += 1
-            else:
-                for recipient in item.recipients:
-                    self.transport.send(data, recipient)
-                    report.messages_sent += 1
-                    report.bytes_sent += len(data)
-                    report.datagrams_sent += 1
+    def _peer_news(self, index: int) -> tuple[float, bool] | None:
+        peer = self.robot.belief.peers.get(index)
+        return None if peer is None else (peer.heard_at, peer.arrived)
 
-    # -- the main loop ---------------------------------------------------------------------
+    def _state_messages(self, now: float) -> list[Outgoing]:
+        return self.robot.announce(now)
 
-    def run(self, on_progress: Callable[[AgentReport], None] | None = None, progress_every: float = 1.0) -> AgentReport:
-        """Run until done, timed out or stopped; returns (and keeps in :attr:`report`) the report."""
-        robot, body, timing, report = self.robot, self.body, self.timing, self.report
-        clock = self.clock
-        self._receiving.set()
-        receiver = threading.Thread(target=self._receive_loop, name=f"robot-{self.index}-server", daemon=True)
-        receiver.start()
-        self._wait_for_fleet()
-        started = clock()
-        report.started_at = started
-        report.believed_path.append((started, robot.present))
-        self._send(robot.announce(started))
-        last_state = started
-        next_decision = started + timing.listen_time
-        phase = Phase.LISTEN
-        decided_at = started
-        everyone_done_since: float | None = None
-        last_progress = started
-        try:
-            while not self.stop_requested.is_set():
-                now = clock()
-                if now - started > timing.timeout:
-                    report.stop_reason = "timeout"
-                    break
-                self._drain_inbox(now)
-                if body.moving:
-                    if body.poll(now):
-                        robot.arrived_at(body.cell, body.heading)
-                        report.steps += 1
-                        report.believed_path.append((now, body.cell))
-                        self._send(robot.announce(now))
-                        last_state = now
-                        phase, next_decision = Phase.LISTEN, now + timing.listen_time
-                        if robot.arrived and report.arrival_time is None:
-                            report.arrival_time = now - started
-                        elif not robot.arrived:
-                            report.arrival_time = None
-                elif phase is Phase.LISTEN and now >= next_decision:
-                    self._send(robot.decide(now))
-                    phase, decided_at = Phase.CLAIM, now
-                if phase is Phase.CLAIM and not body.moving:
-                    target = robot.motion(now)
-                    if target is not None:
-                        body.start_move(target, now)
-                        report.decision_latency.append(now - decided_at)
-                        phase = Phase.MOVING
-                    elif robot.wanted is None and robot.safety.pending is None:
-                        pause = timing.heartbeat if robot.arrived else timing.listen_time * (1 + self.random.random())
-                        phase, next_decision = Phase.PAUSE, now + pause
-                if phase is Phase.PAUSE and now >= next_decision:
-                    self._send(robot.announce(now))
-                    last_state = now
-                    phase, next_decision = Phase.LISTEN, now + timing.listen_time
-                self._send(robot.expire(now))
-                if now - last_state >= timing.heartbeat:
-                    self._send(robot.announce(now))
-                    last_state = now
-                if self._everyone_done(now):
-                    everyone_done_since = everyone_done_since if everyone_done_since is not None else now
-                    if now - everyone_done_since >= timing.linger:
-                        report.stop_reason = "all arrived" if not report.silent_peers else "arrived; peers silent"
-                        break
-                else:
-                    everyone_done_since = None
-                if on_progress is not None and now - last_progress >= progress_every:
-                    last_progress = now
-                    self._fill_report(now)
-                    on_progress(report)
-                time.sleep(timing.poll)
-            else:
-                report.stop_reason = "interrupted"
-        finally:
-            self._receiving.clear()
-            receiver.join(timeout=1.0)
-            self._fill_report(clock())
-        return report
+    def _fleet_wait_messages(self) -> list[Outgoing]:
+        return [Outgoing(self.robot.state_message())]
 
-    def _wait_for_fleet(self) -> None:
-        """Announce every heartbeat, and answer, until every peer has been heard (or ``start_wait`` passes)."""
-        robot, clock = self.robot, self.clock
-        deadline = clock() + self.timing.start_wait
-        last_state = -float("inf")
-        while not self.stop_requested.is_set() and len(robot.belief.peers) < self._peers and clock() < deadline:
-            now = clock()
-            self._drain_inbox(now)
-            if now - last_state >= self.timing.heartbeat:
-                self._send([Outgoing(robot.state_message())])
-                last_state = now
-            time.sleep(self.timing.poll)
-
-    def _everyone_done(self, now: float) -> bool:
+    def _safety_counts(self) -> dict[str, int]:
         robot = self.robot
-        if not robot.arrived:
-            return False
-        horizon = now - self.timing.give_up_after
-        silent = []
-        for index in range(len(self.scenario.robots)):
-            if index == self.index:
-                continue
-            peer = robot.belief.peers.get(index)
-            if peer is not None and peer.arrived and peer.heard_at >= now - 2 * self.timing.silence_timeout:
-                continue
-            if peer is None or peer.heard_at < horizon:
-                silent.append(index)
-                continue
-            return False
-        self.report.silent_peers = silent
-        return True
+        return {**robot.safety.stats.__dict__, "stale_states": robot.belief.stale_messages}
 
-    def _fill_report(self, now: float) -> None:
-        report, robot = self.report, self.robot
-        report.ended_at = now
-        report.arrived = robot.arrived
-        report.turns = getattr(self.body, "turns", 0)
-        report.missed_lines = getattr(self.body, "missed_lines", 0)
-        with self._lock:
-            rejected = Counter(self.opener.rejected)
-        rejected.update(robot.dropped)
-        report.rejected = dict(rejected)
-        if isinstance(self.transport, FaultyTransport):
-            report.faults = dict(self.transport.counts.__dict__)
-        report.safety = dict(robot.safety.stats.__dict__)
-        report.safety["stale_states"] = robot.belief.stale_messages
+    # -- the step ----------------------------------------------------------------------------
+
+    def _begin(self, started: float) -> None:
+        self._phase, self._next_decision, self._decided_at = Phase.LISTEN, started + self.timing.listen_time, started
+
+    def _step(self, now: float, started: float) -> bool:
+        """Announce, listen, decide (and claim), move, or pause (module docstring)."""
+        robot, body, timing, report = self.robot, self.body, self.timing, self.report
+        sent_state = False
+        if body.moving:
+            if body.poll(now):
+                robot.arrived_at(body.cell, body.heading)
+                report.steps += 1
+                report.believed_path.append((now, body.cell))
+                self._send(robot.announce(now))
+                sent_state = True
+                self._phase, self._next_decision = Phase.LISTEN, now + timing.listen_time
+                if robot.arrived and report.arrival_time is None:
+                    report.arrival_time = now - started
+                elif not robot.arrived:
+                    report.arrival_time = None
+        elif self._phase is Phase.LISTEN and now >= self._next_decision:
+            self._send(robot.decide(now))
+            self._phase, self._decided_at = Phase.CLAIM, now
+        if self._phase is Phase.CLAIM and not body.moving:
+            target = robot.motion(now)
+            if target is not None:
+                body.start_move(target, now)
+                report.decision_latency.append(now - self._decided_at)
+                self._phase = Phase.MOVING
+            elif robot.wanted is None and robot.safety.pending is None:
+                pause = timing.heartbeat if robot.arrived else timing.listen_time * (1 + self.random.random())
+                self._phase, self._next_decision = Phase.PAUSE, now + pause
+        if self._phase is Phase.PAUSE and now >= self._next_decision:
+            self._send(robot.announce(now))
+            sent_state = True
+            self._phase, self._next_decision = Phase.LISTEN, now + timing.listen_time
+        return sent_state

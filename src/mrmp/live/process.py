@@ -24,6 +24,8 @@ from mrmp.io.live_files import TraceReader, TraceWriter, write_json
 from mrmp.io.plans import read_share
 from mrmp.policies.plan_following import PlanFollowingPolicy
 from mrmp.live.agent import Agent, AgentReport, AgentTiming
+from mrmp.live.causal_agent import CausalAgent
+from mrmp.policies.registry import ASYNC_POLICIES
 from mrmp.live.body import OccupancyRecorder, SimulatedBody
 from mrmp.live.referee import IntervalReferee
 from mrmp.live.transport import (
@@ -159,18 +161,24 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
             rng=random.Random(options.seed * 104_729 + index),
             recorder=OccupancyRecorder(trace.write),
         )
-        agent = Agent(
-            scenario,
-            index,
-            transport,
-            body,
-            Sealer(options.key, options.session),
-            Opener(options.key, options.session, fleet_size=len(scenario.robots)),
-            timing=options.timing,
-            guarded=options.guarded,
-            seed=options.seed,
-            policy=policy,
-        )
+        sealer = Sealer(options.key, options.session)
+        opener = Opener(options.key, options.session, fleet_size=len(scenario.robots))
+        agent: Agent | CausalAgent
+        if scenario.policy.name in ASYNC_POLICIES:  # Causal-PIBT: always through the safety layer
+            agent = CausalAgent(scenario, index, transport, body, sealer, opener, timing=options.timing, seed=options.seed)
+        else:
+            agent = Agent(
+                scenario,
+                index,
+                transport,
+                body,
+                sealer,
+                opener,
+                timing=options.timing,
+                guarded=options.guarded,
+                seed=options.seed,
+                policy=policy,
+            )
         _on_stop_signals(agent.stop_requested.set)
         inner = getattr(transport, "inner", transport)
         wait_for_peers = getattr(inner, "wait_for_peers", None)

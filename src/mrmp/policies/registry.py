@@ -32,7 +32,11 @@ ROUND_POLICIES: tuple[str, ...] = ("pibt",)
 """Policies whose robots decide together by messages in synchronous rounds
 (:mod:`mrmp.sim.rounds`), rather than each alone by a :class:`Policy`."""
 
-POLICY_NAMES: tuple[str, ...] = (*POLICIES, *ROUND_POLICIES)
+ASYNC_POLICIES: tuple[str, ...] = ("causal",)
+"""Policies whose robots run asynchronously, each at its own speed, and interact through locks
+(:mod:`mrmp.robot.causal_pibt`, simulated by :mod:`mrmp.sim.asynchronous`)."""
+
+POLICY_NAMES: tuple[str, ...] = (*POLICIES, *ROUND_POLICIES, *ASYNC_POLICIES)
 
 
 def make_policy(options: PolicyOptions, timing: Timing | None = None) -> Policy:
@@ -46,6 +50,10 @@ def make_policy(options: PolicyOptions, timing: Timing | None = None) -> Policy:
     if options.name in ROUND_POLICIES:
         raise InputError(
             Problem("policy.name", f"{options.name!r} runs in synchronous rounds (mrmp.sim.rounds), not as a per-robot policy")
+        )
+    if options.name in ASYNC_POLICIES:
+        raise InputError(
+            Problem("policy.name", f"{options.name!r} runs asynchronously (mrmp.sim.asynchronous), not as a per-robot policy")
         )
     try:
         factory = POLICIES[options.name]

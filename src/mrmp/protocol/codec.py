@@ -21,6 +21,15 @@ Bodies (cells are two signed 32-bit integers)::
     6 answer step (u32), moved (1 byte, 0 or 1)                                         15 bytes in all
     7 reserve step (u32), cell                                                          22 bytes in all
     8 pull   step (u32), cell                                                           22 bytes in all
+    9 lock request   session (u32)                                                      14 bytes in all
+   10 lock grant     locker (u32), session (u32), mode (1 byte, 0..2), flags (1 byte:
+                     bit 0 has a head, bit 1 urgent), tail, head, reached (u32),
+                     rank (u32), count (1 byte), count visited cells              45 + 8 * count bytes
+   11 lock release   session (u32), operations (1 byte), count (1 byte),
+                     count visited cells                                          16 + 8 * count bytes
+   12 lock ack       locker (u32), session (u32)                                        18 bytes in all
+
+Counts of visited cells are at most :data:`~mrmp.protocol.messages.MAX_VISITED_CELLS`.
 
 Every datagram is at most :data:`MAX_MESSAGE_BYTES`. Authentication (a MAC
 over these bytes) is a separate layer, :mod:`mrmp.protocol.auth`.
@@ -55,7 +64,12 @@ from mrmp.protocol.messages import (
     AnswerMessage,
     BeaconMessage,
     ClaimMessage,
+    MAX_VISITED_CELLS,
     InheritMessage,
+    LockAckMessage,
+    LockGrantMessage,
+    LockReleaseMessage,
+    LockRequestMessage,
     Message,
     PullMessage,
     ReplyMessage,
@@ -63,7 +77,7 @@ from mrmp.protocol.messages import (
     StateMessage,
 )
 
-PROTOCOL_VERSION = 4
+PROTOCOL_VERSION = 5
 """Version byte of every datagram; a receiver drops other versions."""
 MAX_MESSAGE_BYTES = 512
 """Upper bound on the size of any encoded message."""
@@ -78,7 +92,17 @@ _REPLY_BODY = struct.Struct("!IIiiB")
 _BEACON_BODY = struct.Struct("!IiiiiIIB")
 _STEP_CELL_BODY = struct.Struct("!Iii")
 _ANSWER_BODY = struct.Struct("!IB")
+_LOCK_REQUEST_BODY = struct.Struct("!I")
+_LOCK_GRANT_BODY = struct.Struct("!IIBBiiiiIIB")
+_LOCK_RELEASE_BODY = struct.Struct("!IBB")
+_LOCK_ACK_BODY = struct.Struct("!II")
+_CELL = struct.Struct("!ii")
 _STATE, _CLAIM, _REPLY, _BEACON, _INHERIT, _ANSWER, _RESERVE, _PULL = 1, 2, 3, 4, 5, 6, 7, 8
+_LOCK_REQUEST, _LOCK_GRANT, _LOCK_RELEASE, _LOCK_ACK = 9, 10, 11, 12
+_HAS_HEAD, _URGENT = 0x01, 0x02
+_RELEASE_OPERATIONS = 0x1F
+"""Every operation bit a lock release may carry (:mod:`mrmp.robot.causal_pibt`)."""
+_VARIABLE = {_LOCK_GRANT: _LOCK_GRANT_BODY, _LOCK_RELEASE: _LOCK_RELEASE_BODY}
 _ARRIVED, _MOVING, _CLAIMING = 0x01, 0x02, 0x04
 _BODIES = {
     _STATE: _STATE_BODY,
@@ -89,6 +113,10 @@ _BODIES = {
     _ANSWER: _ANSWER_BODY,
     _RESERVE: _STEP_CELL_BODY,
     _PULL: _STEP_CELL_BODY,
+    _LOCK_REQUEST: _LOCK_REQUEST_BODY,
+    _LOCK_GRANT: _LOCK_GRANT_BODY,
+    _LOCK_RELEASE: _LOCK_RELEASE_BODY,
+    _LOCK_ACK: _LOCK_ACK_BODY,
 }
 _STEP_CELL_TYPES: dict[type, int] = {InheritMessage: _INHERIT, ReserveMessage: _RESERVE, PullMessage: _PULL}
 _STEP_CELL_CLASSES = {code: cls for cls, code in _STEP_CELL_TYPES.items()}
@@ -138,6 +166,25 @@ def encode(message: Message) -> bytes:
     elif isinstance(message, AnswerMessage):
         body = _ANSWER_BODY.pack(message.step, 1 if message.moved else 0)
         type_code = _ANSWER
+    elif isinstance(message, LockRequestMessage):
+        body = _LOCK_REQUEST_BODY.pack(message.session)
+        type_code = _LOCK_REQUEST
+    elif isinstance(message, LockGrantMessage):
+        if not 0 <= message.mode <= 2 or (message.head is None) != (message.mode == 0):
+            raise ValueError(f"lock grant with mode {message.mode} and head {message.head}")
+        head = message.head if message.head is not None else NO_CELL
+        flags = (_HAS_HEAD if message.head is not None else 0) | (_URGENT if message.urgent else 0)
+        body = _LOCK_GRANT_BODY.pack(
+            message.locker, message.session, message.mode, flags, *message.tail, *head,
+            message.reached, message.rank, len(message.visited),
+        ) + _cells(message.visited)
+        type_code = _LOCK_GRANT
+    elif isinstance(message, LockReleaseMessage):
+        body = _LOCK_RELEASE_BODY.pack(message.session, message.operations, len(message.visited)) + _cells(message.visited)
+        type_code = _LOCK_RELEASE
+    elif isinstance(message, LockAckMessage):
+        body = _LOCK_ACK_BODY.pack(message.locker, message.session)
+        type_code = _LOCK_ACK
     elif type(message) in _STEP_CELL_TYPES:
         body = _STEP_CELL_BODY.pack(message.step, *message.cell)  # type: ignore[union-attr]
         type_code = _STEP_CELL_TYPES[type(message)]
@@ -167,6 +214,11 @@ def decode(data: bytes) -> Message:
     if body is None:
         raise DecodeError("type", f"unknown message type {type_code}")
     expected = _HEADER.size + body.size
+    if type_code in _VARIABLE and size >= expected:
+        count = data[expected - 1]
+        if count > MAX_VISITED_CELLS:
+            raise DecodeError("malformed", f"{count} visited cells, at most {MAX_VISITED_CELLS}")
+        expected += _CELL.size * count
     if size != expected:
         raise DecodeError("truncated" if size < expected else "malformed", f"{size} bytes, expected {expected}")
     fields = body.unpack_from(data, _HEADER.size)
@@ -201,6 +253,14 @@ def decode(data: bytes) -> Message:
         if moved > 1:
             raise DecodeError("malformed", f"answer with moved={moved}")
         return AnswerMessage(sender, seq, step, bool(moved))
+    if type_code in _VARIABLE:
+        return _decode_lock(type_code, sender, seq, fields, data[_HEADER.size + body.size :])
+    if type_code == _LOCK_REQUEST:
+        (session,) = fields
+        return LockRequestMessage(sender, seq, session)
+    if type_code == _LOCK_ACK:
+        locker, session = fields
+        return LockAckMessage(sender, seq, locker, session)
     if type_code in _STEP_CELL_CLASSES:
         step, cx, cy = fields
         return _STEP_CELL_CLASSES[type_code](sender, seq, step, (cx, cy))  # type: ignore[no-any-return]
@@ -213,3 +273,28 @@ def decode(data: bytes) -> Message:
     if granted > 1 or claim == 0:
         raise DecodeError("malformed", f"reply with granted={granted}, claim={claim}")
     return ReplyMessage(sender, seq, claimant, claim, (cx, cy), bool(granted))
+
+
+def _cells(cells: tuple[tuple[int, int], ...]) -> bytes:
+    """The wire form of a visited set (at most :data:`MAX_VISITED_CELLS` cells)."""
+    if len(cells) > MAX_VISITED_CELLS:
+        raise ValueError(f"{len(cells)} visited cells, at most {MAX_VISITED_CELLS}")
+    return b"".join(_CELL.pack(*cell) for cell in cells)
+
+
+def _decode_lock(type_code: int, sender: int, seq: int, fields: tuple[int, ...], rest: bytes) -> Message:
+    """Decode a lock grant or release whose fixed fields are ``fields`` and whose visited cells are ``rest``."""
+    visited = tuple((x, y) for x, y in _CELL.iter_unpack(rest))
+    if type_code == _LOCK_RELEASE:
+        session, operations, _ = fields
+        if operations & ~_RELEASE_OPERATIONS:
+            raise DecodeError("malformed", f"unknown release operations {operations:#04x}")
+        return LockReleaseMessage(sender, seq, session, operations, visited)
+    locker, session, mode, flags, tx, ty, hx, hy, reached, rank, _ = fields
+    if mode > 2 or flags & ~(_HAS_HEAD | _URGENT):
+        raise DecodeError("malformed", f"lock grant with mode {mode}, flags {flags:#04x}")
+    has_head = bool(flags & _HAS_HEAD)
+    if has_head != (mode != 0) or has_head != ((hx, hy) != NO_CELL):
+        raise DecodeError("malformed", "lock grant whose head disagrees with its mode")
+    head = (hx, hy) if has_head else None
+    return LockGrantMessage(sender, seq, locker, session, mode, (tx, ty), head, bool(flags & _URGENT), reached, rank, visited)

@@ -13,6 +13,10 @@ current claim; see ``docs/protocol.md``).
 request for a cell and its answer. :class:`BeaconMessage`,
 :class:`InheritMessage`, :class:`AnswerMessage`, :class:`ReserveMessage` and
 :class:`PullMessage` carry decentralized PIBT (:mod:`mrmp.robot.pibt_robot`).
+:class:`LockRequestMessage`, :class:`LockGrantMessage`,
+:class:`LockReleaseMessage` and :class:`LockAckMessage` make one activation of
+Causal-PIBT atomic among the robots near the one activating
+(:mod:`mrmp.robot.causal_pibt`).
 
 Robots are named on the wire by their index in the scenario (the same scenario
 file is loaded by every robot), which keeps messages small.
@@ -167,8 +171,77 @@ class PullMessage:
     cell: Cell
 
 
+MAX_VISITED_CELLS = 48
+"""Most cells a lock grant or release carries in its ``visited`` set (Causal-PIBT's S), so
+that every message stays size-bounded."""
+
+
+@dataclass(frozen=True, slots=True)
+class LockRequestMessage:
+    """Causal-PIBT: lock the recipient for the sender's activation number ``session``."""
+
+    sender: int
+    seq: int
+    session: int
+
+
+@dataclass(frozen=True, slots=True)
+class LockGrantMessage:
+    """Causal-PIBT: the sender is locked for activation ``session`` of robot ``locker``; its state.
+
+    ``mode`` is 0 contracted, 1 requesting, 2 extended; ``head`` is None when
+    contracted. The sender's current (possibly inherited) priority is
+    ``(urgent, -reached, rank)``, compared as a tuple: ``urgent`` is whether its
+    source robot is away from its goal, ``reached`` how often that robot reached
+    its goal, ``rank`` that robot's index. ``visited`` is its set S of cells
+    already taken by its inheritance tree.
+    """
+
+    sender: int
+    seq: int
+    locker: int
+    session: int
+    mode: int
+    tail: Cell
+    head: Cell | None
+    urgent: bool
+    reached: int
+    rank: int
+    visited: tuple[Cell, ...] = ()
+
+
+@dataclass(frozen=True, slots=True)
+class LockReleaseMessage:
+    """Causal-PIBT: the end of activation ``session`` of the sender, with what it wrote into the recipient.
+
+    ``operations`` is a set of bits (:mod:`mrmp.robot.causal_pibt`): clear the
+    recipient's parent if it is the sender, remove or add the sender as a child,
+    contract (drop the head), and replace the visited set S by ``visited``
+    (also removing those cells from the recipient's candidates).
+    """
+
+    sender: int
+    seq: int
+    session: int
+    operations: int = 0
+    visited: tuple[Cell, ...] = ()
+
+
+@dataclass(frozen=True, slots=True)
+class LockAckMessage:
+    """Causal-PIBT: the sender took in the release of activation ``session`` of robot ``locker``."""
+
+    sender: int
+    seq: int
+    locker: int
+    session: int
+
+
+CausalMessage = LockRequestMessage | LockGrantMessage | LockReleaseMessage | LockAckMessage
+"""The messages of Causal-PIBT's locks (:mod:`mrmp.robot.causal_pibt`)."""
+
 PibtMessage = BeaconMessage | InheritMessage | AnswerMessage | ReserveMessage | PullMessage
 """The messages of decentralized PIBT (:mod:`mrmp.robot.pibt_robot`)."""
 
-Message = StateMessage | ClaimMessage | ReplyMessage | PibtMessage
+Message = StateMessage | ClaimMessage | ReplyMessage | PibtMessage | CausalMessage
 """Every message type the codec knows."""

@@ -52,10 +52,10 @@ from mrmp.core.heading import Heading
 from mrmp.core.scenario import RobotSpec
 from mrmp.policies.base import Decision, Policy, Situation
 from mrmp.policies.priority import outranks
-from mrmp.protocol.codec import DecodeError, decode
 from mrmp.protocol.messages import ClaimMessage, Message, ReplyMessage, StateMessage
 from mrmp.protocol.safety import SafetyLayer
 from mrmp.robot.belief import Belief
+from mrmp.robot.messaging import MessageEndpoint
 
 
 @dataclass(frozen=True, slots=True)
@@ -66,7 +66,7 @@ class Outgoing:
     recipients: tuple[int, ...] | None = None
 
 
-class Robot:
+class Robot(MessageEndpoint):
     """One robot's decision logic, free of I/O (module docstring has the step protocol).
 
     Parameters
@@ -139,25 +139,9 @@ class Robot:
                 }
         return Situation(self.index, self.present, self.heading, self.goal, self.grid, peers)
 
-
-
-    def _stamp(self, message: Message) -> Message:
-        self.seq += 1
-        return replace(message, seq=self.seq)
-
     def state_message(self) -> StateMessage:
         """A fresh state message: Present, Next, heading, arrival and safety state."""
-        self.seq += 1
-        return StateMessage(
-            self.index,
-            self.seq,
-            self.present,
-            self.intended,
-            self.heading,
-            self.arrived,
-            progress=self.progress,
-            **self.safety.state_fields(),  # type: ignore[arg-type]
-        )
+        return self._state(self.present, self.intended, self.heading, self.arrived, self.progress)
 
     # -- the step -------------------------------------------------------------------
 
@@ -241,12 +225,3 @@ class Robot:
         if isinstance(message, ReplyMessage):
             self.safety.handle_reply(message, now)
         return []
-
-    def receive_datagram(self, data: bytes, now: float) -> list[Outgoing]:
-        """Decode and take in a datagram; malformed data is dropped and counted by reason."""
-        try:
-            message = decode(data)
-        except DecodeError as error:
-            self.dropped[error.reason] += 1
-            return []
-        return self.receive(message, now)

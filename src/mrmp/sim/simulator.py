@@ -34,22 +34,26 @@ from __future__ import annotations
 
 import time
 from collections import Counter
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 
 from mrmp.core.cell import Cell
 from mrmp.core.heading import Heading, right_turns
 from mrmp.core.result import RobotResult, RunResult
 from mrmp.core.scenario import Scenario
 from mrmp.policies.base import Decision, Policy
-from mrmp.policies.registry import ROUND_POLICIES, make_policy
-from mrmp.protocol.codec import DecodeError, decode, encode
+from mrmp.policies.registry import ASYNC_POLICIES, ROUND_POLICIES, make_policy
+from mrmp.protocol.codec import DecodeError, decode
 from mrmp.protocol.messages import Message
 from mrmp.robot.robot import Outgoing, Robot
 from mrmp.sim.goals import GoalBook
 from mrmp.sim.metrics import default_max_ticks, network_slowdown, shortest_steps
-from mrmp.sim.network import SimulatedNetwork
+from mrmp.sim.asynchronous import AsynchronousSimulator
 from mrmp.sim.referee import Referee
 from mrmp.sim.rounds import RoundsSimulator
+from mrmp.sim.ticking import run_result, run_ticks, scenario_network, send_counted
+
+TickObserver = Callable[[int, list[Cell]], None]
+"""Called after every tick with the tick number and every robot's cell, in scenario order."""
 
 RECURRENCE_LIMIT = 10
 """How often one configuration may recur before the run is declared stuck (plus
@@ -83,10 +87,22 @@ class LockstepSimulator:
     policies:
         One policy per robot, replacing the scenario's (for example robots
         following a central plan).
+    record_messages:
+        Keep the ``(sender id, recipient id, kind)`` of every message sent,
+        tick by tick, in the result's ``message_log`` (for drawing them).
+    on_tick:
+        Called at the end of every tick with the tick and the robots' cells
+        (for watching a run as it goes).
     """
 
     def __init__(
-        self, scenario: Scenario, record_decisions: bool = False, policies: Sequence[Policy] | None = None
+        self,
+        scenario: Scenario,
+        record_decisions: bool = False,
+        policies: Sequence[Policy] | None = None,
+        *,
+        record_messages: bool = False,
+        on_tick: TickObserver | None = None,
     ) -> None:
         self.scenario = scenario
         grid = scenario.grid
@@ -107,9 +123,7 @@ class LockstepSimulator:
         ]
         slowdown = network_slowdown(scenario) if scenario.safety else 1.0
         self.recurrence_limit = int((RECURRENCE_LIMIT + 2 * timeout) * max(1.0, slowdown / (2 * scenario.worst_faults().delay_max + 1)))
-        index_of = {spec.id: index for index, spec in enumerate(scenario.robots)}
-        links = {(index_of[link.sender], index_of[link.recipient]): link.faults for link in scenario.links}
-        self.network = SimulatedNetwork(scenario.network, seed=scenario.seed, links=links)
+        self.network = scenario_network(scenario)
         self.referee = Referee(grid, [spec.id for spec in scenario.robots])
         self.lengths = shortest_steps(scenario)
         self.max_ticks = scenario.max_ticks or default_max_ticks(scenario, self.lengths)
@@ -125,27 +139,15 @@ class LockstepSimulator:
         self._still_since = 0
         self._everyone = range(len(self.robots))
         self._goals = GoalBook(scenario.seed, grid.free_cells() if scenario.lifelong else [])
+        self.on_tick = on_tick
+        self._ids = [spec.id for spec in scenario.robots]
+        self._message_log: list[list[tuple[str, str, str]]] | None = [[]] if record_messages else None
 
     def run(self) -> RunResult:
         """Run to the end and return the result (partial on Ctrl-C)."""
         started = time.perf_counter()
         self.referee.check_start([robot.present for robot in self.robots])
-        stop_reason = "time up" if self.scenario.lifelong else "tick limit"
-        try:
-            while self.tick < self.max_ticks:
-                if not self.scenario.lifelong and all(robot.arrived for robot in self.robots):
-                    stop_reason = "all arrived"
-                    break
-                self.step()
-                stuck = self._stuck()
-                if stuck:
-                    stop_reason = stuck
-                    break
-            else:
-                if not self.scenario.lifelong and all(robot.arrived for robot in self.robots):
-                    stop_reason = "all arrived"
-        except KeyboardInterrupt:
-            stop_reason = "interrupted"
+        stop_reason = run_ticks(self, lambda: all(robot.arrived for robot in self.robots), self._stuck)
         return self._result(stop_reason, time.perf_counter() - started)
 
     def step(self) -> None:
@@ -153,6 +155,8 @@ class LockstepSimulator:
         self.tick += 1
         tick = self.tick
         robots = self.robots
+        if self._message_log is not None:
+            self._message_log.append([])
         for robot in robots:
             self._send(robot, robot.announce(tick))
         self._drain()
@@ -191,17 +195,25 @@ class LockstepSimulator:
         self._count_goals()
         for robot in robots:
             self._send(robot, robot.expire(tick))
+        if self.on_tick is not None:
+            self.on_tick(tick, [robot.present for robot in robots])
 
     def _send(self, robot: Robot, outgoing: list[Outgoing]) -> None:
         result = self._results[robot.index]
+        log = self._message_log
         for item in outgoing:
-            payload = encode(item.message)
-            recipients = item.recipients if item.recipients is not None else self._everyone
-            for recipient in recipients:
-                if recipient != robot.index:
-                    self.network.send(robot.index, recipient, payload, self.tick)
-                    result.messages_sent += 1
-                    result.bytes_sent += len(payload)
+            recipients = send_counted(self.network, robot.index, item, self._everyone, self.tick, result)
+            if log is not None:
+                self._log_message(log[-1], robot.index, item.message, recipients)
+
+    def _log_message(
+        self, entries: list[tuple[str, str, str]], sender: int, message: Message, recipients: Sequence[int] | range
+    ) -> None:
+        """Note in this tick's ``entries`` one message sent to each of ``recipients`` (but its sender)."""
+        kind = message_kind(message)
+        ids = self._ids
+        name = ids[sender]
+        entries.extend((name, ids[recipient], kind) for recipient in recipients if recipient != sender)
 
     def _drain(self) -> None:
         """Deliver everything due by this tick, including answers sent meanwhile."""
@@ -259,28 +271,77 @@ class LockstepSimulator:
             network[f"claims_{name}" if name != "claims" else "claims"] = sum(
                 getattr(robot.safety.stats, name) for robot in self.robots
             )
-        return RunResult(
-            scenario=self.scenario.name,
-            policy=self.robots[0].policy.name if self.robots else self.scenario.policy.name,
-            seed=self.scenario.seed,
-            robots=self._results,
-            collisions=list(self.referee.collisions),
-            stop_reason=stop_reason,
-            ticks=self.tick,
-            lower_bound=sum(self.lengths),
-            wall_time_s=wall_time,
-            network=network,
-            lifelong=self.scenario.lifelong,
-        )
+        policy = self.robots[0].policy.name if self.robots else self.scenario.policy.name
+        return run_result(self, self._results, policy, stop_reason, wall_time, network, message_log=self._message_log)
 
 
-def simulate(scenario: Scenario, record_decisions: bool = False, policies: Sequence[Policy] | None = None) -> RunResult:
+def message_kind(message: object) -> str:
+    """The short name of a message's type, as written in a message log.
+
+    >>> from mrmp.protocol.messages import ClaimMessage
+    >>> message_kind(ClaimMessage.__new__(ClaimMessage))
+    'claim'
+    """
+    name = type(message).__name__
+    return (name[: -len("Message")] if name.endswith("Message") else name).lower()
+
+
+def records_messages(scenario: Scenario, policies: Sequence[Policy] | None = None) -> bool:
+    """Whether :func:`simulate` can keep a message log for ``scenario``.
+
+    Runs in synchronous rounds (policy ``pibt``) exchange their messages
+    inside each step and do not log them.
+    """
+    return not (scenario.policy.name in (*ROUND_POLICIES, *ASYNC_POLICIES) and policies is None)
+
+
+def simulate(
+    scenario: Scenario,
+    record_decisions: bool = False,
+    policies: Sequence[Policy] | None = None,
+    *,
+    record_messages: bool = False,
+    on_tick: TickObserver | None = None,
+) -> RunResult:
     """Run ``scenario`` in the lockstep simulator and return its result.
 
-    Policy ``pibt`` runs in synchronous rounds (:class:`mrmp.sim.rounds.RoundsSimulator`).
+    Policy ``pibt`` runs in synchronous rounds (:class:`mrmp.sim.rounds.RoundsSimulator`),
+    which calls ``on_tick`` too but keeps no message log (its ``message_log``
+    stays ``None`` even with ``record_messages``; see :func:`records_messages`); policy
+    ``causal`` runs asynchronously (:class:`mrmp.sim.asynchronous.AsynchronousSimulator`),
+    likewise without a message log.
+
+    Parameters
+    ----------
+    scenario:
+        What to run.
+    record_decisions:
+        Keep every robot's decisions (per-robot policies only).
+    policies:
+        One policy per robot, replacing the scenario's.
+    record_messages:
+        Keep the per-tick ``(sender, recipient, kind)`` of every message sent
+        in the result's ``message_log``.
+    on_tick:
+        Called at the end of every tick with the tick and the robots' cells.
+
+    Examples
+    --------
+    >>> from mrmp.core import Grid, RobotSpec, Scenario
+    >>> swap = Scenario(Grid(1, 3), (RobotSpec("A", (0, 0), (0, 1)), RobotSpec("B", (0, 2), (0, 2))))
+    >>> seen = []
+    >>> result = simulate(swap, record_messages=True, on_tick=lambda tick, cells: seen.append((tick, cells)))
+    >>> seen
+    [(1, [(0, 1), (0, 2)])]
+    >>> sorted(set(result.message_log[1]))
+    [('A', 'B', 'claim'), ('A', 'B', 'state'), ('B', 'A', 'reply'), ('B', 'A', 'state')]
     """
-    if scenario.policy.name in ROUND_POLICIES and policies is None:
+    if not records_messages(scenario, policies):
         if record_decisions:
             raise ValueError("decisions are recorded for per-robot policies only")
-        return RoundsSimulator(scenario).run()
-    return LockstepSimulator(scenario, record_decisions=record_decisions, policies=policies).run()
+        if scenario.policy.name in ASYNC_POLICIES:
+            return AsynchronousSimulator(scenario, on_tick=on_tick).run()
+        return RoundsSimulator(scenario, on_tick=on_tick).run()
+    return LockstepSimulator(
+        scenario, record_decisions=record_decisions, policies=policies, record_messages=record_messages, on_tick=on_tick
+    ).run()

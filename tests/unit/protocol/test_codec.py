@@ -5,6 +5,7 @@ import struct
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from codec_checks import assert_exact_or_refused, assert_round_trip, mutated
 
 from mrmp.core.heading import Heading
 from mrmp.protocol.codec import MAX_MESSAGE_BYTES, PROTOCOL_VERSION, DecodeError, decode, encode
@@ -44,42 +45,20 @@ messages = (
 @settings(max_examples=500, derandomize=True)
 @given(messages)
 def test_round_trip(message):
-    data = encode(message)
-    assert data[0] == PROTOCOL_VERSION
-    assert len(data) <= MAX_MESSAGE_BYTES
-    assert decode(data) == message
+    assert_round_trip(message)
 
 
 @settings(max_examples=500, derandomize=True)
 @given(st.binary(max_size=2 * MAX_MESSAGE_BYTES))
 def test_garbage_raises_only_decode_error(data):
-    try:
-        message = decode(data)
-    except DecodeError as error:
-        assert error.reason in ("oversized", "truncated", "version", "type", "malformed")
-    else:
-        assert encode(message) == data  # anything accepted is exactly a valid encoding
+    assert_exact_or_refused(data)
 
 
 @settings(max_examples=500, derandomize=True)
 @given(messages, st.data())
 def test_mutations_of_valid_messages_decode_to_valid_messages_or_raise(message, data):
     """Flip, cut or extend a valid encoding: the result is a typed error or a message that encodes back exactly."""
-    encoded = bytearray(encode(message))
-    how = data.draw(st.sampled_from(["flip", "cut", "extend"]))
-    if how == "flip":
-        position = data.draw(st.integers(0, len(encoded) - 1))
-        encoded[position] ^= data.draw(st.integers(1, 255))
-    elif how == "cut":
-        encoded = encoded[: data.draw(st.integers(0, len(encoded) - 1))]
-    else:
-        encoded += data.draw(st.binary(min_size=1, max_size=8))
-    try:
-        decoded = decode(bytes(encoded))
-    except DecodeError as error:
-        assert error.reason in ("oversized", "truncated", "version", "type", "malformed")
-    else:
-        assert encode(decoded) == bytes(encoded)
+    assert_exact_or_refused(mutated(encode(message), data, most_extra=8))
 
 
 def _valid():

@@ -1,0 +1,152 @@
+"""The live driver of one Causal-PIBT robot (policy ``causal``): real time around the sans-IO brain.
+
+The brain is :class:`mrmp.robot.causal_pibt.CausalRobot` (Okumura, Tamura and
+Défago, AAAI 2021), the same object the asynchronous simulator runs. As in
+:mod:`mrmp.live.agent`, a receiving thread queues what the transport delivers
+and the brain runs in the main thread only, fed with those messages and the
+clock. Every ``poll``:
+
+* hand the brain the queued messages and send its answers (lock grants,
+  acknowledgements, claim replies);
+* when the body reports the end of its move, tell the brain (it contracts on
+  its head and announces its state); else start the move the safety layer
+  allows, if any;
+* when the robot's next activation is due, activate it (an activation locks
+  the robots within two cells, runs one Causal-PIBT transition and releases
+  them); activations come every ``listen_time`` seconds, times a random factor
+  in [0.5, 1.5), so robots interleave differently in every run;
+* run the brain's timers (resend lock requests, releases and claims) and send
+  the state every ``heartbeat`` seconds.
+
+Before its first activation a robot waits (at most ``start_wait`` seconds)
+until it has heard every peer. The run ends as :class:`~mrmp.live.agent.Agent`'s
+does: when this robot and every peer stand on their goals (then a short linger,
+so that late requests are still answered), when the peers that have not arrived
+have been silent for ``give_up_after`` seconds, on timeout or on a stop
+request. The report (:class:`~mrmp.live.driver.AgentReport`) is written by the
+caller, through ``on_progress`` while running and at the end.
+"""
+
+from __future__ import annotations
+
+import random
+import time
+from collections.abc import Callable
+
+from mrmp.core.cell import Cell
+from mrmp.core.scenario import Scenario
+from mrmp.live.body import Body
+from mrmp.live.driver import AgentTiming, LiveDriver
+from mrmp.live.transport import Transport
+from mrmp.protocol.auth import Opener, Sealer
+from mrmp.robot.causal_pibt import CausalRobot
+from mrmp.robot.robot import Outgoing
+
+LOCK_RETRY_FRACTION = 3
+"""Lock requests and releases are resent this many times more often than claims (a lock holds others up)."""
+
+
+class CausalAgent(LiveDriver):
+    """Runs one Causal-PIBT robot in real time (see the module docstring).
+
+    The parameters ``scenario``, ``index``, ``transport``, ``body``,
+    ``sealer``, ``opener``, ``timing`` and ``clock`` are those of
+    :class:`~mrmp.live.driver.LiveDriver`.
+
+    Parameters
+    ----------
+    seed:
+        Seed of the robot's randomness (ties between cells, activation times).
+    """
+
+    def __init__(
+        self,
+        scenario: Scenario,
+        index: int,
+        transport: Transport,
+        body: Body,
+        sealer: Sealer,
+        opener: Opener,
+        timing: AgentTiming = AgentTiming(),
+        seed: int = 0,
+        clock: Callable[[], float] = time.monotonic,
+    ) -> None:
+        super().__init__(scenario, index, transport, body, sealer, opener, timing, seed, clock)
+        spec = scenario.robots[index]
+        retry = timing.claim_retry / LOCK_RETRY_FRACTION
+        self.robot: CausalRobot = CausalRobot(
+            index,
+            scenario.grid,
+            [robot.start for robot in scenario.robots],
+            spec.goal,
+            rng=random.Random(seed * 7919 + index),
+            retry_interval=retry,
+            lock_timeout=max(1.0, 20 * retry),
+            claim_timeout=timing.claim_timeout,
+            heading=spec.heading,
+        )
+        self._next_activation = 0.0
+        self._extended_at: float | None = None
+
+    # -- what the driver reads of the brain --------------------------------------------------
+
+    def _present(self) -> Cell:
+        return self.robot.tail
+
+    def _arrived(self) -> bool:
+        return self.robot.at_goal
+
+    def _settled(self) -> bool:
+        """On the goal, with no activation of its own under way and not locked by another robot's."""
+        robot = self.robot
+        return robot.at_goal and robot.idle and robot.locked_by is None
+
+    def _peers_heard(self) -> int:
+        return len(self.robot.heard)
+
+    def _peer_news(self, index: int) -> tuple[float, bool] | None:
+        return self.robot.heard.get(index)
+
+    def _state_messages(self, now: float) -> list[Outgoing]:
+        return self.robot.heartbeat()
+
+    def _fleet_wait_messages(self) -> list[Outgoing]:
+        return self.robot.heartbeat()
+
+    def _safety_counts(self) -> dict[str, int]:
+        robot = self.robot
+        return {**robot.safety.stats.__dict__, **{f"causal_{name}": count for name, count in robot.stats.items()}}
+
+    # -- the step ----------------------------------------------------------------------------
+
+    def _begin(self, started: float) -> None:
+        self._next_activation = started + self.timing.listen_time * self.random.random()
+        self._extended_at = None
+
+    def _step(self, now: float, started: float) -> bool:
+        """Finish or start the body's move, and activate the robot when due (module docstring)."""
+        robot, body, timing, report = self.robot, self.body, self.timing, self.report
+        sent_state = False
+        if body.moving:
+            if body.poll(now):
+                self._send(robot.arrived_at(body.cell, now, body.heading))
+                sent_state = True
+                report.steps += 1
+                report.believed_path.append((now, body.cell))
+                if robot.at_goal and report.arrival_time is None:
+                    report.arrival_time = now - started
+        else:
+            if robot.mode_name == "extended" and self._extended_at is None:
+                self._extended_at = now
+            target = robot.motion(now)
+            if target is not None:
+                body.start_move(target, now)
+                if self._extended_at is not None:
+                    report.decision_latency.append(now - self._extended_at)
+                self._extended_at = None
+        if now >= self._next_activation:
+            self._send(robot.activate(now))
+            self._next_activation = now + timing.listen_time * (0.5 + self.random.random())
+        if not robot.at_goal:
+            report.arrival_time = None
+        return sent_state

@@ -1,0 +1,340 @@
+"""What every live robot driver shares: the receiving thread, sending, the fleet wait, the run loop, the report.
+
+A live driver runs one sans-IO robot brain in real time (thesis, section 3.5):
+a *receiving thread* keeps reading the transport for the whole run and queues
+what it opens, and the brain runs in the main thread only, fed with those
+messages and with the clock. :class:`LiveDriver` holds that machinery; a
+policy's driver (:class:`mrmp.live.agent.Agent`,
+:class:`mrmp.live.causal_agent.CausalAgent`) supplies its brain and its step.
+
+Every ``poll`` the loop hands the brain the queued messages (sending its
+answers), runs the policy's step, runs the brain's timers, and sends the state
+when nothing was sent for ``heartbeat`` seconds. Before its first step a robot
+waits (at most ``start_wait`` seconds) until it has heard from every peer, so
+that a fleet whose processes start one by one begins together; its clock starts
+then. The run ends when this robot and every peer have arrived (and a short
+linger has passed so that late requests are still answered), when every peer
+that has not arrived has been silent for ``give_up_after`` seconds, on timeout,
+or on a stop request.
+"""
+
+from __future__ import annotations
+
+import queue
+import random
+import threading
+import time
+from collections import Counter
+from collections.abc import Callable
+from dataclasses import dataclass, field
+from typing import Any, Protocol
+
+from mrmp.core.cell import Cell
+from mrmp.core.scenario import Scenario
+from mrmp.live.body import Body
+from mrmp.live.transport import FaultyTransport, Transport
+from mrmp.protocol.auth import Opener, Sealer
+from mrmp.protocol.messages import Message
+from mrmp.robot.robot import Outgoing
+
+
+@dataclass(frozen=True)
+class AgentTiming:
+    """Real-time settings of a live robot, in seconds of wall-clock time."""
+
+    listen_time: float = 0.05
+    heartbeat: float = 0.2
+    claim_retry: float = 0.15
+    claim_timeout: float = 1.0
+    silence_timeout: float = 1.5
+    give_up_after: float = 3.0
+    linger: float = 0.6
+    poll: float = 0.004
+    timeout: float = 120.0
+    start_wait: float = 15.0
+
+
+@dataclass
+class AgentReport:
+    """What one robot did in a live run (written to ``agent-<index>.json``)."""
+
+    robot: str
+    index: int
+    start: Cell
+    goal: Cell
+    arrived: bool = False
+    arrival_time: float | None = None
+    stop_reason: str = "running"
+    started_at: float = 0.0
+    ended_at: float = 0.0
+    believed_path: list[tuple[float, Cell]] = field(default_factory=list)
+    turns: int = 0
+    steps: int = 0
+    messages_sent: int = 0
+    bytes_sent: int = 0
+    datagrams_sent: int = 0
+    messages_received: int = 0
+    rejected: dict[str, int] = field(default_factory=dict)
+    faults: dict[str, int] = field(default_factory=dict)
+    safety: dict[str, int] = field(default_factory=dict)
+    decision_latency: list[float] = field(default_factory=list)
+    silent_peers: list[int] = field(default_factory=list)
+    missed_lines: int = 0
+
+    def as_dict(self) -> dict[str, Any]:
+        """A JSON-ready copy."""
+        data = dict(self.__dict__)
+        data["start"], data["goal"] = list(self.start), list(self.goal)
+        data["believed_path"] = [[t, list(cell)] for t, cell in self.believed_path]
+        return data
+
+
+class Brain(Protocol):
+    """What the driver needs of a sans-IO robot brain (:class:`~mrmp.robot.robot.Robot`, ``CausalRobot``)."""
+
+    dropped: Counter[str]
+
+    def receive(self, message: Message, now: float) -> list[Outgoing]:
+        """Take in one decoded message; return the answers to send."""
+        ...
+
+    def expire(self, now: float) -> list[Outgoing]:
+        """Run the brain's timers; return what to resend."""
+        ...
+
+
+class LiveDriver:
+    """The machinery of a live robot driver around a brain (see the module docstring).
+
+    A subclass sets :attr:`robot` (its brain) in its constructor and supplies
+    the hooks below: the policy's step and what it reads of its brain.
+
+    Parameters
+    ----------
+    scenario:
+        The whole scenario (every robot loads the same one).
+    index:
+        Which robot this process is.
+    transport:
+        Its transport, already connected.
+    body:
+        Its body, standing on the robot's start cell.
+    sealer, opener:
+        Its authenticated envelope, for sending and receiving.
+    timing:
+        Real-time settings.
+    seed:
+        Seed of the driver's own randomness.
+    clock:
+        The clock (``time.monotonic``; shared by every process on a machine).
+    """
+
+    robot: Brain
+
+    def __init__(
+        self,
+        scenario: Scenario,
+        index: int,
+        transport: Transport,
+        body: Body,
+        sealer: Sealer,
+        opener: Opener,
+        timing: AgentTiming,
+        seed: int,
+        clock: Callable[[], float],
+    ) -> None:
+        spec = scenario.robots[index]
+        self.scenario = scenario
+        self.index = index
+        self.transport = transport
+        self.body = body
+        self.sealer = sealer
+        self.opener = opener
+        self.timing = timing
+        self.clock = clock
+        self.random = random.Random(seed * 1_000_003 + index)
+        self.report = AgentReport(spec.id, index, spec.start, spec.goal)
+        self.stop_requested = threading.Event()
+        self._inbox: queue.SimpleQueue[Message] = queue.SimpleQueue()
+        self._receiving = threading.Event()
+        self._lock = threading.Lock()
+        self._peers = len(scenario.robots) - 1
+
+    # -- what a policy's driver supplies ----------------------------------------------------
+
+    def _present(self) -> Cell:
+        """The cell the brain stands on."""
+        raise NotImplementedError
+
+    def _arrived(self) -> bool:
+        """Whether the brain stands on its goal (the report's ``arrived``)."""
+        raise NotImplementedError
+
+    def _settled(self) -> bool:
+        """Whether this robot is done, as far as it is concerned (by default: it arrived)."""
+        return self._arrived()
+
+    def _peers_heard(self) -> int:
+        """How many peers the brain has heard from."""
+        raise NotImplementedError
+
+    def _peer_news(self, index: int) -> tuple[float, bool] | None:
+        """When peer ``index`` was last heard and whether it said it arrived (``None``: never heard)."""
+        raise NotImplementedError
+
+    def _state_messages(self, now: float) -> list[Outgoing]:
+        """The state to send at the start and on every heartbeat of the run."""
+        raise NotImplementedError
+
+    def _fleet_wait_messages(self) -> list[Outgoing]:
+        """The state to send every heartbeat while waiting for the fleet."""
+        raise NotImplementedError
+
+    def _begin(self, started: float) -> None:
+        """Set up the policy's step at the start of the run (the clock reads ``started``)."""
+        raise NotImplementedError
+
+    def _step(self, now: float, started: float) -> bool:
+        """One poll of the policy's step; returns whether it sent the state (which defers the heartbeat)."""
+        raise NotImplementedError
+
+    def _safety_counts(self) -> dict[str, int]:
+        """The report's ``safety`` counts."""
+        raise NotImplementedError
+
+    # -- the receiving thread ----------------------------------------------------------
+
+    def _receive_loop(self) -> None:
+        while self._receiving.is_set():
+            data = self.transport.receive(0.05)
+            if data is None:
+                continue
+            with self._lock:
+                message = self.opener.open(data)
+            if message is not None:
+                self._inbox.put(message)
+
+    def _drain_inbox(self, now: float) -> None:
+        """Hand the brain every message the receiving thread queued, and send its answers."""
+        while True:
+            try:
+                message = self._inbox.get_nowait()
+            except queue.Empty:
+                return
+            self.report.messages_received += 1
+            self._send(self.robot.receive(message, now))
+
+    # -- sending ---------------------------------------------------------------------------
+
+    def _send(self, outgoing: list[Outgoing]) -> None:
+        report = self.report
+        for item in outgoing:
+            data = self.sealer.seal(item.message)
+            if item.recipients is None:
+                self.transport.send(data, None)
+                report.messages_sent += self._peers
+                report.bytes_sent += len(data) * self._peers
+                report.datagrams_sent += 1
+            else:
+                for recipient in item.recipients:
+                    self.transport.send(data, recipient)
+                    report.messages_sent += 1
+                    report.bytes_sent += len(data)
+                    report.datagrams_sent += 1
+
+    # -- the main loop ---------------------------------------------------------------------
+
+    def run(self, on_progress: Callable[[AgentReport], None] | None = None, progress_every: float = 1.0) -> AgentReport:
+        """Run until done, timed out or stopped; returns (and keeps in :attr:`report`) the report."""
+        timing, report = self.timing, self.report
+        clock = self.clock
+        self._receiving.set()
+        receiver = threading.Thread(target=self._receive_loop, name=f"robot-{self.index}-server", daemon=True)
+        receiver.start()
+        self._wait_for_fleet()
+        started = clock()
+        report.started_at = started
+        report.believed_path.append((started, self._present()))
+        self._send(self._state_messages(started))
+        last_state = started
+        self._begin(started)
+        everyone_done_since: float | None = None
+        last_progress = started
+        try:
+            while not self.stop_requested.is_set():
+                now = clock()
+                if now - started > timing.timeout:
+                    report.stop_reason = "timeout"
+                    break
+                self._drain_inbox(now)
+                if self._step(now, started):
+                    last_state = now
+                self._send(self.robot.expire(now))
+                if now - last_state >= timing.heartbeat:
+                    self._send(self._state_messages(now))
+                    last_state = now
+                if self._everyone_done(now):
+                    everyone_done_since = everyone_done_since if everyone_done_since is not None else now
+                    if now - everyone_done_since >= timing.linger:
+                        report.stop_reason = "all arrived" if not report.silent_peers else "arrived; peers silent"
+                        break
+                else:
+                    everyone_done_since = None
+                if on_progress is not None and now - last_progress >= progress_every:
+                    last_progress = now
+                    self._fill_report(now)
+                    on_progress(report)
+                time.sleep(timing.poll)
+            else:
+                report.stop_reason = "interrupted"
+        finally:
+            self._receiving.clear()
+            receiver.join(timeout=1.0)
+            self._fill_report(clock())
+        return report
+
+    def _wait_for_fleet(self) -> None:
+        """Send the state every heartbeat, and answer, until every peer has been heard (or ``start_wait`` passes)."""
+        clock = self.clock
+        deadline = clock() + self.timing.start_wait
+        last_state = -float("inf")
+        while not self.stop_requested.is_set() and self._peers_heard() < self._peers and clock() < deadline:
+            now = clock()
+            self._drain_inbox(now)
+            if now - last_state >= self.timing.heartbeat:
+                self._send(self._fleet_wait_messages())
+                last_state = now
+            time.sleep(self.timing.poll)
+
+    def _everyone_done(self, now: float) -> bool:
+        """This robot and every peer arrived (peers silent for ``give_up_after`` are given up on)."""
+        if not self._settled():
+            return False
+        horizon = now - self.timing.give_up_after
+        silent = []
+        for index in range(len(self.scenario.robots)):
+            if index == self.index:
+                continue
+            news = self._peer_news(index)
+            if news is not None and news[1] and news[0] >= now - 2 * self.timing.silence_timeout:
+                continue
+            if news is None or news[0] < horizon:
+                silent.append(index)
+                continue
+            return False
+        self.report.silent_peers = silent
+        return True
+
+    def _fill_report(self, now: float) -> None:
+        report, robot = self.report, self.robot
+        report.ended_at = now
+        report.arrived = self._arrived()
+        report.turns = getattr(self.body, "turns", 0)
+        report.missed_lines = getattr(self.body, "missed_lines", 0)
+        with self._lock:
+            rejected = Counter(self.opener.rejected)
+        rejected.update(robot.dropped)
+        report.rejected = dict(rejected)
+        if isinstance(self.transport, FaultyTransport):
+            report.faults = dict(self.transport.counts.__dict__)
+        report.safety = self._safety_counts()

@@ -1,0 +1,79 @@
+"""What every robot brain does with messages alike: numbering what it sends, decoding what it receives.
+
+Every message a robot sends carries the next number of the robot's sequence
+(``seq``), so that receivers can tell newer states from older ones; its state
+message carries the safety layer's part (:meth:`~mrmp.protocol.safety.SafetyLayer.state_fields`).
+A datagram that does not decode is dropped and counted by the reason the codec
+gives (:class:`~mrmp.protocol.codec.DecodeError`).
+
+Examples
+--------
+>>> from collections import Counter
+>>> class Silent(MessageEndpoint):
+...     def __init__(self):
+...         self.index, self.seq, self.dropped = 0, 0, Counter()
+...     def receive(self, message, now):
+...         return []
+>>> robot = Silent()
+>>> robot.receive_datagram(b"", now=0.0), dict(robot.dropped)
+([], {'truncated': 1})
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+from dataclasses import replace
+from typing import TYPE_CHECKING
+
+from mrmp.core.cell import Cell
+from mrmp.core.heading import Heading
+from mrmp.protocol.codec import DecodeError, decode
+from mrmp.protocol.messages import Message, StateMessage
+from mrmp.protocol.safety import SafetyLayer
+
+if TYPE_CHECKING:
+    from mrmp.robot.robot import Outgoing
+
+
+class MessageEndpoint:
+    """Numbering, state messages and datagram decoding of a robot brain (see the module docstring).
+
+    A subclass sets ``index``, ``seq`` (0 at first), ``dropped`` and, for
+    state messages, ``safety``, and takes in decoded messages in :meth:`receive`.
+    """
+
+    index: int
+    seq: int
+    dropped: Counter[str]
+    safety: SafetyLayer
+
+    def _stamp(self, message: Message) -> Message:
+        self.seq += 1
+        return replace(message, seq=self.seq)
+
+    def _state(self, present: Cell, next: Cell, heading: Heading, arrived: bool, progress: int = 0) -> StateMessage:
+        """A fresh state message with the next sequence number and the safety layer's state."""
+        self.seq += 1
+        return StateMessage(
+            self.index,
+            self.seq,
+            present,
+            next,
+            heading,
+            arrived,
+            progress=progress,
+            **self.safety.state_fields(),  # type: ignore[arg-type]
+        )
+
+    def receive(self, message: Message, now: float) -> list[Outgoing]:
+        """Take in one decoded message; return the answers to send."""
+        raise NotImplementedError
+
+    def receive_datagram(self, data: bytes, now: float) -> list[Outgoing]:
+        """Decode and take in a datagram; malformed data is dropped and counted by reason."""
+        try:
+            message = decode(data)
+        except DecodeError as error:
+            self.dropped[error.reason] += 1
+            return []
+        return self.receive(message, now)

@@ -1,0 +1,128 @@
+"""What the tick-driven simulators share: the scenario's network, the run loop, counted sending, the result.
+
+The lockstep simulator (:mod:`mrmp.sim.simulator`) and the asynchronous one
+(:mod:`mrmp.sim.asynchronous`) differ in what a tick does; they run their
+ticks, send their robots' messages over the simulated network and build their
+:class:`~mrmp.core.result.RunResult` alike, with these functions.
+
+Examples
+--------
+>>> from mrmp.core import Grid, RobotSpec, Scenario
+>>> scenario = Scenario(Grid(1, 2), (RobotSpec("A", (0, 0), (0, 1)),))
+>>> network = scenario_network(scenario)
+>>> result = RobotResult("A", (0, 0), (0, 1))
+>>> from mrmp.protocol.messages import ClaimMessage
+>>> send_counted(network, 0, Outgoing(ClaimMessage(0, 1, 1, (0, 1)), (0, 1)), range(2), 0, result)
+(0, 1)
+>>> result.messages_sent, result.bytes_sent > 0
+(1, True)
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+from typing import Any, Protocol
+
+from mrmp.core.result import RobotResult, RunResult
+from mrmp.core.scenario import Scenario
+from mrmp.protocol.codec import encode
+from mrmp.robot.robot import Outgoing
+from mrmp.sim.network import SimulatedNetwork
+from mrmp.sim.referee import Referee
+
+
+class TickedSimulation(Protocol):
+    """What :func:`run_ticks` and :func:`run_result` read of a simulator."""
+
+    scenario: Scenario
+    referee: Referee
+    tick: int
+    max_ticks: int
+    lengths: list[int]
+
+    def step(self) -> None:
+        """Advance one tick."""
+        ...
+
+
+def scenario_network(scenario: Scenario) -> SimulatedNetwork:
+    """The simulated network of ``scenario``: its faults, seed and per-link faults (by robot index)."""
+    index_of = {spec.id: index for index, spec in enumerate(scenario.robots)}
+    links = {(index_of[link.sender], index_of[link.recipient]): link.faults for link in scenario.links}
+    return SimulatedNetwork(scenario.network, seed=scenario.seed, links=links)
+
+
+def run_ticks(
+    simulation: TickedSimulation, all_arrived: Callable[[], bool], stuck: Callable[[], str | None] | None = None
+) -> str:
+    """Step ``simulation`` to the end and say why it ended.
+
+    The run ends when every robot arrived (``"all arrived"``; never in a
+    lifelong run), at the tick limit (``"tick limit"``, or ``"time up"`` in a
+    lifelong run), when ``stuck`` (asked after every tick) gives a reason, or
+    on Ctrl-C (``"interrupted"``).
+    """
+    lifelong = simulation.scenario.lifelong
+    stop_reason = "time up" if lifelong else "tick limit"
+    try:
+        while simulation.tick < simulation.max_ticks:
+            if not lifelong and all_arrived():
+                stop_reason = "all arrived"
+                break
+            simulation.step()
+            if stuck is not None:
+                reason = stuck()
+                if reason:
+                    stop_reason = reason
+                    break
+        else:
+            if not lifelong and all_arrived():
+                stop_reason = "all arrived"
+    except KeyboardInterrupt:
+        stop_reason = "interrupted"
+    return stop_reason
+
+
+def send_counted(
+    network: SimulatedNetwork, sender: int, item: Outgoing, everyone: range, tick: int, result: RobotResult
+) -> Sequence[int] | range:
+    """Send ``item`` over ``network`` to its recipients (``everyone`` but the sender when it has none).
+
+    Counts the messages and bytes sent in ``result``; returns the recipients
+    (the sender among them if it was listed or broadcast to).
+    """
+    payload = encode(item.message)
+    recipients = item.recipients if item.recipients is not None else everyone
+    for recipient in recipients:
+        if recipient != sender:
+            network.send(sender, recipient, payload, tick)
+            result.messages_sent += 1
+            result.bytes_sent += len(payload)
+    return recipients
+
+
+def run_result(
+    simulation: TickedSimulation,
+    results: list[RobotResult],
+    policy: str,
+    stop_reason: str,
+    wall_time: float,
+    network: dict[str, int],
+    **extra: Any,
+) -> RunResult:
+    """The :class:`RunResult` of ``simulation`` so far: its robots' ``results``, the referee's collisions, ``extra`` fields."""
+    scenario = simulation.scenario
+    return RunResult(
+        scenario=scenario.name,
+        policy=policy,
+        seed=scenario.seed,
+        robots=results,
+        collisions=list(simulation.referee.collisions),
+        stop_reason=stop_reason,
+        ticks=simulation.tick,
+        lower_bound=sum(simulation.lengths),
+        wall_time_s=wall_time,
+        network=network,
+        lifelong=scenario.lifelong,
+        **extra,
+    )
