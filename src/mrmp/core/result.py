@@ -109,7 +109,10 @@ class RunResult:
     ``planning_time_s``, and the size of the shares of the plan handed to the
     robots (their moves and dependencies), ``plan_bytes``. In a ``lifelong``
     run robots receive new goals as they reach theirs; its figure is the
-    ``throughput``, goals reached per tick.
+    ``throughput``, goals reached per tick. A run simulated with
+    ``record_messages`` carries its ``message_log``: for each tick (index 0,
+    the start, is empty) the ``(sender id, recipient id, kind)`` of every
+    message sent during that tick; ``None`` when messages were not recorded.
     """
 
     scenario: str
@@ -128,6 +131,7 @@ class RunResult:
     planning_time_s: float | None = None
     plan_bytes: int | None = None
     lifelong: bool = False
+    message_log: list[list[tuple[str, str, str]]] | None = None
 
     @property
     def all_arrived(self) -> bool:

@@ -82,8 +82,10 @@ def result_to_dict(result: RunResult, grid: Grid | None = None) -> dict[str, Any
         ``lower_bound``, ``time_makespan_s``, ``messages``, ``network``,
         ``wall_time_s``, ``collisions`` (each ``{kind, tick, robots, cells}``),
         ``robots`` (each ``{id, start, goal, arrived, arrival_tick, cost, steps,
-        turns, waits, messages_sent, bytes_sent, time_s, path, headings}``) and,
-        with a grid, ``map``. Cells are ``[x, y]`` lists, headings names.
+        turns, waits, messages_sent, bytes_sent, time_s, path, headings}``),
+        for a run that recorded its messages ``message_log`` (per tick, a
+        list of ``[sender, recipient, kind]``) and, with a grid, ``map``.
+        Cells are ``[x, y]`` lists, headings names.
 
     Examples
     --------
@@ -116,6 +118,8 @@ def result_to_dict(result: RunResult, grid: Grid | None = None) -> dict[str, Any
         "collisions": [_collision_to_dict(collision) for collision in result.collisions],
         "robots": [_robot_to_dict(robot) for robot in result.robots],
     }
+    if result.message_log is not None:
+        data["message_log"] = [[list(entry) for entry in entries] for entries in result.message_log]
     if grid is not None:
         data["map"] = {"name": grid.name, "x_size": grid.x_size, "y_size": grid.y_size, "rows": grid.to_rows()}
     return data
@@ -297,7 +301,35 @@ def result_from_dict(data: Mapping[str, Any], source: str = "result") -> RunResu
         ),
         plan_bytes=fields.get("plan_bytes", (int, type(None)), "an integer or null", None),
         lifelong=fields.get("lifelong", bool, "true or false", False),
+        message_log=_message_log(fields.get("message_log", (list, type(None)), "a list of ticks or null", None), source),
     )
+
+
+def _message_log(ticks: list[Any] | None, source: str) -> list[list[tuple[str, str, str]]] | None:
+    """A message log from its JSON form: per tick, ``[sender, recipient, kind]`` strings.
+
+    >>> _message_log([[], [["A", "B", "state"]]], "run.json")
+    [[], [('A', 'B', 'state')]]
+    >>> _message_log([[["A", "B"]]], "run.json")
+    Traceback (most recent call last):
+    ...
+    mrmp.core.errors.InputError: run.json: message_log[0][0]: expected [sender, recipient, kind] strings, got ['A', 'B']
+    """
+    if ticks is None:
+        return None
+    log: list[list[tuple[str, str, str]]] = []
+    for tick, entries in enumerate(ticks):
+        if not isinstance(entries, list):
+            raise InputError(Problem(source, f"message_log[{tick}]: expected a list of messages, got {type(entries).__name__}"))
+        parsed: list[tuple[str, str, str]] = []
+        for number, entry in enumerate(entries):
+            if not (isinstance(entry, list) and len(entry) == 3 and all(isinstance(part, str) for part in entry)):
+                raise InputError(
+                    Problem(source, f"message_log[{tick}][{number}]: expected [sender, recipient, kind] strings, got {entry!r}")
+                )
+            parsed.append((entry[0], entry[1], entry[2]))
+        log.append(parsed)
+    return log
 
 
 def _optional_number(value: Any) -> float | None:

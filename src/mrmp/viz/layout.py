@@ -558,3 +558,164 @@ def run_verdict(result: RunResult) -> tuple[str, bool]:
     if missing:
         return (f"{missing} not arrived", False)
     return ("all arrived", True)
+
+
+# -- messages ------------------------------------------------------------------------
+
+MAX_MESSAGE_ARROWS = 200
+"""Most sender-to-recipient arrows drawn per tick (the shortest); crowded runs broadcast far more."""
+MESSAGE_OFFSET = 0.09
+"""Sideways shift of a message arrow, in cells, so that A to B and B to A show as two parallel arrows."""
+MESSAGE_LABEL_CELL = 48
+"""Cells at least this many pixels wide write the kinds of message on each arrow."""
+
+
+@dataclass(frozen=True)
+class MessageArrow:
+    """Messages one robot sent another during ``tick``, drawn as an arrow.
+
+    The arrow joins the edges of the two robots' discs where they stood when
+    the tick began (tick ``tick - 1``, when they spoke) and is shown from time
+    ``tick - 1`` until ``tick``, while the robots make that tick's move.
+    ``start`` and ``end`` (the tip) are pixels; ``sender`` and ``recipient``
+    are robot indices; ``kinds`` are the kinds of the messages, in the order
+    first sent.
+    """
+
+    tick: int
+    sender: int
+    recipient: int
+    kinds: tuple[str, ...]
+    start: tuple[float, float]
+    end: tuple[float, float]
+
+    @property
+    def label(self) -> str:
+        """The kinds, joined: written on the arrow in big cells.
+
+        >>> MessageArrow(1, 0, 1, ("state", "claim"), (0, 0), (1, 0)).label
+        'state+claim'
+        """
+        return "+".join(self.kinds)
+
+    def shown_at(self, t: float) -> bool:
+        """Whether the arrow is on screen at time ``t`` (ticks): ``tick - 1 <= t < tick``.
+
+        >>> arrow = MessageArrow(2, 0, 1, ("state",), (0, 0), (1, 0))
+        >>> arrow.shown_at(0.9), arrow.shown_at(1.0), arrow.shown_at(1.99), arrow.shown_at(2.0)
+        (False, True, True, False)
+        """
+        return self.tick - 1 <= t < self.tick
+
+
+def message_arrows(result: RunResult, layout: Layout, limit: int = MAX_MESSAGE_ARROWS) -> list[MessageArrow]:
+    """The arrows that draw ``result``'s message log (none if it has no log), tick by tick.
+
+    Messages of one tick between the same two robots make one arrow; at most
+    ``limit`` arrows per tick, the shortest (then the first logged), so a
+    crowd that broadcasts shows who talks to its neighbours. An arrow starts just outside the sender's disc
+    and ends just outside the recipient's, shifted sideways by
+    :data:`MESSAGE_OFFSET` cells to the right of its direction.
+
+    >>> from mrmp.core import Grid, RobotResult, RunResult
+    >>> a = RobotResult("A", (0, 0), (0, 2), path=[(0, 0), (0, 1)])
+    >>> b = RobotResult("B", (0, 2), (0, 2), path=[(0, 2), (0, 2)])
+    >>> log = [[], [("A", "B", "state"), ("B", "A", "state"), ("A", "B", "claim")]]
+    >>> run = RunResult("s", "p", 0, [a, b], [], "done", 1, 0, 0.0, message_log=log)
+    >>> layout = make_layout(Grid(1, 3))
+    >>> arrows = message_arrows(run, layout)
+    >>> [(arrow.tick, arrow.sender, arrow.recipient, arrow.label) for arrow in arrows]
+    [(1, 0, 1, 'state+claim'), (1, 1, 0, 'state')]
+    >>> first = arrows[0]   # A (west) to B (east): points east, below the centre line (to its right)
+    >>> first.end[0] > first.start[0], first.start[1] == first.end[1] > layout.centre((0, 0))[1]
+    (True, True)
+    """
+    if not result.message_log:
+        return []
+    index_of = {robot.id: index for index, robot in enumerate(result.robots)}
+    reach = layout.cell * ROBOT_RADIUS * 1.15
+    shift = layout.cell * MESSAGE_OFFSET
+    arrows: list[MessageArrow] = []
+    for tick, entries in enumerate(result.message_log):
+        if tick == 0 or not entries:
+            continue
+        kinds_of: dict[tuple[int, int], list[str]] = {}
+        for sender_id, recipient_id, kind in entries:
+            sender, recipient = index_of.get(sender_id), index_of.get(recipient_id)
+            if sender is None or recipient is None or sender == recipient:
+                continue
+            kinds = kinds_of.setdefault((sender, recipient), [])
+            if kind not in kinds:
+                kinds.append(kind)
+        pairs = []
+        for (sender, recipient), kinds in kinds_of.items():
+            here = layout.centre(cell_at(result.robots[sender], tick - 1))
+            there = layout.centre(cell_at(result.robots[recipient], tick - 1))
+            length = math.dist(here, there)
+            if length > 2 * reach:
+                pairs.append((length, sender, recipient, kinds, here, there))
+        if len(pairs) > limit:
+            pairs = sorted(pairs, key=_length_of)[:limit]  # a stable sort: ties stay in logged order
+        for length, sender, recipient, kinds, here, there in pairs:
+            ux, uy = (there[0] - here[0]) / length, (there[1] - here[1]) / length
+            nx, ny = -uy * shift, ux * shift  # screen y grows down: (-uy, ux) is to the right of travel
+            start = (here[0] + ux * reach + nx, here[1] + uy * reach + ny)
+            end = (there[0] - ux * reach + nx, there[1] - uy * reach + ny)
+            arrows.append(MessageArrow(tick, sender, recipient, tuple(kinds), start, end))
+    return arrows
+
+
+def _length_of(pair: tuple[float, int, int, list[str], tuple[float, float], tuple[float, float]]) -> float:
+    return pair[0]
+
+
+def arrow_head(arrow: MessageArrow, size: float) -> list[tuple[float, float]]:
+    """Triangle of an arrow's tip, ``size`` pixels long, as three points (the tip first).
+
+    >>> arrow = MessageArrow(1, 0, 1, ("state",), (0.0, 0.0), (10.0, 0.0))
+    >>> arrow_head(arrow, 4.0)
+    [(10.0, 0.0), (6.0, -2.0), (6.0, 2.0)]
+    """
+    (x0, y0), (x1, y1) = arrow.start, arrow.end
+    length = math.dist(arrow.start, arrow.end) or 1.0
+    ux, uy = (x1 - x0) / length, (y1 - y0) / length
+    back_x, back_y = x1 - ux * size, y1 - uy * size
+    half = size / 2
+    return [(x1, y1), (back_x + uy * half, back_y - ux * half), (back_x - uy * half, back_y + ux * half)]
+
+
+def message_width(layout: Layout) -> float:
+    """Stroke width of message arrows in pixels.
+
+    >>> message_width(make_layout(Grid(5, 5)))
+    2.88
+    """
+    return max(1.0, layout.cell * 0.04)
+
+
+def message_label_place(arrow: MessageArrow, cell: float) -> tuple[tuple[float, float], str]:
+    """Where an arrow's :attr:`~MessageArrow.label` goes and how it is anchored: ``"start"``, ``"middle"`` or ``"end"``.
+
+    The label sits beside the arrow, on its right (the side it is shifted
+    to), a third of the way from the sender, so the labels of A to B and of
+    B to A never overlap. ``"start"`` means the text begins at the point (it
+    extends to the right), ``"end"`` that it ends there.
+
+    >>> north = MessageArrow(1, 0, 1, ("state",), (50.0, 100.0), (50.0, 10.0))   # drawn upwards
+    >>> message_label_place(north, 60.0)
+    ((59.0, 70.0), 'start')
+    >>> south = MessageArrow(1, 1, 0, ("state",), (40.0, 10.0), (40.0, 100.0))
+    >>> message_label_place(south, 60.0)[1]
+    'end'
+    """
+    (x0, y0), (x1, y1) = arrow.start, arrow.end
+    length = math.dist(arrow.start, arrow.end) or 1.0
+    ux, uy = (x1 - x0) / length, (y1 - y0) / length
+    nx, ny = -uy, ux
+    gap = cell * 0.15
+    x, y = x0 + (x1 - x0) / 3 + nx * gap, y0 + (y1 - y0) / 3 + ny * gap
+    if nx > 0.35:
+        return ((x, y), "start")
+    if nx < -0.35:
+        return ((x, y), "end")
+    return ((x, y + ny * gap * 0.5), "middle")

@@ -16,7 +16,14 @@ How it moves, all looping with ``repeatCount="indefinite"``:
   the last few cells);
 * the tick counter is one ``<text>`` per tick whose ``opacity`` switches with a
   discrete ``<animate>``;
-* a collision cell's ``opacity`` flashes at its tick and then stays faint.
+* a collision cell's ``opacity`` flashes at its tick and then stays faint;
+* with ``show_messages``, each tick's messages are arrows from sender to
+  recipient (:func:`mrmp.viz.layout.message_arrows`) whose ``opacity``
+  switches on for that tick with a discrete ``<animate>``.
+
+To show one moment (for a screenshot), pause the document's clock and set it:
+``svg.pauseAnimations(); svg.setCurrentTime(seconds)``; tick ``t`` plays at
+``t * seconds_per_tick`` seconds.
 
 Examples
 --------
@@ -41,6 +48,7 @@ from pathlib import Path
 
 from mrmp.core.grid import Grid
 from mrmp.core.result import RunResult
+from mrmp.viz._atomic import replacing
 from mrmp.viz.layout import (
     BACKGROUND,
     COLLISION,
@@ -53,18 +61,23 @@ from mrmp.viz.layout import (
     HEADER_DIM,
     HEADER_TEXT,
     HEADING_MARKER,
+    MESSAGE_LABEL_CELL,
     OBSTACLE,
     OBSTACLE_EDGE,
     PALETTE,
     ROBOT_RADIUS,
     SUCCESS,
     Keyframe,
+    arrow_head,
     cell_at,
     cost_tint,
     darker,
     hex_colour,
     label_size,
     make_layout,
+    message_arrows,
+    message_label_place,
+    message_width,
     mix,
     robot_colours,
     robot_label,
@@ -89,6 +102,7 @@ def write_svg(
     *,
     seconds_per_tick: float = 0.4,
     hold_s: float = 1.5,
+    show_messages: bool = False,
 ) -> Path:
     """Draw ``result`` on ``grid`` as a looping animated SVG at ``path``.
 
@@ -104,11 +118,15 @@ def write_svg(
         Playing time of one tick.
     hold_s:
         How long the final state stays on screen before the loop restarts.
+    show_messages:
+        Draw each tick's messages as arrows from sender to recipient (runs
+        with a message log).
 
     Returns
     -------
     Path
-        The path written.
+        The path written (atomically: a temporary file in the same folder,
+        then renamed).
 
     Raises
     ------
@@ -119,10 +137,11 @@ def write_svg(
         raise ValueError(f"seconds_per_tick must be positive, got {seconds_per_tick}")
     if not hold_s >= 0:
         raise ValueError(f"hold_s must not be negative, got {hold_s}")
-    root = _SvgRun(grid, result, seconds_per_tick, hold_s).build()
+    root = _SvgRun(grid, result, seconds_per_tick, hold_s, show_messages).build()
     ET.indent(root, space=" ")
     target = Path(path)
-    ET.ElementTree(root).write(target, encoding="utf-8", xml_declaration=True)
+    with replacing(target) as temporary:
+        ET.ElementTree(root).write(temporary, encoding="utf-8", xml_declaration=True)
     return target
 
 
@@ -139,7 +158,10 @@ def _n(value: float) -> str:
 class _SvgRun:
     """Builds the SVG element tree of one run."""
 
-    def __init__(self, grid: Grid, result: RunResult, seconds_per_tick: float, hold_s: float) -> None:
+    def __init__(
+        self, grid: Grid, result: RunResult, seconds_per_tick: float, hold_s: float, show_messages: bool = False
+    ) -> None:
+        self.show_messages = show_messages
         self.grid = grid
         self.result = result
         self.layout = make_layout(grid, len(result.robots))
@@ -232,6 +254,8 @@ class _SvgRun:
             )
         )
         self._robots(ET.SubElement(root, "g", {"id": "robots"}))
+        if self.show_messages:
+            self._messages(ET.SubElement(root, "g", {"id": "messages"}))
         self._collision_rings(ET.SubElement(root, "g", {"id": "collision-rings", "fill": "none"}))
         self._caption(ET.SubElement(root, "g", {"id": "caption"}))
         return root
@@ -480,6 +504,65 @@ class _SvgRun:
                     },
                 )
                 label.text = robot_label(robot.id)
+
+    def _messages(self, group: ET.Element) -> None:
+        """One ``<g class="message">`` per arrow, visible during its tick only."""
+        layout = self.layout
+        width = message_width(layout)
+        head = max(3.0, layout.cell * 0.16)
+        labelled = layout.cell >= MESSAGE_LABEL_CELL
+        robots = self.result.robots
+        for arrow in message_arrows(self.result, layout):
+            colour = hex_colour(self.colours[arrow.sender])
+            element = ET.SubElement(
+                group,
+                "g",
+                {
+                    "class": "message",
+                    "data-tick": str(arrow.tick),
+                    "data-from": robots[arrow.sender].id,
+                    "data-to": robots[arrow.recipient].id,
+                    "data-kinds": arrow.label,
+                    "opacity": "1" if arrow.tick == 1 else "0",
+                },
+            )
+            tip = arrow_head(arrow, head)
+            base = ((tip[1][0] + tip[2][0]) / 2, (tip[1][1] + tip[2][1]) / 2)
+            ET.SubElement(
+                element,
+                "line",
+                {
+                    "x1": _n(arrow.start[0]),
+                    "y1": _n(arrow.start[1]),
+                    "x2": _n(base[0]),
+                    "y2": _n(base[1]),
+                    "stroke": colour,
+                    "stroke-width": _n(width),
+                },
+            )
+            ET.SubElement(
+                element, "polygon", {"points": " ".join(f"{_n(x)},{_n(y)}" for x, y in tip), "fill": colour}
+            )
+            if labelled:
+                (label_x, label_y), side = message_label_place(arrow, layout.cell)
+                label = ET.SubElement(
+                    element,
+                    "text",
+                    {
+                        "x": _n(label_x),
+                        "y": _n(label_y),
+                        "dy": "0.35em",
+                        "text-anchor": side,
+                        "font-size": _n(layout.cell * 0.12),
+                        "fill": colour,
+                        "stroke": hex_colour(BACKGROUND),
+                        "stroke-width": "2",
+                        "paint-order": "stroke",
+                    },
+                )
+                label.text = arrow.label
+            samples = [(0.0, "0"), (arrow.tick - 1.0, "1"), (float(arrow.tick), "0")]
+            self._animate(element, "opacity", samples, discrete=True)
 
     def _caption(self, group: ET.Element) -> None:
         layout = self.layout

@@ -7,14 +7,12 @@ from pathlib import Path
 
 import pytest
 from PIL import Image
+from pixels import Colour, close, share_near
 
 from mrmp.core import Grid, RunResult
 from mrmp.viz import write_gif
 from mrmp.viz.gif import frame_times
 from mrmp.viz.layout import darker, make_layout, robot_colours
-
-Colour = tuple[int, int, int]
-
 
 def frames_of(path: Path) -> list[Image.Image]:
     with Image.open(path) as gif:
@@ -23,22 +21,6 @@ def frames_of(path: Path) -> list[Image.Image]:
             gif.seek(index)
             frames.append(gif.convert("RGB"))
         return frames
-
-
-def close(pixel: Colour, colour: Colour, tolerance: int = 24) -> bool:
-    return all(abs(a - b) <= tolerance for a, b in zip(pixel, colour))
-
-
-def share_near(image: Image.Image, centre: tuple[float, float], radius: float, colour: Colour) -> float:
-    """Share of the pixels within ``radius`` of ``centre`` that have about ``colour``."""
-    cx, cy = centre
-    hits = total = 0
-    for x in range(int(cx - radius), int(cx + radius) + 1):
-        for y in range(int(cy - radius), int(cy + radius) + 1):
-            if (x - cx) ** 2 + (y - cy) ** 2 <= radius**2:
-                total += 1
-                hits += close(image.getpixel((x, y)), colour)
-    return hits / total
 
 
 def test_frame_count_size_and_timing(swap: tuple[Grid, RunResult], tmp_path: Path) -> None:
