@@ -8,6 +8,7 @@ printed and written); 2 for bad input (each problem on one line, no traceback).
 from __future__ import annotations
 
 import sys
+from collections.abc import Callable
 from pathlib import Path
 from typing import Annotated, Optional
 
@@ -19,8 +20,8 @@ from mrmp.core.errors import InputError, MrmpError, Problem
 from mrmp.core.result import RunResult
 from mrmp.core.scenario import RESOLUTIONS, NetworkFaults, PolicyOptions, Scenario, scenario_problems
 from mrmp.io import load_movingai_scenario, load_scenario, validate_file, write_result_json
-from mrmp.policies.registry import POLICY_NAMES, ROUND_POLICIES
-from mrmp.sim.simulator import simulate
+from mrmp.policies.registry import ASYNC_POLICIES, POLICY_NAMES, ROUND_POLICIES
+from mrmp.sim.simulator import TickObserver, simulate
 
 app = typer.Typer(
     add_completion=False,
@@ -236,6 +237,36 @@ def print_result(result: RunResult, console: Console) -> None:
         console.print(f"  did not arrive: {names}")
 
 
+def _check_show_messages(scenario: Scenario, written: bool, live: bool, planned: bool) -> None:
+    """Refuse ``--show-messages`` before the run when its messages would not be recorded or drawn."""
+    from mrmp.sim.simulator import records_messages
+
+    if not written:
+        raise InputError(Problem("--show-messages", "messages are drawn in an animation: give --animate (or --json to keep them)"))
+    if live:
+        raise InputError(Problem("--show-messages", "live runs do not record their messages; simulate instead (without --live)"))
+    if not planned and not records_messages(scenario):
+        raise InputError(
+            Problem(
+                "--show-messages",
+                f"{scenario.policy.name} runs in synchronous rounds whose messages are not recorded; "
+                "use a per-robot policy or --planner",
+            )
+        )
+
+
+def _watched(
+    scenario: Scenario, fps: float | None, console: Console, start: Callable[[TickObserver | None], RunResult]
+) -> RunResult:
+    """``start(on_tick)``, drawing every tick in the terminal when ``fps`` is given (``--watch``)."""
+    if fps is None:
+        return start(None)
+    from mrmp.viz.terminal import TerminalView
+
+    with TerminalView(scenario, console, fps) as view:
+        return start(view.on_tick)
+
+
 @app.command()
 def run(
     scenario_path: Annotated[Optional[Path], typer.Argument(metavar="SCENARIO", help="A YAML scenario.")] = None,
@@ -256,7 +287,10 @@ def run(
     duplicate: Annotated[Optional[float], typer.Option(help="Probability that a message is duplicated.")] = None,
     reorder: Annotated[Optional[float], typer.Option(help="Probability that a message overtakes earlier ones.")] = None,
     json_path: Annotated[Optional[str], typer.Option("--json", help="Write the whole result as JSON (- for stdout).")] = None,
-    animate: Annotated[Optional[Path], typer.Option(help="Write an animation: .gif or .svg.")] = None,
+    animate: Annotated[Optional[Path], typer.Option(help="Write an animation: .gif, .svg or .mp4 (needs ffmpeg).")] = None,
+    show_messages: Annotated[bool, typer.Option("--show-messages", help="Record each tick's messages and draw them in the --animate animation (and the --json result).")] = False,
+    watch: Annotated[bool, typer.Option("--watch", help="Draw the grid in the terminal as the robots move.")] = False,
+    watch_fps: Annotated[float, typer.Option(help="--watch: ticks drawn per second.")] = 10.0,
     planner: Annotated[Optional[str], typer.Option(help="Plan centrally first (cbs, pp, lacam), then execute the plan.")] = None,
     time_limit: Annotated[float, typer.Option(help="Seconds a central planner may spend.")] = 30.0,
     live: Annotated[bool, typer.Option("--live", help="One OS process per robot, in real time, over a loopback network.")] = False,
@@ -290,12 +324,24 @@ def run(
         )
         if scenario.lifelong and (live or planner is not None):
             raise InputError(Problem("--lifelong", "lifelong runs are simulated with a decentralized policy (not --live, not --planner)"))
+        if unsafe and scenario.policy.name in ASYNC_POLICIES:
+            raise InputError(Problem("--unsafe", f"{scenario.policy.name} always enters cells through the safety layer; it has no unsafe form"))
         if live and scenario.policy.name in ROUND_POLICIES:
             raise InputError(
-                Problem("--policy", f"{scenario.policy.name} runs in the simulator's synchronous rounds only, not --live yet")
+                Problem("--policy", f"{scenario.policy.name} runs in the simulator's synchronous rounds only; its live, asynchronous form is --policy causal")
             )
-        if animate is not None and animate.suffix.lower() not in (".gif", ".svg"):
-            raise InputError(Problem("--animate", f"unsupported suffix {animate.suffix!r}; use .gif or .svg"))
+        if animate is not None:
+            from mrmp.viz.animate import animation_problem
+
+            animation_issue = animation_problem(animate)
+            if animation_issue is not None:
+                raise InputError(Problem("--animate", animation_issue))
+        if show_messages:
+            _check_show_messages(scenario, animate is not None or json_path is not None, live, planner is not None)
+        if watch and live:
+            raise InputError(Problem("--watch", "live runs are not drawn in the terminal (--watch is for simulated runs)"))
+        if watch:
+            _positive(watch_fps, "--watch-fps")
         plan = None
         if planner is not None:
             plan = _plan(planner, scenario, time_limit, console)
@@ -318,19 +364,33 @@ def run(
         elif plan is not None:
             from mrmp.centralized.execution import execute_in_simulator
 
-            result = execute_in_simulator(scenario, plan)
+            executed_plan = plan
+            result = _watched(
+                scenario,
+                watch_fps if watch else None,
+                console,
+                lambda on_tick: execute_in_simulator(scenario, executed_plan, record_messages=show_messages, on_tick=on_tick),
+            )
         else:
-            result = simulate(scenario)
+            result = _watched(
+                scenario,
+                watch_fps if watch else None,
+                console,
+                lambda on_tick: simulate(scenario, record_messages=show_messages, on_tick=on_tick),
+            )
     except InputError as error:
         raise _fail(error.problems) from None
+    except MrmpError as error:  # e.g. a plan that cannot be executed (PlanDeadlockError)
+        Console(stderr=True).print(f"error: {error}", markup=False)
+        raise typer.Exit(2) from None
     print_result(result, console)
     try:
         if json_path is not None:
-            write_result_json(result, json_path)
+            write_result_json(result, json_path, grid=scenario.grid)
         if animate is not None:
             from mrmp.viz import write_animation
 
-            write_animation(scenario.grid, result, animate)
+            write_animation(scenario.grid, result, animate, show_messages=show_messages)
             console.print(f"animation written to {animate}")
     except (MrmpError, OSError) as error:
         Console(stderr=True).print(f"error: {error}", markup=False)
@@ -383,6 +443,134 @@ def compare(
             print(json.dumps(rows_data, indent=1))
         else:
             write_json(json_path, rows_data)
+
+
+@app.command()
+def report(
+    source: Annotated[Path, typer.Argument(metavar="DIR_OR_JSONL", help="A benchmark's --out folder, or its results.jsonl.")],
+    out: Annotated[Path, typer.Option(help="The HTML page to write; its plots go to <stem>_plots/ next to it.")] = Path("report.html"),
+    title: Annotated[Optional[str], typer.Option(help="The page's title (default: named after the benchmark).")] = None,
+    markdown: Annotated[Optional[Path], typer.Option(help="Also write the headline table as Markdown to this file.")] = None,
+) -> None:
+    """Write an HTML report of a benchmark: what was run, the headline table, plots, timeouts and errors."""
+    from mrmp.bench.aggregate import headline_table, summarize
+    from mrmp.io.report_input import read_bench_results
+    from mrmp.viz.report_html import write_report
+
+    console = Console(highlight=False)
+    try:
+        results = read_bench_results(source)
+        if not results.records:
+            cut = f" ({results.truncated_lines} truncated line set aside)" if results.truncated_lines else ""
+            raise InputError(Problem(str(results.path), f"no run record in the file{cut}"))
+        files = write_report(results, out, title=title, markdown=markdown)
+    except InputError as error:
+        raise _fail(error.problems) from None
+    summaries = summarize(results.records)
+    console.print(f"{len(results.records)} runs from {results.path}", markup=False, soft_wrap=True)
+    for map_name in sorted({summary.key.map for summary in summaries}):
+        headline = headline_table([summary for summary in summaries if summary.key.map == map_name])
+        table = Table(title=map_name, title_justify="left", box=None, pad_edge=False, padding=(0, 1), header_style="bold")
+        for index, (column, numeric) in enumerate(zip(headline.columns[1:], headline.numeric[1:]), start=1):
+            widest = max(len(row[index]) for row in headline.rows)
+            table.add_column(column, justify="right" if numeric else "left", no_wrap=numeric, min_width=min(widest, 14))
+        for row in headline.rows:
+            table.add_row(*row[1:])
+        console.print(table)
+    if results.truncated_lines:
+        console.print(f"note: the last line of {results.path} was cut short (an interrupted bench); it was set aside", markup=False, soft_wrap=True)
+    unfinished = sum(1 for record in results.records if not record.finished)
+    if unfinished:
+        console.print(f"note: {unfinished} runs timed out or failed; see the report's notes", markup=False, soft_wrap=True)
+    console.print(f"report written to {files.html}", markup=False, soft_wrap=True)
+    console.print(f"{len(files.plots)} plots written to {files.plots_folder}", markup=False, soft_wrap=True)
+    if markdown is not None:
+        console.print(f"headline table (Markdown) written to {markdown}", markup=False, soft_wrap=True)
+
+
+@app.command("animate")
+def animate_command(
+    result_path: Annotated[Path, typer.Argument(metavar="RESULT", help="A run saved with mrmp run --json (it holds the map).")],
+    out: Annotated[Path, typer.Option("--out", help="The animation to write: .gif, .svg or .mp4 (needs ffmpeg).")],
+    show_messages: Annotated[bool, typer.Option("--show-messages", help="Draw each tick's messages (runs saved with them).")] = False,
+) -> None:
+    """Draw a saved run as an animation."""
+    from mrmp.io.results import read_result_json
+    from mrmp.viz import animation_problem, write_animation
+
+    console = Console(highlight=False)
+    try:
+        animation_issue = animation_problem(out)
+        if animation_issue is not None:
+            raise InputError(Problem("--out", animation_issue))
+        result, grid = read_result_json(result_path)
+        if grid is None:
+            raise InputError(Problem(str(result_path), "no map is stored with this run: save it with mrmp run --json"))
+        if show_messages and not result.message_log:
+            raise InputError(
+                Problem(str(result_path), "no messages are recorded in this run: save it with mrmp run --show-messages --json")
+            )
+    except InputError as error:
+        raise _fail(error.problems) from None
+    try:
+        write_animation(grid, result, out, show_messages=show_messages)
+    except (MrmpError, OSError) as error:
+        Console(stderr=True).print(f"error: {error}", markup=False)
+        raise typer.Exit(2) from None
+    console.print(f"animation written to {out}", markup=False)
+
+
+@app.command()
+def bench(
+    config_path: Annotated[Path, typer.Argument(metavar="CONFIG.yaml", help="A benchmark configuration (see bench/tiny.yaml).")],
+    out: Annotated[Path, typer.Option(help="Output folder: results.jsonl (one record per run) and results.csv.")],
+    workers: Annotated[Optional[int], typer.Option(help="Worker processes (default: the number of CPUs).")] = None,
+    dask: Annotated[Optional[str], typer.Option(help="Run on this dask.distributed scheduler (HOST:PORT) instead.")] = None,
+    time_limit: Annotated[Optional[float], typer.Option(help="Seconds per run, replacing the configuration's time_limit.")] = None,
+    only_missing: Annotated[bool, typer.Option("--only-missing", help="Also run again the runs whose last record is an error.")] = False,
+) -> None:
+    """Run a benchmark matrix (maps x robots x methods x seeds x faults); resumes where it stopped."""
+    from mrmp.bench.runner import run_bench
+    from mrmp.bench.summary import summary_rows
+    from mrmp.io.bench_config import load_bench_config
+
+    console = Console(highlight=False, width=None if sys.stdout.isatty() else 140)
+    err = Console(stderr=True, highlight=False, soft_wrap=True)
+    try:
+        if workers is not None and workers < 1:
+            raise InputError(Problem("--workers", f"must be at least 1, got {workers}"))
+        if time_limit is not None:
+            _positive(time_limit, "--time-limit")
+        config = load_bench_config(config_path, time_limit=time_limit)
+        for note in config.notes:
+            err.print(f"note: {note}", markup=False)
+        if not config.runs:
+            raise InputError(Problem(str(config_path), "the matrix has no runs (every combination was left out)"))
+        console.print(f"{config.name}: {len(config.runs)} runs, results in {out}", markup=False)
+        outcome = run_bench(
+            config.runs, out, workers=workers, dask_address=dask, retry_errors=only_missing,
+            say=lambda text: err.print(text, markup=False),
+        )  # fmt: skip
+    except InputError as error:
+        raise _fail(error.problems) from None
+    table = Table(title=f"{config.name}: {len(outcome.records)} of {outcome.total} runs recorded")
+    rows = summary_rows(outcome.records)
+    table.add_column("map", min_width=max((len(row.map) for row in rows), default=3))
+    for column in ("policy", "N", "runs", "success", "SoC/LB", "wall s", "timeouts", "errors"):
+        table.add_column(column, justify="left" if column == "policy" else "right")
+    for row in rows:
+        table.add_row(
+            row.map, row.policy, str(row.agents), str(row.runs), f"{100 * row.success_rate:.0f}%",
+            f"{row.mean_soc_over_lb:.3f}" if row.mean_soc_over_lb is not None else "-",
+            f"{row.mean_wall_time_s:.2f}" if row.mean_wall_time_s is not None else "-",
+            str(row.timeouts), str(row.errors),
+        )  # fmt: skip
+    console.print(table)
+    console.print(f"results: {out / 'results.jsonl'} and {out / 'results.csv'}", markup=False)
+    if outcome.interrupted:
+        raise typer.Exit(130)
+    if outcome.failure is not None:
+        raise typer.Exit(1)
 
 
 @app.command()

@@ -654,6 +654,17 @@ def _yaml_error_problem(error: yaml.YAMLError, text: str, source: str) -> Proble
     return Problem(f"{source}:{line}", f"invalid YAML: {reason}")
 
 
+def _compose(text: str, source: str, expected: str) -> Node:
+    """The YAML node tree of ``text``; invalid YAML, or an empty file (that should hold ``expected``), is an InputError."""
+    try:
+        root = yaml.compose(text, Loader=yaml.SafeLoader)
+    except yaml.YAMLError as error:
+        raise InputError(_yaml_error_problem(error, text, source)) from None
+    if root is None:
+        raise InputError(Problem(f"{source}:1", f"the file is empty: expected {expected}"))
+    return root
+
+
 def _problem_order(problem: Problem, source: str) -> tuple[bool, str, int]:
     """Sort key: problems of ``source`` first, then other files, each by line."""
     file, _, line = problem.where.rpartition(":")
@@ -701,12 +712,7 @@ def scenario_from_text(
     mrmp.core.errors.InputError: swap.yaml:3: robots[0].goal: cell (9, 2) is outside the 5x5 grid
     """
     folder = Path(source_name).parent if base_dir is None else Path(base_dir)
-    try:
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
-    except yaml.YAMLError as error:
-        raise InputError(_yaml_error_problem(error, text, source_name)) from None
-    if root is None:
-        raise InputError(Problem(f"{source_name}:1", "the file is empty: expected a mapping with map and robots"))
+    root = _compose(text, source_name, "a mapping with map and robots")
     if not isinstance(root, MappingNode):
         kind = "a list" if isinstance(root, SequenceNode) else f"a single value {root.value!r}"
         raise InputError(

@@ -86,7 +86,7 @@ def test_movingai_run():
         (["--policy", "nope"], "unknown policy 'nope'"),
         (["--loss", "1.5"], "network.loss: must be a probability"),
         (["--delay", "x"], "--delay: expected N or A..B"),
-        (["--animate", "out.mp4"], "unsupported suffix '.mp4'"),
+        (["--animate", "out.avi"], "unsupported suffix '.avi'"),
     ],
 )
 def test_bad_options_exit_2_with_one_line(args, fragment):
@@ -159,7 +159,7 @@ def test_compare_prints_every_method(tmp_path):
     result = invoke("compare", EXAMPLES / "thesis-cross.yaml", "--json", out)
     assert result.exit_code == 0, result.output
     rows = json.loads(out.read_text())
-    assert [row["method"] for row in rows] == ["thesis", "astar", "pibt", "cbs", "pp", "lacam"]
+    assert [row["method"] for row in rows] == ["thesis", "astar", "pibt", "causal", "cbs", "pp", "lacam"]
     assert all(row["success"] for row in rows)
     cbs = next(row for row in rows if row["method"] == "cbs")
     assert cbs["sum_of_costs"] == 16 == cbs["lower_bound"]  # optimal: the lower bound is reached
