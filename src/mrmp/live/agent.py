@@ -138,15 +138,10 @@ class Agent(LiveDriver):
         if body.moving:
             if body.poll(now):
                 robot.arrived_at(body.cell, body.heading)
-                report.steps += 1
-                report.believed_path.append((now, body.cell))
+                self._record_move(now, started, robot.arrived)
                 self._send(robot.announce(now))
                 sent_state = True
                 self._phase, self._next_decision = Phase.LISTEN, now + timing.listen_time
-                if robot.arrived and report.arrival_time is None:
-                    report.arrival_time = now - started
-                elif not robot.arrived:
-                    report.arrival_time = None
         elif self._phase is Phase.LISTEN and now >= self._next_decision:
             self._send(robot.decide(now))
             self._phase, self._decided_at = Phase.CLAIM, now

@@ -131,10 +131,7 @@ class CausalAgent(LiveDriver):
             if body.poll(now):
                 self._send(robot.arrived_at(body.cell, now, body.heading))
                 sent_state = True
-                report.steps += 1
-                report.believed_path.append((now, body.cell))
-                if robot.at_goal and report.arrival_time is None:
-                    report.arrival_time = now - started
+                self._record_move(now, started, robot.body_on_goal)
         else:
             if robot.mode_name == "extended" and self._extended_at is None:
                 self._extended_at = now
@@ -147,6 +144,6 @@ class CausalAgent(LiveDriver):
         if now >= self._next_activation:
             self._send(robot.activate(now))
             self._next_activation = now + timing.listen_time * (0.5 + self.random.random())
-        if not robot.at_goal:
+        if not robot.body_on_goal:
             report.arrival_time = None
         return sent_state

@@ -202,6 +202,16 @@ class LiveDriver:
         """The report's ``safety`` counts."""
         raise NotImplementedError
 
+    def _record_move(self, now: float, started: float, on_goal: bool) -> None:
+        """The body ended a move, on the goal or not: count it, log the cell, keep the arrival time."""
+        report = self.report
+        report.steps += 1
+        report.believed_path.append((now, self.body.cell))
+        if not on_goal:
+            report.arrival_time = None
+        elif report.arrival_time is None:
+            report.arrival_time = now - started
+
     # -- the receiving thread ----------------------------------------------------------
 
     def _receive_loop(self) -> None:

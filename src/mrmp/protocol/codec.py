@@ -65,6 +65,7 @@ from mrmp.protocol.messages import (
     BeaconMessage,
     ClaimMessage,
     MAX_VISITED_CELLS,
+    RELEASE_OPERATIONS,
     InheritMessage,
     LockAckMessage,
     LockGrantMessage,
@@ -100,9 +101,8 @@ _CELL = struct.Struct("!ii")
 _STATE, _CLAIM, _REPLY, _BEACON, _INHERIT, _ANSWER, _RESERVE, _PULL = 1, 2, 3, 4, 5, 6, 7, 8
 _LOCK_REQUEST, _LOCK_GRANT, _LOCK_RELEASE, _LOCK_ACK = 9, 10, 11, 12
 _HAS_HEAD, _URGENT = 0x01, 0x02
-_RELEASE_OPERATIONS = 0x1F
-"""Every operation bit a lock release may carry (:mod:`mrmp.robot.causal_pibt`)."""
-_VARIABLE = {_LOCK_GRANT: _LOCK_GRANT_BODY, _LOCK_RELEASE: _LOCK_RELEASE_BODY}
+_VARIABLE = frozenset({_LOCK_GRANT, _LOCK_RELEASE})
+"""Types whose fixed body ends with a count of the visited cells that follow it."""
 _ARRIVED, _MOVING, _CLAIMING = 0x01, 0x02, 0x04
 _BODIES = {
     _STATE: _STATE_BODY,
@@ -287,7 +287,7 @@ def _decode_lock(type_code: int, sender: int, seq: int, fields: tuple[int, ...],
     visited = tuple((x, y) for x, y in _CELL.iter_unpack(rest))
     if type_code == _LOCK_RELEASE:
         session, operations, _ = fields
-        if operations & ~_RELEASE_OPERATIONS:
+        if operations & ~RELEASE_OPERATIONS:
             raise DecodeError("malformed", f"unknown release operations {operations:#04x}")
         return LockReleaseMessage(sender, seq, session, operations, visited)
     locker, session, mode, flags, tx, ty, hx, hy, reached, rank, _ = fields

@@ -175,6 +175,20 @@ MAX_VISITED_CELLS = 48
 """Most cells a lock grant or release carries in its ``visited`` set (Causal-PIBT's S), so
 that every message stays size-bounded."""
 
+# operations a lock release writes into the locked robot (its ``operations`` bits)
+CLEAR_PARENT = 0x01
+"""If your parent is the sender, you are your own parent again (the sender released its children)."""
+REMOVE_CHILD = 0x02
+"""The sender is no longer your child."""
+ADD_CHILD = 0x04
+"""The sender is your child (it inherited your priority)."""
+CONTRACT = 0x08
+"""Drop your head and be contracted (you lost a contest, or your child backtracked)."""
+SET_VISITED = 0x10
+"""Your visited set S becomes the release's ``visited``; remove those cells from your candidates C."""
+RELEASE_OPERATIONS = CLEAR_PARENT | REMOVE_CHILD | ADD_CHILD | CONTRACT | SET_VISITED
+"""Every operation bit a lock release may carry."""
+
 
 @dataclass(frozen=True, slots=True)
 class LockRequestMessage:
@@ -214,10 +228,12 @@ class LockGrantMessage:
 class LockReleaseMessage:
     """Causal-PIBT: the end of activation ``session`` of the sender, with what it wrote into the recipient.
 
-    ``operations`` is a set of bits (:mod:`mrmp.robot.causal_pibt`): clear the
-    recipient's parent if it is the sender, remove or add the sender as a child,
-    contract (drop the head), and replace the visited set S by ``visited``
-    (also removing those cells from the recipient's candidates).
+    ``operations`` is a set of bits (:data:`RELEASE_OPERATIONS`): clear the
+    recipient's parent if it is the sender (:data:`CLEAR_PARENT`), remove or add
+    the sender as a child (:data:`REMOVE_CHILD`, :data:`ADD_CHILD`), contract
+    (drop the head, :data:`CONTRACT`), and replace the visited set S by
+    ``visited`` (also removing those cells from the recipient's candidates,
+    :data:`SET_VISITED`).
     """
 
     sender: int

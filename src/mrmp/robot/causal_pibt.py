@@ -80,9 +80,13 @@ from dataclasses import dataclass, field
 from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
 from mrmp.core.heading import Heading
-from mrmp.policies.priority import outranks
 from mrmp.protocol.messages import (
+    ADD_CHILD,
+    CLEAR_PARENT,
+    CONTRACT,
     MAX_VISITED_CELLS,
+    REMOVE_CHILD,
+    SET_VISITED,
     ClaimMessage,
     LockAckMessage,
     LockGrantMessage,
@@ -93,8 +97,7 @@ from mrmp.protocol.messages import (
     StateMessage,
 )
 from mrmp.protocol.safety import SafetyLayer
-from mrmp.robot.messaging import MessageEndpoint
-from mrmp.robot.robot import Outgoing
+from mrmp.robot.messaging import MessageEndpoint, Outgoing
 from mrmp.search.flat_map import FlatMap
 
 __all__ = [
@@ -113,18 +116,6 @@ LOCK_RADIUS = 2
 """An activation locks the robots whose known cells lie within this many cells (Manhattan) of the tail."""
 MAX_CLAIM_FAILURES = 8
 """Claims of the head refused or timed out in a row before an extended robot gives the head up."""
-
-# operations a lock release writes into the locked robot
-CLEAR_PARENT = 0x01
-"""If your parent is the sender, you are your own parent again (the sender released its children)."""
-REMOVE_CHILD = 0x02
-"""The sender is no longer your child."""
-ADD_CHILD = 0x04
-"""The sender is your child (it inherited your priority)."""
-CONTRACT = 0x08
-"""Drop your head and be contracted (you lost a contest, or your child backtracked)."""
-SET_VISITED = 0x10
-"""Your visited set S becomes the release's ``visited``; remove those cells from your candidates C."""
 
 Priority = tuple[int, int, int]
 """``(away from goal, -(goals reached), index)``: larger is higher."""
@@ -261,6 +252,11 @@ class CausalRobot(MessageEndpoint):
         return self.mode != EXTENDED and self.tail == self.goal
 
     @property
+    def body_on_goal(self) -> bool:
+        """Whether the body stands on the goal: contracted there, or moved there and not yet contracted (locked)."""
+        return self.at_goal or (self.body_arrived and self.head == self.goal)
+
+    @property
     def idle(self) -> bool:
         """Whether no activation of this robot is under way."""
         return self.session is None
@@ -307,7 +303,7 @@ class CausalRobot(MessageEndpoint):
         if self.session is not None:
             return []
         if self.mode == EXTENDED:
-            return self._finish_move(now) if self.body_arrived and self.locked_by is None else []
+            return self._finish_move_when_free(now)
         if self._nothing_to_do():
             return []
         self._sessions += 1
@@ -357,16 +353,23 @@ class CausalRobot(MessageEndpoint):
         for member, view in views.items():
             visited = tuple(_bounded(view.new_visited, view.tail)) if view.new_visited is not None else ()
             session.releases[member] = LockReleaseMessage(self.index, 0, session.number, view.operations, visited)
-        session.releasing = True
-        session.sent_at = now
-        for member, release in session.releases.items():
-            sent.append(Outgoing(self._stamp(release), (member,)))
-        if not session.releases:
-            self.session = None
+        sent.extend(self._start_releasing(session, now))
         sent.append(Outgoing(self.state_message()))
         if self.mode == EXTENDED:
             sent.extend(self._claim_head(now))
         return sent
+
+    def _send_releases(self, session: _Session, now: float) -> list[Outgoing]:
+        """Send (again) every release of ``session`` not yet acknowledged."""
+        session.sent_at = now
+        return [Outgoing(self._stamp(release), (member,)) for member, release in session.releases.items()]
+
+    def _start_releasing(self, session: _Session, now: float) -> list[Outgoing]:
+        """The locks of ``session`` are given back: send its releases (none: the activation is over)."""
+        session.releasing = True
+        if not session.releases:
+            self.session = None
+        return self._send_releases(session, now)
 
     def _abandon(self, now: float) -> list[Outgoing]:
         """Give the activation up: release every robot asked so far, writing nothing back."""
@@ -383,11 +386,7 @@ class CausalRobot(MessageEndpoint):
             for member in session.order[: session.position + 1]
             if member != self.index
         }
-        session.releasing = True
-        session.sent_at = now
-        if not session.releases:
-            self.session = None
-        return sent + [Outgoing(self._stamp(release), (member,)) for member, release in session.releases.items()]
+        return sent + self._start_releasing(session, now)
 
     # -- the transitions (the authors' actContracted, actRequesting, priorityInheritance) ----------
 
@@ -520,7 +519,13 @@ class CausalRobot(MessageEndpoint):
             self.heading = heading
         self.moving = False
         self.body_arrived = True
-        return self._finish_move(now) if self.locked_by is None and self.session is None else []
+        return self._finish_move_when_free(now)
+
+    def _finish_move_when_free(self, now: float) -> list[Outgoing]:
+        """Finish the body's move once it has arrived, no activation of this robot is under way and no peer holds its lock."""
+        if self.body_arrived and self.locked_by is None and self.session is None:
+            return self._finish_move(now)
+        return []
 
     def _finish_move(self, now: float) -> list[Outgoing]:
         """The authors' ``actExtended``: the head becomes the tail; count a goal reached; reset."""
@@ -553,8 +558,7 @@ class CausalRobot(MessageEndpoint):
         session = self.session
         if session is not None and now - session.sent_at >= self.retry_interval:
             if session.releasing:
-                session.sent_at = now
-                sent.extend(Outgoing(self._stamp(release), (member,)) for member, release in session.releases.items())
+                sent.extend(self._send_releases(session, now))
                 self.stats["resent"] += len(session.releases)
             elif now - max(session.started_at, session.progress_at) >= self.lock_timeout:
                 sent.extend(self._abandon(now))
@@ -573,8 +577,8 @@ class CausalRobot(MessageEndpoint):
                     sent.extend(self._give_up_head())
                 elif now - self._failed_at >= 2 * self.retry_interval:
                     sent.extend(self._claim_head(now))  # registries release a cell only on its last owner's state
-        elif self.body_arrived and self.locked_by is None and self.session is None:
-            sent.extend(self._finish_move(now))
+        else:
+            sent.extend(self._finish_move_when_free(now))
         return sent
 
     def heartbeat(self) -> list[Outgoing]:
@@ -594,12 +598,7 @@ class CausalRobot(MessageEndpoint):
             return []
         if isinstance(message, ClaimMessage):
             _, cells = self.known.get(sender, (0, (message.cell,)))
-            outranks_me = outranks(cells[0], sender, self.tail, self.index)
-            reply = self.safety.handle_claim(message, outranks_me)
-            if reply is None:
-                self.dropped["stale_claim"] += 1
-                return []
-            return [Outgoing(self._stamp(reply), (sender,))]
+            return self._answer_claim(message, cells[0], self.tail)
         if isinstance(message, ReplyMessage):
             self.safety.handle_reply(message, now)
             return []
@@ -706,9 +705,7 @@ class CausalRobot(MessageEndpoint):
         elif number <= self._released.get(locker, 0):
             self.dropped["duplicate_release"] += 1
         self._released[locker] = max(self._released.get(locker, 0), number)
-        sent = [ack]
-        if self.locked_by is None and self.session is None and self.body_arrived:
-            sent.extend(self._finish_move(now))
+        sent = [ack, *self._finish_move_when_free(now)]
         if self.locked_by is None:
             sent.extend(self._grant_next_waiting(now))
         return sent

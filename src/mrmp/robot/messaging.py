@@ -1,8 +1,11 @@
-"""What every robot brain does with messages alike: numbering what it sends, decoding what it receives.
+"""What every robot brain does with messages alike: numbering what it sends, answering claims, decoding.
 
-Every message a robot sends carries the next number of the robot's sequence
-(``seq``), so that receivers can tell newer states from older ones; its state
-message carries the safety layer's part (:meth:`~mrmp.protocol.safety.SafetyLayer.state_fields`).
+What a brain sends is a list of :class:`Outgoing`. Every message a robot
+sends carries the next number of the robot's sequence (``seq``), so that
+receivers can tell newer states from older ones; its state message carries the
+safety layer's part (:meth:`~mrmp.protocol.safety.SafetyLayer.state_fields`).
+A peer's claim of a cell is answered by the safety layer, which yields to the
+claimant when it outranks this robot (:func:`~mrmp.policies.priority.outranks`).
 A datagram that does not decode is dropped and counted by the reason the codec
 gives (:class:`~mrmp.protocol.codec.DecodeError`).
 
@@ -22,17 +25,22 @@ Examples
 from __future__ import annotations
 
 from collections import Counter
-from dataclasses import replace
-from typing import TYPE_CHECKING
+from dataclasses import dataclass, replace
 
 from mrmp.core.cell import Cell
 from mrmp.core.heading import Heading
+from mrmp.policies.priority import outranks
 from mrmp.protocol.codec import DecodeError, decode
-from mrmp.protocol.messages import Message, StateMessage
+from mrmp.protocol.messages import ClaimMessage, Message, StateMessage
 from mrmp.protocol.safety import SafetyLayer
 
-if TYPE_CHECKING:
-    from mrmp.robot.robot import Outgoing
+
+@dataclass(frozen=True, slots=True)
+class Outgoing:
+    """A message to send; ``recipients`` None means every peer."""
+
+    message: Message
+    recipients: tuple[int, ...] | None = None
 
 
 class MessageEndpoint:
@@ -64,6 +72,18 @@ class MessageEndpoint:
             progress=progress,
             **self.safety.state_fields(),  # type: ignore[arg-type]
         )
+
+    def _answer_claim(self, message: ClaimMessage, claimant_present: Cell, present: Cell) -> list[Outgoing]:
+        """The safety layer's reply to a peer's claim, for the claimant alone (none to a stale claim, counted).
+
+        ``claimant_present`` is where the claimant is believed to stand, ``present`` where this robot stands.
+        """
+        claimant_outranks = outranks(claimant_present, message.sender, present, self.index)
+        reply = self.safety.handle_claim(message, claimant_outranks)
+        if reply is None:
+            self.dropped["stale_claim"] += 1
+            return []
+        return [Outgoing(self._stamp(reply), (message.sender,))]
 
     def receive(self, message: Message, now: float) -> list[Outgoing]:
         """Take in one decoded message; return the answers to send."""

@@ -44,26 +44,19 @@ from __future__ import annotations
 
 from collections import Counter
 from collections.abc import Sequence
-from dataclasses import dataclass, replace
+from dataclasses import replace
 
 from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
 from mrmp.core.heading import Heading
 from mrmp.core.scenario import RobotSpec
 from mrmp.policies.base import Decision, Policy, Situation
-from mrmp.policies.priority import outranks
 from mrmp.protocol.messages import ClaimMessage, Message, ReplyMessage, StateMessage
 from mrmp.protocol.safety import SafetyLayer
 from mrmp.robot.belief import Belief
-from mrmp.robot.messaging import MessageEndpoint
+from mrmp.robot.messaging import MessageEndpoint, Outgoing
 
-
-@dataclass(frozen=True, slots=True)
-class Outgoing:
-    """A message to send; ``recipients`` None means every peer."""
-
-    message: Message
-    recipients: tuple[int, ...] | None = None
+__all__ = ["Outgoing", "Robot"]
 
 
 class Robot(MessageEndpoint):
@@ -215,13 +208,7 @@ class Robot(MessageEndpoint):
             return []
         if isinstance(message, ClaimMessage):
             peer = self.belief.peers.get(message.sender)
-            claimant_present = peer.present if peer is not None else message.cell
-            claimant_outranks = outranks(claimant_present, message.sender, self.present, self.index)
-            reply = self.safety.handle_claim(message, claimant_outranks)
-            if reply is None:
-                self.dropped["stale_claim"] += 1
-                return []
-            return [Outgoing(self._stamp(reply), (message.sender,))]
+            return self._answer_claim(message, peer.present if peer is not None else message.cell, self.present)
         if isinstance(message, ReplyMessage):
             self.safety.handle_reply(message, now)
         return []
