@@ -56,9 +56,7 @@ from mrmp.viz.layout import (
     Layout,
     make_layout,
 )
-from mrmp.viz.raster import check_frame_options, frame_times, frames_of_run
-
-__all__ = ["write_gif", "frame_times", "PIXEL_BUDGET", "BYTE_BUDGET", "SIZE_LIMIT", "MIN_FRAMES"]
+from mrmp.viz.raster import check_frame_options, frames_of_run
 
 PIXEL_BUDGET = 90_000_000
 """Frames times pixels per frame that a GIF may hold before frames are sampled."""
@@ -130,13 +128,13 @@ def write_gif(
     durations = [step_ms] * len(frames)
     durations[-1] = max(step_ms, round(hold_s * 1000.0))
     target = Path(path)
-    size = 0
     with replacing(target) as temporary:
         _save(temporary, frames, durations)
         size = temporary.stat().st_size
-        if max_frames_given is None and len(times) > MIN_FRAMES and size > SIZE_LIMIT:
+        too_big = max_frames_given is None and len(times) > MIN_FRAMES and size > SIZE_LIMIT
+        if too_big:
             temporary.unlink()  # nothing replaces the target: it is drawn again below
-    if max_frames_given is None and len(times) > MIN_FRAMES and size > SIZE_LIMIT:
+    if too_big:
         # The size estimate was too hopeful (a crowded run): draw fewer frames.
         fewer = max(MIN_FRAMES, int(len(times) * 0.85 * SIZE_LIMIT / size))
         return write_gif(

@@ -669,6 +669,13 @@ def _length_of(pair: tuple[float, int, int, list[str], tuple[float, float], tupl
     return pair[0]
 
 
+def _direction(arrow: MessageArrow) -> tuple[float, float]:
+    """The unit vector from an arrow's start to its tip (``(0, 0)`` for an arrow of no length)."""
+    (x0, y0), (x1, y1) = arrow.start, arrow.end
+    length = math.dist(arrow.start, arrow.end) or 1.0
+    return (x1 - x0) / length, (y1 - y0) / length
+
+
 def arrow_head(arrow: MessageArrow, size: float) -> list[tuple[float, float]]:
     """Triangle of an arrow's tip, ``size`` pixels long, as three points (the tip first).
 
@@ -676,12 +683,25 @@ def arrow_head(arrow: MessageArrow, size: float) -> list[tuple[float, float]]:
     >>> arrow_head(arrow, 4.0)
     [(10.0, 0.0), (6.0, -2.0), (6.0, 2.0)]
     """
-    (x0, y0), (x1, y1) = arrow.start, arrow.end
-    length = math.dist(arrow.start, arrow.end) or 1.0
-    ux, uy = (x1 - x0) / length, (y1 - y0) / length
+    x1, y1 = arrow.end
+    ux, uy = _direction(arrow)
     back_x, back_y = x1 - ux * size, y1 - uy * size
     half = size / 2
     return [(x1, y1), (back_x + uy * half, back_y - ux * half), (back_x - uy * half, back_y + ux * half)]
+
+
+def arrow_shape(arrow: MessageArrow, cell: float) -> tuple[tuple[float, float], list[tuple[float, float]]]:
+    """Where an arrow's shaft ends and its head (:func:`arrow_head`), for cells ``cell`` pixels wide.
+
+    The head is 0.16 of a cell long, at least 3 pixels; the shaft stops at
+    the middle of the head's base.
+
+    >>> arrow = MessageArrow(1, 0, 1, ("state",), (0.0, 0.0), (50.0, 0.0))
+    >>> arrow_shape(arrow, 10.0)
+    ((47.0, 0.0), [(50.0, 0.0), (47.0, -1.5), (47.0, 1.5)])
+    """
+    tip = arrow_head(arrow, max(3.0, cell * 0.16))
+    return ((tip[1][0] + tip[2][0]) / 2, (tip[1][1] + tip[2][1]) / 2), tip
 
 
 def message_width(layout: Layout) -> float:
@@ -709,8 +729,7 @@ def message_label_place(arrow: MessageArrow, cell: float) -> tuple[tuple[float, 
     'end'
     """
     (x0, y0), (x1, y1) = arrow.start, arrow.end
-    length = math.dist(arrow.start, arrow.end) or 1.0
-    ux, uy = (x1 - x0) / length, (y1 - y0) / length
+    ux, uy = _direction(arrow)
     nx, ny = -uy, ux
     gap = cell * 0.15
     x, y = x0 + (x1 - x0) / 3 + nx * gap, y0 + (y1 - y0) / 3 + ny * gap

@@ -37,7 +37,6 @@ from __future__ import annotations
 import io
 import os
 import re
-import tempfile
 import textwrap
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass
@@ -46,6 +45,7 @@ from typing import TYPE_CHECKING, Any
 
 from mrmp.bench.aggregate import FaultSuccess, GroupSummary, success_by_faults
 from mrmp.io.report_input import FaultSetting
+from mrmp.viz._atomic import write_bytes_atomically
 
 if TYPE_CHECKING:
     from matplotlib.axes import Axes
@@ -108,25 +108,6 @@ def file_stem(name: str) -> str:
     ('gen_random-32x32-p0.2-s3', 'maps_den_520d')
     """
     return re.sub(r"[^A-Za-z0-9._-]+", "_", name).strip("._") or "map"
-
-
-def write_bytes_atomically(path: Path, data: bytes) -> None:
-    """Write ``data`` to a temporary file next to ``path``, flush it to disk, then move it over ``path``."""
-    path.parent.mkdir(parents=True, exist_ok=True)
-    descriptor, name = tempfile.mkstemp(dir=path.parent, prefix=f".{path.name}.", suffix=".tmp")
-    temporary = Path(name)
-    try:
-        with os.fdopen(descriptor, "wb") as handle:
-            handle.write(data)
-            handle.flush()
-            os.fsync(handle.fileno())
-        mask = os.umask(0o022)
-        os.umask(mask)
-        os.chmod(temporary, 0o666 & ~mask)
-        os.replace(temporary, path)
-    except BaseException:
-        temporary.unlink(missing_ok=True)
-        raise
 
 
 def _new_figure(width: float, height: float) -> Figure:

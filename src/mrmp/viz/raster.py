@@ -55,7 +55,7 @@ from mrmp.viz.layout import (
     Keyframe,
     Layout,
     MessageArrow,
-    arrow_head,
+    arrow_shape,
     cell_at,
     cost_tint,
     darker,
@@ -365,14 +365,12 @@ class FramePainter:
         """Arrows of the messages sent during the tick under way at ``t``, in the senders' colours."""
         big = self.big
         width = max(1, round(message_width(self.layout) * self.ss))
-        head = max(3.0, big.cell * 0.16)
         font = _font(max(6, round(big.cell * 0.12))) if self.layout.cell >= MESSAGE_LABEL_CELL else None
         for arrow in self.arrows:
             if not arrow.shown_at(t):
                 continue
             colour = self.colours[arrow.sender]  # exact: it is in the GIF's palette
-            tip = arrow_head(arrow, head)
-            base = ((tip[1][0] + tip[2][0]) / 2, (tip[1][1] + tip[2][1]) / 2)
+            base, tip = arrow_shape(arrow, big.cell)
             draw.line((arrow.start, base), fill=colour, width=width)
             draw.polygon(tip, fill=colour)
             if font is not None:

@@ -42,7 +42,8 @@ from mrmp.bench.aggregate import (
 )
 from mrmp.core.errors import InputError, Problem
 from mrmp.io.report_input import BenchRecord, BenchResults
-from mrmp.viz.plots import PlotFile, write_bytes_atomically, write_report_plots
+from mrmp.viz._atomic import write_bytes_atomically
+from mrmp.viz.plots import PlotFile, write_report_plots
 
 STYLE = """
 body { font-family: -apple-system, "Segoe UI", "DejaVu Sans", Helvetica, Arial, sans-serif; color: #1f2328;

@@ -68,7 +68,7 @@ from mrmp.viz.layout import (
     ROBOT_RADIUS,
     SUCCESS,
     Keyframe,
-    arrow_head,
+    arrow_shape,
     cell_at,
     cost_tint,
     darker,
@@ -509,7 +509,6 @@ class _SvgRun:
         """One ``<g class="message">`` per arrow, visible during its tick only."""
         layout = self.layout
         width = message_width(layout)
-        head = max(3.0, layout.cell * 0.16)
         labelled = layout.cell >= MESSAGE_LABEL_CELL
         robots = self.result.robots
         for arrow in message_arrows(self.result, layout):
@@ -526,8 +525,7 @@ class _SvgRun:
                     "opacity": "1" if arrow.tick == 1 else "0",
                 },
             )
-            tip = arrow_head(arrow, head)
-            base = ((tip[1][0] + tip[2][0]) / 2, (tip[1][1] + tip[2][1]) / 2)
+            base, tip = arrow_shape(arrow, layout.cell)
             ET.SubElement(
                 element,
                 "line",

@@ -234,7 +234,8 @@ class TerminalView:
         """The caption and the grid as they are now, fitted to the console."""
         width, height = self.console.size
         grid = self.scenario.grid
-        k = scale_for(grid, width, max(1, height - RESERVED_LINES))
+        room = max(1, height - RESERVED_LINES)
+        k = scale_for(grid, width, room)
         caption = Text(f"{self.scenario.name or 'run'} · {self.scenario.policy.name} · tick {self.tick}", style="bold")
         if k > 1:
             caption.append(f"  (1:{k})", style="dim")
@@ -247,7 +248,7 @@ class TerminalView:
             self.headings,
             self.goals,
             columns=width,
-            lines=max(1, height - RESERVED_LINES),
+            lines=room,
             colours=self.colours,
         )
         return Text("\n", no_wrap=True, overflow="crop").join([caption, body])

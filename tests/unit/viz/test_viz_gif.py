@@ -11,8 +11,9 @@ from pixels import Colour, close, share_near
 
 from mrmp.core import Grid, RunResult
 from mrmp.viz import write_gif
-from mrmp.viz.gif import frame_times
 from mrmp.viz.layout import darker, make_layout, robot_colours
+from mrmp.viz.raster import frame_times
+
 
 def frames_of(path: Path) -> list[Image.Image]:
     with Image.open(path) as gif:
@@ -97,6 +98,21 @@ def test_frame_cap_reduces_frames_per_tick_then_samples(swap: tuple[Grid, RunRes
         assert gif.n_frames == 7
     with Image.open(write_gif(grid, result, tmp_path / "few.gif", max_frames=4)) as gif:
         assert gif.n_frames == 4
+
+
+def test_a_gif_over_the_size_limit_is_drawn_again_with_fewer_frames(
+    swap: tuple[Grid, RunResult], tmp_path: Path, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    from mrmp.viz import gif
+
+    grid, result = swap
+    monkeypatch.setattr(gif, "SIZE_LIMIT", 1)
+    target = tmp_path / "swap.gif"
+    target.write_bytes(b"previous")
+    write_gif(grid, result, target, frames_per_tick=8)  # 6 ticks: 49 frames, then at most 40
+    with Image.open(target) as drawn:
+        assert drawn.n_frames == 6 * 6 + 1
+    assert [path.name for path in tmp_path.iterdir()] == ["swap.gif"]
 
 
 def test_frame_times() -> None:
