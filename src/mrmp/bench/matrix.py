@@ -31,9 +31,6 @@ from typing import Any
 from mrmp.centralized.registry import PLANNER_NAMES
 from mrmp.core.scenario import NetworkFaults
 
-RECORD_FORMAT = "mrmp-bench-1"
-"""The ``format`` of every results record (see :mod:`mrmp.io.bench_results`)."""
-
 
 def faults_to_dict(faults: NetworkFaults) -> dict[str, Any]:
     """The record form of network faults: ``{loss, delay: [min, max], duplicate, reorder}``.

@@ -33,18 +33,12 @@ import time
 import traceback
 from typing import Any
 
-from mrmp.bench.matrix import RECORD_FORMAT, BenchRun, faults_to_dict
+from mrmp.bench.matrix import BenchRun, faults_to_dict
 from mrmp.core.errors import MrmpError
 from mrmp.core.map_generators import generate, random_instance
 from mrmp.core.result import RunResult
 from mrmp.core.scenario import PolicyOptions, Scenario
-
-RESULT_FIELDS: tuple[str, ...] = (
-    "success", "stop_reason", "ticks", "makespan", "sum_of_costs", "lower_bound", "time_makespan_s", "messages",
-    "network", "wall_time_s", "planning_time_s", "plan_bytes", "throughput", "collisions", "soc_over_lb",
-    "robots_arrived", "goals_reached", "steps", "wall_time_per_step_s", "messages_per_robot_move",
-)  # fmt: skip
-"""The fields of a record that come from the run's result (null for a timeout or an error)."""
+from mrmp.io.bench_results import RECORD_FORMAT, RESULT_FIELDS
 
 
 def build_scenario(run: BenchRun) -> Scenario:

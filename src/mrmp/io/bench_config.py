@@ -52,7 +52,6 @@ demo.yaml:5: unknown key 'policy' (did you mean 'policies'?)
 
 from __future__ import annotations
 
-from collections.abc import Sequence
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any
@@ -61,7 +60,7 @@ from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
 from mrmp.bench.matrix import BenchRun
 from mrmp.centralized.registry import PLANNER_NAMES
-from mrmp.core.errors import InputError, Problem
+from mrmp.core.errors import InputError
 from mrmp.core.grid import Grid
 from mrmp.core.map_generators import GENERATORS, complete_spec, generate, largest_region
 from mrmp.core.scenario import NetworkFaults, _fault_problems
@@ -72,8 +71,8 @@ from mrmp.io.scenario_file import (
     FAULT_KEYS,
     _compose,
     _describe,
+    _in_order,
     _line,
-    _problem_order,
     _Reader,
 )
 from mrmp.policies.registry import POLICY_NAMES
@@ -414,11 +413,6 @@ def bench_config_from_text(
     if config is None:
         raise InputError(_in_order(reader.problems, source_name))
     return config
-
-
-def _in_order(problems: Sequence[Problem], source: str) -> list[Problem]:
-    """Problems of the configuration first, by line, then those of the files it names."""
-    return sorted(problems, key=lambda problem: _problem_order(problem, source))
 
 
 def load_bench_config(path: PathLike, time_limit: float | None = None) -> BenchConfig:

@@ -35,19 +35,26 @@ from typing import Any
 from mrmp.core.errors import InputError, Problem
 from mrmp.io._files import PathLike, atomic_write_text
 
+RECORD_FORMAT = "mrmp-bench-1"
+"""The ``format`` of every record (the contract between ``mrmp bench`` and ``mrmp report``)."""
 RESULTS_JSONL = "results.jsonl"
 """The records file inside a benchmark's output folder."""
 RESULTS_CSV = "results.csv"
 """The table inside a benchmark's output folder."""
 
+RESULT_FIELDS: tuple[str, ...] = (
+    "success", "stop_reason", "ticks", "makespan", "sum_of_costs", "lower_bound", "time_makespan_s", "messages",
+    "network", "wall_time_s", "planning_time_s", "plan_bytes", "throughput", "collisions", "soc_over_lb",
+    "robots_arrived", "goals_reached", "steps", "wall_time_per_step_s", "messages_per_robot_move",
+)  # fmt: skip
+"""The fields of a record that come from the run's result (null for a timeout or an error)."""
+
 CSV_COLUMNS: tuple[str, ...] = (
     "run_id", "bench", "status", "error", "map", "map_path", "scen", "instance", "agents", "policy", "kind",
     "seed", "loss", "delay_min", "delay_max", "duplicate", "reorder", "lifelong", "max_ticks", "time_limit_s",
-    "success", "stop_reason", "ticks", "makespan", "sum_of_costs", "lower_bound", "time_makespan_s", "messages",
-    "wall_time_s", "planning_time_s", "plan_bytes", "throughput", "collisions", "soc_over_lb", "robots_arrived",
-    "goals_reached", "steps", "wall_time_per_step_s", "messages_per_robot_move",
+    *(name for name in RESULT_FIELDS if name != "network"),
 )  # fmt: skip
-"""The columns of ``results.csv``."""
+"""The columns of ``results.csv``: the run's parameters (faults spread out), then its scalar result fields."""
 
 
 def append_record(path: PathLike, record: Mapping[str, Any]) -> None:

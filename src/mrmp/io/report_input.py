@@ -44,12 +44,7 @@ from typing import Any
 
 from mrmp.core.errors import InputError, Problem
 from mrmp.io._files import PathLike, read_text
-
-BENCH_FORMAT = "mrmp-bench-1"
-"""The ``format`` of every record this reader accepts."""
-
-RESULTS_FILE_NAME = "results.jsonl"
-"""The file a benchmark folder holds its records in."""
+from mrmp.io.bench_results import RECORD_FORMAT, RESULTS_JSONL
 
 STATUSES = ("done", "timeout", "error")
 """A record's ``status``: the run finished (successfully or not), ran out of time, or failed."""
@@ -235,7 +230,7 @@ def results_file(path: PathLike) -> Path:
     (PosixPath('runs/results.jsonl'), PosixPath('/results.jsonl'))
     """
     candidate = Path(path)
-    return candidate / RESULTS_FILE_NAME if candidate.is_dir() else candidate
+    return candidate / RESULTS_JSONL if candidate.is_dir() else candidate
 
 
 def read_bench_results(path: PathLike) -> BenchResults:
@@ -260,7 +255,7 @@ def read_bench_results(path: PathLike) -> BenchResults:
     """
     target = results_file(path)
     if Path(path).is_dir() and not target.exists():
-        raise InputError(Problem(str(path), f"no {RESULTS_FILE_NAME} in this folder (is it the --out of mrmp bench?)"))
+        raise InputError(Problem(str(path), f"no {RESULTS_JSONL} in this folder (is it the --out of mrmp bench?)"))
     text = read_text(target)
     lines = text.split("\n")
     if lines and lines[-1] == "":
@@ -290,10 +285,7 @@ def read_bench_results(path: PathLike) -> BenchResults:
             hidden = len(problems) - MAX_PROBLEMS
             problems = problems[:MAX_PROBLEMS] + [Problem(str(target), f"... and {hidden} more bad lines")]
         raise InputError(problems)
-    latest: dict[str, BenchRecord] = {}
-    for record in records:
-        latest.pop(record.run_id, None)
-        latest[record.run_id] = record
+    latest = {record.run_id: record for record in records}  # the last record of each run
     kept = tuple(sorted(latest.values(), key=lambda record: record.line))
     return BenchResults(target, kept, truncated_lines=truncated, replaced_records=len(records) - len(kept))
 
@@ -313,6 +305,14 @@ def _kind_problem(value: Any, kind: str) -> str | None:
     else:
         good = isinstance(value, dict)
     return None if good else f"expected {kind}, got {value!r}"
+
+
+def _typed(name: str, value: Any, kind: str) -> Any:
+    """``value`` of field ``name`` if it is of ``kind`` (a number as a float), else ``ValueError`` naming the field."""
+    problem = _kind_problem(value, kind)
+    if problem:
+        raise ValueError(f"{name}: {problem}")
+    return float(value) if kind == _NUMBER else value
 
 
 def _faults_from_dict(data: Mapping[str, Any]) -> FaultSetting:
@@ -370,20 +370,14 @@ def record_from_dict(data: Any, line: int = 0) -> BenchRecord:
     """
     if not isinstance(data, dict):
         raise ValueError(f"expected a JSON object (one run record), got {_json_kind(data)}")
-    if data.get("format") != BENCH_FORMAT:
-        raise ValueError(f"format: expected {BENCH_FORMAT!r}, got {data.get('format')!r}")
+    if data.get("format") != RECORD_FORMAT:
+        raise ValueError(f"format: expected {RECORD_FORMAT!r}, got {data.get('format')!r}")
     values: dict[str, Any] = {}
     for name, (kind, nullable) in _FIELDS.items():
         if name not in data:
             raise ValueError(f"{name}: missing")
         value = data[name]
-        if value is None and nullable:
-            values[name] = None
-            continue
-        problem = _kind_problem(value, kind)
-        if problem:
-            raise ValueError(f"{name}: {problem}")
-        values[name] = value
+        values[name] = None if value is None and nullable else _typed(name, value, kind)
     status = values["status"]
     if status not in STATUSES:
         raise ValueError(f"status: expected one of {', '.join(STATUSES)}, got {status!r}")
@@ -406,18 +400,10 @@ def record_from_dict(data: Any, line: int = 0) -> BenchRecord:
                 raise ValueError(f"{name}: null, but the run finished (status 'done')")
             values[name] = None
             continue
-        problem = _kind_problem(value, kind)
-        if problem:
-            raise ValueError(f"{name}: {problem}")
-        values[name] = float(value) if kind == _NUMBER else value
+        values[name] = _typed(name, value, kind)
     for name, kind in _OPTIONAL_FIELDS.items():
         value = data.get(name)
-        problem = None if value is None else _kind_problem(value, kind)
-        if problem:
-            raise ValueError(f"{name}: {problem}")
-        values[name] = value
-    if values["time_limit_s"] is not None:
-        values["time_limit_s"] = float(values["time_limit_s"])
+        values[name] = None if value is None else _typed(name, value, kind)
     return BenchRecord(line=line, **values)
 
 

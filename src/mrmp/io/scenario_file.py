@@ -673,6 +673,11 @@ def _problem_order(problem: Problem, source: str) -> tuple[bool, str, int]:
     return (file != source, file, int(line))
 
 
+def _in_order(problems: Sequence[Problem], source: str) -> list[Problem]:
+    """Problems of ``source`` first, by line, then those of the files it names (see :func:`_problem_order`)."""
+    return sorted(problems, key=lambda problem: _problem_order(problem, source))
+
+
 def scenario_from_text(
     text: str,
     source_name: str = "<scenario>",
@@ -724,7 +729,7 @@ def scenario_from_text(
     reader = _Reader(source_name, folder, policies)
     scenario = reader.read(root)
     if scenario is None:
-        raise InputError(sorted(reader.problems, key=lambda problem: _problem_order(problem, source_name)))
+        raise InputError(_in_order(reader.problems, source_name))
     return scenario
 
 

@@ -5,7 +5,10 @@ import json
 import pytest
 from report_fixtures import make_record, unfinished, write_jsonl
 
+from mrmp.bench.matrix import BenchRun
+from mrmp.bench.records import base_record, execute_run
 from mrmp.core.errors import InputError
+from mrmp.io.bench_results import append_record
 from mrmp.io.report_input import FaultSetting, read_bench_results, record_from_dict
 
 
@@ -144,15 +147,34 @@ def test_records_of_real_simulated_runs_are_read(tmp_path, simulated_records):
 
 
 def test_records_appended_by_the_bench_writer_are_read(tmp_path):
-    bench_results = pytest.importorskip("mrmp.io.bench_results")
     path = tmp_path / "results.jsonl"
-    bench_results.append_record(path, make_record(run_id="a"))
-    bench_results.append_record(path, unfinished("error", "planner crashed", run_id="b"))
+    append_record(path, make_record(run_id="a"))
+    append_record(path, unfinished("error", "planner crashed", run_id="b"))
     results = read_bench_results(tmp_path)
     assert [(record.run_id, record.status, record.error) for record in results.records] == [
         ("a", "done", None),
         ("b", "error", "planner crashed"),
     ]
+
+
+def test_records_of_real_bench_runs_are_read_back_as_written(tmp_path):
+    spec = (("density", 0.1), ("height", 12), ("kind", "random"), ("seed", 0), ("width", 12))
+    one_shot = BenchRun("gen:random-12x12-p0.10-s0", 4, "pibt", generator=spec, instance=0, time_limit_s=20, bench="t")
+    runs = [one_shot, one_shot.with_changes(policy="pp"), one_shot.with_changes(lifelong=True, max_ticks=30)]
+    written = [execute_run(run) for run in runs]
+    written.append(base_record(one_shot.with_changes(seed=1), "timeout", "killed"))
+    written.append(base_record(one_shot.with_changes(seed=2), "error", "boom"))
+    for record in written:
+        append_record(tmp_path / "results.jsonl", record)
+    results = read_bench_results(tmp_path)
+    assert [record.run_id for record in results.records] == [record["run_id"] for record in written]
+    for record, data in zip(results.records, written):
+        for name in ("status", "error", "map", "agents", "policy", "kind", "seed", "lifelong", "success", "makespan",
+                     "soc_over_lb", "throughput", "collisions", "messages_per_robot_move", "bench", "instance"):  # fmt: skip
+            assert getattr(record, name) == data[name], name
+    assert [record.kind for record in results.records[:2]] == ["decentralized", "centralized"]
+    assert all(record.succeeded for record in results.records[:3])
+    assert results.records[2].throughput > 0 and results.records[3].status == "timeout"
 
 
 def test_a_planner_that_found_no_plan_is_a_finished_failure_without_measurements():
