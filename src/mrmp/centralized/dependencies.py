@@ -183,11 +183,16 @@ def rotations_at(tick: int, before: Sequence[Cell], after: Sequence[Cell], *, mi
         cycle = chain[position[robot] :]
         if len(cycle) < min_robots:
             continue
-        least = cycle.index(min(cycle))
-        cycle = cycle[least:] + cycle[:least]
+        cycle = _least_first(cycle)
         found.append(Rotation(tick, tuple(cycle), tuple(before[member] for member in cycle)))
     found.sort(key=lambda rotation: rotation.robots[0])
     return found
+
+
+def _least_first(cycle: list[int]) -> list[int]:
+    """``cycle`` (robots, each waiting for or entering the cell of the next) turned to start with its least robot."""
+    least = cycle.index(min(cycle))
+    return cycle[least:] + cycle[:least]
 
 
 def plan_moves(path: Sequence[Cell]) -> tuple[list[Cell], list[int]]:
@@ -314,9 +319,7 @@ def check_executable(
         seen[robot] = len(chain)
         chain.append(robot)
         robot = blocked_by[robot]
-    cycle = chain[seen[robot] :]
-    least = cycle.index(min(cycle))
-    cycle = cycle[least:] + cycle[:least]
+    cycle = _least_first(chain[seen[robot] :])
     cells = [moves[member][progress[member]] for member in cycle]
     at = [ticks[member][progress[member]] if ticks is not None else progress[member] + 1 for member in cycle]
     raise PlanDeadlockError(cycle, cells, at)

@@ -141,13 +141,13 @@ def heading_candidates(
     Facing NORTH, going EAST first (one turn now, three later) costs more than waiting.
     """
 
+    origin = divmod(here, y_size)
+
     def rank(cell: int) -> tuple[float, float]:
         tie = noise() if noise is not None else 0.0
         if cell == here:
             return round(1.0 + table[4 * here + heading - 1], 9), tie
-        hx, hy = divmod(here, y_size)
-        cx, cy = divmod(cell, y_size)
-        moving = Heading.between((hx, hy), (cx, cy))
+        moving = Heading.between(origin, divmod(cell, y_size))
         entry = cell_costs[cell] if cell_costs is not None else 1.0
         # rounded, so that equal costs summed in another order still tie
         return round(right_turns(heading, moving) * turn_cost + entry + table[4 * cell + moving - 1], 9), tie

@@ -185,8 +185,6 @@ class PibtRobot:
         self._seen: set[tuple[int, int]] = set()
         self._control: list[PibtMessage] = []
         self._settled: set[int] = set()  # cells where, as far as the robot heard, a robot stands on its own goal
-        self._table_goal = -1  # the goal of ``_distances``
-        self._distances: list[float] = []
         # the robot's own PIBT call, while it runs
         self._candidates: list[int] = []
         self._next = 0
@@ -264,14 +262,7 @@ class PibtRobot:
         sender = message.sender
         kind = type(message)
         if kind is BeaconMessage:
-            y_size = self.flat.y_size
-            x, y = message.present  # type: ignore[union-attr]
-            cell = x * y_size + y
-            self._occupants[cell] = sender
-            x, y = message.goal  # type: ignore[union-attr]
-            goal = self._goals[sender] = x * y_size + y
-            if cell == goal:
-                self._settled.add(cell)
+            self.receive_beacons([message])  # type: ignore[list-item]
             return False
         if kind is ReserveMessage:
             x, y = message.cell  # type: ignore[union-attr]
@@ -362,10 +353,7 @@ class PibtRobot:
 
     def _begin_call(self, out: list[Transmission]) -> None:
         flat = self.flat
-        if self._table_goal != self.goal:  # the goal changes in lifelong runs
-            self._distances = flat.distances(self.goal)
-            self._table_goal = self.goal
-        distances = self._distances
+        distances = flat.distances(self.goal)
         if self.heading_aware:
             candidates = heading_candidates(
                 flat.neighbours,

@@ -38,7 +38,6 @@ import math
 import random
 import time
 from collections import Counter
-from collections.abc import Callable
 
 from mrmp.core.cell import Cell
 from mrmp.core.heading import Heading, right_turns
@@ -50,7 +49,7 @@ from mrmp.search.flat_map import FlatMap
 from mrmp.sim.goals import GoalBook
 from mrmp.sim.metrics import shortest_steps
 from mrmp.sim.referee import Referee
-from mrmp.sim.ticking import run_result, run_ticks, scenario_network, send_counted
+from mrmp.sim.ticking import TickObserver, run_result, run_ticks, scenario_network, send_counted
 
 __all__ = ["SLOWEST_PACE", "AsynchronousSimulator", "causal_timers"]
 
@@ -80,7 +79,7 @@ class AsynchronousSimulator:
         Called at the end of every tick with the tick and the bodies' cells.
     """
 
-    def __init__(self, scenario: Scenario, on_tick: Callable[[int, list[Cell]], None] | None = None) -> None:
+    def __init__(self, scenario: Scenario, on_tick: TickObserver | None = None) -> None:
         self.scenario = scenario
         self.on_tick = on_tick
         grid = scenario.grid
@@ -220,7 +219,7 @@ class AsynchronousSimulator:
         cell_time = self.scenario.timing.cell_time
         for result in self._results:
             result.time_s = result.cost * cell_time
-        network: dict[str, int] = dict(self.network.stats.as_dict())
+        network = self.network.stats.as_dict()
         dropped: Counter[str] = Counter()
         stats: Counter[str] = Counter()
         for robot in self.robots:

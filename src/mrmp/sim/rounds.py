@@ -46,7 +46,7 @@ import gc
 import random
 import time
 from collections import Counter
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 from operator import attrgetter
 
 from mrmp.core.heading import right_turns
@@ -60,6 +60,7 @@ from mrmp.search.flat_map import FlatMap
 from mrmp.sim.goals import GoalBook
 from mrmp.sim.metrics import default_max_ticks, network_slowdown, shortest_steps
 from mrmp.sim.referee import Referee
+from mrmp.sim.ticking import TickObserver, link_faults, run_result, run_ticks
 
 __all__ = ["MAX_TRIES", "RoundsSimulator", "message_size"]
 
@@ -118,7 +119,7 @@ class RoundsSimulator:
         self,
         scenario: Scenario,
         random_ties: bool = True,
-        on_tick: Callable[[int, list[tuple[int, int]]], None] | None = None,
+        on_tick: TickObserver | None = None,
         tie_penalties: bool | None = None,
     ) -> None:
         self.scenario = scenario
@@ -159,8 +160,7 @@ class RoundsSimulator:
         ]
         self._durations: list[list[float]] = [[] for _ in scenario.robots]
         self._random = random.Random(scenario.seed)
-        index_of = {spec.id: index for index, spec in enumerate(scenario.robots)}
-        self._links = {(index_of[link.sender], index_of[link.recipient]): link.faults for link in scenario.links}
+        self._links = link_faults(scenario)
         self._perfect = scenario.network.is_perfect and not self._links
         self._near: dict[int, list[tuple[int, ...] | None]] = {}
         self._occupant: list[int] = []  # robot on every flat cell this step, NO_ROBOT where none
@@ -193,20 +193,10 @@ class RoundsSimulator:
         started = time.perf_counter()
         robots = self.robots
         self.referee.check_start([spec.start for spec in self.scenario.robots])
-        stop_reason = "time up" if self.scenario.lifelong else "tick limit"
         collecting = gc.isenabled()
         gc.disable()
         try:
-            while self.tick < self.max_ticks:
-                if not self.scenario.lifelong and all(robot.at_goal for robot in robots):
-                    stop_reason = "all arrived"
-                    break
-                self.step()
-            else:
-                if not self.scenario.lifelong and all(robot.at_goal for robot in robots):
-                    stop_reason = "all arrived"
-        except KeyboardInterrupt:
-            stop_reason = "interrupted"
+            stop_reason = run_ticks(self, lambda: all(robot.at_goal for robot in robots))
         finally:
             if collecting:
                 gc.enable()
@@ -229,16 +219,11 @@ class RoundsSimulator:
             # highest priority first: ``(elapsed, tie, -index)`` descending (a stable sort keeps index order)
             order = sorted(robots, key=attrgetter("elapsed", "tie"), reverse=True)
             rounds = self._rounds
-            if self._perfect:  # rounds take no time
-                for robot in order:
-                    if robot.target is None:
-                        rounds([(robot.index, sent) for sent in robot.start()])
-            else:
-                for robot in order:
-                    if robot.target is None:
-                        spent = rounds([(robot.index, sent) for sent in robot.start()])
-                        if spent:
-                            group_time[self._group_of[robot.index]] += spent
+            for robot in order:
+                if robot.target is None:
+                    spent = rounds([(robot.index, sent) for sent in robot.start()])
+                    if spent:  # never over a perfect network, whose rounds take no time
+                        group_time[self._group_of[robot.index]] += spent
             extra += max(group_time.values(), default=0)
             abandoned = False
         except _CutLink:
@@ -256,8 +241,7 @@ class RoundsSimulator:
         """One tick: the robots move to their reserved cells (``moves``) or all stand still."""
         self.tick += 1
         robots = self.robots
-        flat = self.flat
-        cells = flat.cells
+        cells = self.flat.cells
         timing = self.scenario.timing
         grid = self.scenario.grid
         cost = grid.cost if grid.has_costs else None
@@ -280,10 +264,11 @@ class RoundsSimulator:
             result.path.append(cells[robot.present])
             result.headings.append(robot.heading)
             durations[index].append(duration)
-        self.referee.check_tick(self.tick, before, [cells[robot.present] for robot in robots])
+        after = [cells[robot.present] for robot in robots]
+        self.referee.check_tick(self.tick, before, after)
         self._count_goals()
         if self.on_tick is not None:
-            self.on_tick(self.tick, [flat.cell(robot.present) for robot in robots])
+            self.on_tick(self.tick, after)
 
     def _count_goals(self) -> None:
         """Count goals reached; in a lifelong run, hand each such robot a new goal (drawn with the seed)."""
@@ -511,18 +496,7 @@ class RoundsSimulator:
         network["messages"] = sum(result.messages_sent for result in self._results)
         network["dropped_by_robots"] = sum(sum(robot.dropped.values()) for robot in self.robots)
         network["distance_tables"] = self.flat.tables_computed
-        return RunResult(
-            scenario=self.scenario.name,
-            policy="pibt",
-            seed=self.scenario.seed,
-            robots=self._results,
-            collisions=list(self.referee.collisions),
-            stop_reason=stop_reason,
-            ticks=self.tick,
-            lower_bound=sum(self.lengths),
-            wall_time_s=wall_time,
-            network=network,
-            planning_time_s=self.flat.table_seconds,
-            lifelong=self.scenario.lifelong,
+        return run_result(
+            self, self._results, "pibt", stop_reason, wall_time, network, planning_time_s=self.flat.table_seconds
         )
 

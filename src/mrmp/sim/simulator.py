@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import time
 from collections import Counter
-from collections.abc import Callable, Sequence
+from collections.abc import Sequence
 
 from mrmp.core.cell import Cell
 from mrmp.core.heading import Heading, right_turns
@@ -50,10 +50,7 @@ from mrmp.sim.metrics import default_max_ticks, network_slowdown, shortest_steps
 from mrmp.sim.asynchronous import AsynchronousSimulator
 from mrmp.sim.referee import Referee
 from mrmp.sim.rounds import RoundsSimulator
-from mrmp.sim.ticking import run_result, run_ticks, scenario_network, send_counted
-
-TickObserver = Callable[[int, list[Cell]], None]
-"""Called after every tick with the tick number and every robot's cell, in scenario order."""
+from mrmp.sim.ticking import TickObserver, run_result, run_ticks, scenario_network, send_counted
 
 RECURRENCE_LIMIT = 10
 """How often one configuration may recur before the run is declared stuck (plus
@@ -290,7 +287,8 @@ def records_messages(scenario: Scenario, policies: Sequence[Policy] | None = Non
     """Whether :func:`simulate` can keep a message log for ``scenario``.
 
     Runs in synchronous rounds (policy ``pibt``) exchange their messages
-    inside each step and do not log them.
+    inside each step, and asynchronous runs (policy ``causal``) keep no log
+    either.
     """
     return not (scenario.policy.name in (*ROUND_POLICIES, *ASYNC_POLICIES) and policies is None)
 

@@ -1,9 +1,11 @@
 """What the tick-driven simulators share: the scenario's network, the run loop, counted sending, the result.
 
-The lockstep simulator (:mod:`mrmp.sim.simulator`) and the asynchronous one
-(:mod:`mrmp.sim.asynchronous`) differ in what a tick does; they run their
-ticks, send their robots' messages over the simulated network and build their
-:class:`~mrmp.core.result.RunResult` alike, with these functions.
+The lockstep simulator (:mod:`mrmp.sim.simulator`), the asynchronous one
+(:mod:`mrmp.sim.asynchronous`) and the synchronous rounds of policy ``pibt``
+(:mod:`mrmp.sim.rounds`) differ in what a tick does; they run their ticks and
+build their :class:`~mrmp.core.result.RunResult` alike, and read the
+scenario's per-link faults alike, with these functions. The first two also
+send their robots' messages over the simulated network alike.
 
 Examples
 --------
@@ -23,12 +25,17 @@ from __future__ import annotations
 from collections.abc import Callable, Sequence
 from typing import Any, Protocol
 
+from mrmp.core.cell import Cell
 from mrmp.core.result import RobotResult, RunResult
-from mrmp.core.scenario import Scenario
+from mrmp.core.scenario import NetworkFaults, Scenario
 from mrmp.protocol.codec import encode
 from mrmp.robot.robot import Outgoing
 from mrmp.sim.network import SimulatedNetwork
 from mrmp.sim.referee import Referee
+
+
+TickObserver = Callable[[int, list[Cell]], None]
+"""Called after every tick with the tick number and every robot's cell, in scenario order."""
 
 
 class TickedSimulation(Protocol):
@@ -45,11 +52,15 @@ class TickedSimulation(Protocol):
         ...
 
 
+def link_faults(scenario: Scenario) -> dict[tuple[int, int], NetworkFaults]:
+    """The faults of ``scenario``'s links that have their own, by ``(sender, recipient)`` robot index."""
+    index_of = {spec.id: index for index, spec in enumerate(scenario.robots)}
+    return {(index_of[link.sender], index_of[link.recipient]): link.faults for link in scenario.links}
+
+
 def scenario_network(scenario: Scenario) -> SimulatedNetwork:
     """The simulated network of ``scenario``: its faults, seed and per-link faults (by robot index)."""
-    index_of = {spec.id: index for index, spec in enumerate(scenario.robots)}
-    links = {(index_of[link.sender], index_of[link.recipient]): link.faults for link in scenario.links}
-    return SimulatedNetwork(scenario.network, seed=scenario.seed, links=links)
+    return SimulatedNetwork(scenario.network, seed=scenario.seed, links=link_faults(scenario))
 
 
 def run_ticks(

@@ -18,6 +18,7 @@ from pathlib import Path
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from test_centralized_support import moves_round_a_cycle
 
 from mrmp.centralized.dependencies import find_rotations
 from mrmp.centralized.lacam import lacam
@@ -67,28 +68,6 @@ def lower_bound(scenario: Scenario) -> int:
     return int(sum(distance_table(scenario.grid, robot.goal).distance(robot.start) for robot in scenario.robots))
 
 
-def moves_in_a_cycle(config: tuple[Cell, ...], nxt: tuple[Cell, ...]) -> bool:
-    """Whether some robots move round a cycle: each into the cell another one leaves, back to the first."""
-    who = {cell: robot for robot, cell in enumerate(config)}
-    for first in range(len(config)):
-        robot, steps = first, 0
-        while config[robot] != nxt[robot] and steps <= len(config):
-            robot = who.get(nxt[robot], -1)
-            if robot < 0:
-                break
-            if robot == first:
-                return True
-            steps += 1
-    return False
-
-
-def test_moves_in_a_cycle_oracle():
-    block = ((0, 0), (0, 1), (1, 1), (1, 0))
-    assert moves_in_a_cycle(block, block[1:] + block[:1])
-    assert not moves_in_a_cycle(block[:3], block[1:])  # three robots following into the free cell
-    assert not moves_in_a_cycle(block, block)
-
-
 def brute_force_feasible(scenario: Scenario) -> bool:
     """Breadth-first search over joint configurations (vertex, swap and rotation conflicts forbidden)."""
     grid = scenario.grid
@@ -106,7 +85,7 @@ def brute_force_feasible(scenario: Scenario) -> bool:
                 continue
             if any(nxt[i] == config[j] and nxt[j] == config[i] for i in range(len(config)) for j in range(i)):
                 continue
-            if moves_in_a_cycle(config, nxt):
+            if moves_round_a_cycle(config, nxt):
                 continue
             seen.add(nxt)
             queue.append(nxt)
@@ -335,9 +314,10 @@ def test_pibt_rotation_in_a_cycle():
     assert pibt_step(Grid(2, 2), cells, goals) == goals  # the classic model rotates
 
 
-def rotation_free_pibt(
+def flat_pibt(
     grid: Grid, goals: list[Cell], swap: bool = False, rotations: bool = False, rng: random.Random | None = None
 ) -> PIBT:
+    """A PIBT generator over the flat cells of ``grid`` for ``goals`` (rotation-free unless ``rotations``)."""
     size = grid.x_size * grid.y_size
     return PIBT(
         flat_neighbours(grid),
@@ -354,13 +334,13 @@ def test_pibt_without_rotations_refuses_the_cycle():
     cells = [(0, 0), (0, 1), (1, 1), (1, 0)]
     goals = [cells[(i + 1) % 4] for i in range(4)]
     current = [index_of(grid, cell) for cell in cells]
-    pibt = rotation_free_pibt(grid, goals)
+    pibt = flat_pibt(grid, goals)
     assert pibt.step(current, [0, 1, 2, 3]) == current  # the last robot may not close the cycle: all stay
     rotation = {robot: index_of(grid, goal) for robot, goal in enumerate(goals)}
     assert pibt.step(current, [0, 1, 2, 3], rotation) is None  # constraints forming a rotation fail
     assert pibt.clean
     # three robots: each follows the next into the free cell, a chain, not a cycle
-    three = rotation_free_pibt(grid, goals[:3])
+    three = flat_pibt(grid, goals[:3])
     assert three.step(current[:3], [0, 1, 2]) == [index_of(grid, goal) for goal in goals[:3]]
 
 
@@ -410,6 +390,11 @@ def pibt_cases(draw: st.DrawFn):
     return grid, config, goals, constraints, priorities
 
 
+def flat_start(grid: Grid, config: list[Cell], priorities: list[float]) -> tuple[list[int], list[int]]:
+    """A case's configuration as flat cells, and its robots from the highest priority down."""
+    return [index_of(grid, cell) for cell in config], sorted(range(len(config)), key=lambda robot: -priorities[robot])
+
+
 @settings(max_examples=300, derandomize=True, deadline=None)
 @given(pibt_cases(), st.booleans(), st.sampled_from([None, 0, 7]))
 def test_pibt_step_is_collision_free_and_respects_constraints(case, swap, seed):
@@ -434,15 +419,8 @@ def test_pibt_generator_leaves_no_trace_between_calls(case, swap):
     grid, config, goals, constraints, priorities = case
     if not config:
         return
-    size = grid.x_size * grid.y_size
-    pibt = PIBT(
-        flat_neighbours(grid),
-        [distance_list(distance_table(grid, goal), size) for goal in goals],
-        [index_of(grid, goal) for goal in goals],
-        swap=swap,
-    )
-    current = [index_of(grid, cell) for cell in config]
-    order = sorted(range(len(config)), key=lambda robot: -priorities[robot])
+    pibt = flat_pibt(grid, goals, swap=swap, rotations=True)
+    current, order = flat_start(grid, config, priorities)
     target = [NO_CELL] * len(config)
     for robot, cell in constraints.items():
         target[robot] = index_of(grid, cell)
@@ -458,9 +436,8 @@ def test_pibt_without_rotations_is_rotation_free_and_respects_constraints(case, 
     grid, config, goals, constraints, priorities = case
     if not config:
         return
-    pibt = rotation_free_pibt(grid, goals, swap=swap, rng=random.Random(seed) if seed is not None else None)
-    current = [index_of(grid, cell) for cell in config]
-    order = sorted(range(len(config)), key=lambda robot: -priorities[robot])
+    pibt = flat_pibt(grid, goals, swap=swap, rng=random.Random(seed) if seed is not None else None)
+    current, order = flat_start(grid, config, priorities)
     fixed = {robot: index_of(grid, cell) for robot, cell in constraints.items()}
     result = pibt.step(current, order, fixed)
     assert pibt.clean
@@ -473,7 +450,7 @@ def test_pibt_without_rotations_is_rotation_free_and_respects_constraints(case, 
         assert after[robot] == cell
     paths = {str(robot): [before, nxt] for robot, (before, nxt) in enumerate(zip(config, after))}
     assert check_paths(grid, paths) == []
-    assert not moves_in_a_cycle(tuple(config), after)
+    assert not moves_round_a_cycle(config, after)
 
 
 @settings(max_examples=200, derandomize=True, deadline=None)
@@ -484,13 +461,12 @@ def test_pibt_without_rotations_returns_every_rotation_free_configuration_it_is_
     grid, config, goals, _, priorities = case
     if not config:
         return
-    current = [index_of(grid, cell) for cell in config]
-    order = sorted(range(len(config)), key=lambda robot: -priorities[robot])
-    classic = rotation_free_pibt(grid, goals, swap=swap, rotations=True).step(current, order)
+    current, order = flat_start(grid, config, priorities)
+    classic = flat_pibt(grid, goals, swap=swap, rotations=True).step(current, order)
     assert classic is not None
     everyone = dict(enumerate(classic))
-    result = rotation_free_pibt(grid, goals, swap=swap).step(current, order, everyone)
-    if moves_in_a_cycle(tuple(config), tuple(divmod(index, grid.y_size) for index in classic)):
+    result = flat_pibt(grid, goals, swap=swap).step(current, order, everyone)
+    if moves_round_a_cycle(config, tuple(divmod(index, grid.y_size) for index in classic)):
         assert result is None
     else:
         assert result == classic
