@@ -15,7 +15,6 @@ from __future__ import annotations
 
 import argparse
 import json
-import statistics
 import sys
 import tempfile
 from pathlib import Path
@@ -30,7 +29,9 @@ def swaps(count: int) -> Scenario:
     size = max(5, 2 * pairs + 1)
     east = [RobotSpec(f"a{i}", (2 * i + 1, 0), (2 * i + 1, size - 1)) for i in range(pairs)]
     west = [RobotSpec(f"b{i}", (2 * i + 1, size - 1), (2 * i + 1, 0)) for i in range(pairs)]
-    return Scenario(Grid(size, size), tuple(east + west), timing=Timing(1.0, 0.5), policy=PolicyOptions(name="astar"), name=f"swaps-{count}")
+    return Scenario(
+        Grid(size, size), tuple(east + west), timing=Timing(1.0, 0.5), policy=PolicyOptions(name="astar"), name=f"swaps-{count}"
+    )
 
 
 def percentile(values: list[float], share: float) -> float:
@@ -46,7 +47,10 @@ def main() -> int:
     parser.add_argument("--time-scale", type=float, default=5.0)
     parser.add_argument("--transport", default="udp")
     arguments = parser.parse_args()
-    print(f"{'robots':>6} {'ok':>3} {'coll':>4} {'moves':>5} {'msg/move':>9} {'B/move':>8} {'lat p50 ms':>10} {'lat p99 ms':>10} {'makespan s':>10} {'ideal s':>8} {'ratio':>6}")
+    print(
+        f"{'robots':>6} {'ok':>3} {'coll':>4} {'moves':>5} {'msg/move':>9} {'B/move':>8} {'lat p50 ms':>10}"
+        f" {'lat p99 ms':>10} {'makespan s':>10} {'ideal s':>8} {'ratio':>6}"
+    )
     for size in [int(text) for text in arguments.sizes.split(",")]:
         scenario = swaps(size)
         folder = Path(tempfile.mkdtemp(prefix=f"mrmp-bench-{size}-"))

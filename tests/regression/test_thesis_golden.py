@@ -89,7 +89,7 @@ def test_velocity_tuning_as_written_collides_and_is_reported():
     waiting = scenario.with_changes(policy=PolicyOptions(name="thesis", resolve="wait"), safety=False)
     result = simulate(waiting)
     assert not result.success
-    assert [(c.kind, c.tick, c.robots) for c in result.collisions][0] == ("vertex", 3, ("A", "B"))
+    assert next((c.kind, c.tick, c.robots) for c in result.collisions) == ("vertex", 3, ("A", "B"))
 
 
 def test_velocity_tuning_guarded_deadlocks_without_collision():

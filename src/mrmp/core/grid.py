@@ -125,7 +125,7 @@ class Grid:
     3.0
     """
 
-    __slots__ = ("x_size", "y_size", "name", "_blocked", "_costs", "_neighbours")
+    __slots__ = ("_blocked", "_costs", "_neighbours", "name", "x_size", "y_size")
 
     def __init__(
         self,

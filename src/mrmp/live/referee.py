@@ -75,12 +75,18 @@ class IntervalReferee:
                 self.intervals.append(interval)
                 self._open[key] = interval
         elif event == "leave":
-            interval = self._open.pop(key, None)
-            if interval is not None:
-                interval.end = t
+            leaving = self._open.pop(key, None)
+            if leaving is not None:
+                leaving.end = t
 
     def _tick(self, t: float) -> int:
-        return int(round((t - self.start_time) * 1000))
+        return round((t - self.start_time) * 1000)
+
+    def _static_violation(self, cell: Cell) -> str | None:
+        """``"off_grid"`` or ``"obstacle"`` when covering ``cell`` is a violation by itself, else ``None``."""
+        if not self.grid.in_bounds(cell):
+            return "off_grid"
+        return "obstacle" if self.grid.is_blocked(cell) else None
 
     def collisions(self) -> list[Collision]:
         """Every violation found so far, in time order."""
@@ -89,12 +95,12 @@ class IntervalReferee:
         by_cell: dict[Cell, list[Interval]] = {}
         for interval in self.intervals:
             by_cell.setdefault(interval.cell, []).append(interval)
-            if not self.grid.in_bounds(interval.cell):
-                found.append((interval.start, Collision("off_grid", self._tick(interval.start), (ids[interval.robot],), (interval.cell,))))
-            elif self.grid.is_blocked(interval.cell):
-                found.append((interval.start, Collision("obstacle", self._tick(interval.start), (ids[interval.robot],), (interval.cell,))))
+            kind = self._static_violation(interval.cell)
+            if kind is not None:
+                collision = Collision(kind, self._tick(interval.start), (ids[interval.robot],), (interval.cell,))
+                found.append((interval.start, collision))
         overlaps: dict[tuple[int, int], list[tuple[float, float, Interval, Interval]]] = {}
-        for cell, intervals in by_cell.items():
+        for _cell, intervals in by_cell.items():
             intervals.sort(key=lambda interval: interval.start)
             for i, first in enumerate(intervals):
                 for second in intervals[i + 1 :]:
@@ -104,13 +110,13 @@ class IntervalReferee:
                         a, b = sorted((first, second), key=lambda interval: interval.robot)
                         start, end = max(a.start, b.start), min(a.end, b.end)
                         overlaps.setdefault((a.robot, b.robot), []).append((start, end, a, b))
-        for (a, b), spans in overlaps.items():
+        for (robot_a, robot_b), spans in overlaps.items():
             for episode in _episodes(spans):
                 t = episode[0][0]
                 cells = sorted({span[2].cell for span in episode})
                 kind = "swap" if _exchanged(episode) else "vertex"
                 shown = tuple(cells) if kind == "swap" else (episode[0][2].cell,)
-                found.append((t, Collision(kind, self._tick(t), (ids[a], ids[b]), shown)))
+                found.append((t, Collision(kind, self._tick(t), (ids[robot_a], ids[robot_b]), shown)))
         found.sort(key=lambda item: item[0])
         return [collision for _, collision in found]
 
@@ -143,6 +149,6 @@ def _exchanged(episode: list[Span]) -> bool:
             first.setdefault(interval.robot, {})[interval.cell] = interval.start
     if len(first) != 2 or any(len(entered) != 2 for entered in first.values()):
         return False
-    (robot_a, cells_a), (robot_b, cells_b) = first.items()
+    (_robot_a, cells_a), (_robot_b, cells_b) = first.items()
     x, y = sorted(cells)
     return (cells_a[x] < cells_a[y]) == (cells_b[y] < cells_b[x])

@@ -9,6 +9,7 @@ clocks.
 
 from __future__ import annotations
 
+import itertools
 import math
 from collections import Counter
 from collections.abc import Mapping, Sequence
@@ -37,7 +38,10 @@ def ideal_makespan(scenario: Scenario, time_scale: float) -> float:
 
 def _sample(intervals: Sequence[Mapping[str, Any]], start: Cell, times: Sequence[float]) -> list[Cell]:
     spans = sorted(
-        ((float(i["start"]), math.inf if i["end"] is None else float(i["end"]), (int(i["cell"][0]), int(i["cell"][1]))) for i in intervals),
+        (
+            (float(i["start"]), math.inf if i["end"] is None else float(i["end"]), (int(i["cell"][0]), int(i["cell"][1])))
+            for i in intervals
+        ),
         key=lambda span: span[0],
     )
     path, last = [], start
@@ -71,7 +75,7 @@ def live_result(
     fleet_start = min(starts, default=0.0)
     t0 = min(float(referee["start_time"]), fleet_start) if referee else fleet_start
     end = max([float(report["ended_at"]) for report in reports if report] or [t0])
-    ticks = max(1, int(math.ceil((end - t0) / tick_seconds)))
+    ticks = max(1, math.ceil((end - t0) / tick_seconds))
     times = [t0 + k * tick_seconds for k in range(ticks + 1)]
     intervals = list(referee["intervals"]) if referee else []
     robots: list[RobotResult] = []
@@ -81,8 +85,9 @@ def live_result(
         own = [interval for interval in intervals if int(interval["robot"]) == index]
         path = _sample(own, spec.start, times)
         headings = [spec.heading]
-        for before, after in zip(path, path[1:]):
-            headings.append(Heading.between(before, after) if before != after and abs(before[0] - after[0]) + abs(before[1] - after[1]) == 1 else headings[-1])
+        for before, after in itertools.pairwise(path):
+            adjacent = abs(before[0] - after[0]) + abs(before[1] - after[1]) == 1
+            headings.append(Heading.between(before, after) if adjacent else headings[-1])
         result = RobotResult(spec.id, spec.start, spec.goal, path=path, headings=headings)
         if report:
             result.turns = int(report.get("turns", 0))
@@ -108,9 +113,14 @@ def live_result(
         robots.append(result)
     collisions = []
     for item in referee["collisions"] if referee else []:
-        tick = int(round(int(item["tick"]) / 1000.0 / tick_seconds))
+        tick = round(int(item["tick"]) / 1000.0 / tick_seconds)
         collisions.append(
-            Collision(str(item["kind"]), tick, tuple(str(r) for r in item["robots"]), tuple((int(c[0]), int(c[1])) for c in item["cells"]))
+            Collision(
+                str(item["kind"]),
+                tick,
+                tuple(str(robot) for robot in item["robots"]),
+                tuple((int(cell[0]), int(cell[1])) for cell in item["cells"]),
+            )
         )
     return RunResult(
         scenario=scenario.name,

@@ -26,6 +26,7 @@ Examples
 
 from __future__ import annotations
 
+import itertools
 import math
 from bisect import bisect_right
 from functools import lru_cache
@@ -308,7 +309,7 @@ class FramePainter:
         keep = self.layout.trail_ticks
         fade = float(keep) if keep is not None else max(8.0, self.ticks * 0.75)
         floor = 0.0 if keep is not None else 0.35
-        now = min(int(math.floor(t + 1e-9)), self.ticks)
+        now = min(math.floor(t + 1e-9), self.ticks)
         first = 0 if keep is None else max(0, now - keep)
         for index in range(len(self.result.robots)):
             colour = self.colours[index]
@@ -323,7 +324,7 @@ class FramePainter:
             if len(points) < 2:
                 continue
             half = width / 2
-            for number, ((start, _), (end, reached)) in enumerate(zip(points, points[1:])):
+            for number, ((start, _), (end, reached)) in enumerate(itertools.pairwise(points)):
                 age = t - reached
                 share = max(floor, 0.85 * (1.0 - age / fade))
                 if share <= 0.02:
@@ -384,7 +385,7 @@ class FramePainter:
         title_font, tick_font = _font(size, bold=True), _font(size)
         middle = big.header / 2 - ss
         pad = 12 * ss
-        tick = min(int(math.floor(t + 1e-9)), self.ticks)
+        tick = min(math.floor(t + 1e-9), self.ticks)
         finished = t >= self.ticks
         right = f"tick {tick} / {self.ticks}"
         if finished:

@@ -141,7 +141,7 @@ def headline_html(summaries: Sequence[GroupSummary]) -> str:
     <h3>&lt;m&gt;</h3>
     >>> print(lines[-3])
     <tr class="policy-start"><td>pibt</td><td>none</td><td class="number">4</td><td class="number">2</td><td class="number partial">50% (1/2)</td><td class="number">1.500</td><td class="number">12.0</td><td class="number">2.00</td><td class="number">3.00</td></tr>
-    """
+    """  # noqa: E501
     parts = []
     for map_name in sorted({summary.key.map for summary in summaries}):
         of_map = [summary for summary in summaries if summary.key.map == map_name]

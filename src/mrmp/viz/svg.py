@@ -40,6 +40,7 @@ Examples
 
 from __future__ import annotations
 
+import itertools
 import math
 import os
 import xml.etree.ElementTree as ET
@@ -421,7 +422,7 @@ class _SvgRun:
                 last = cell
             if len(points) < 2:
                 continue
-            total = sum(math.dist(a, b) for a, b in zip(points, points[1:]))
+            total = sum(math.dist(a, b) for a, b in itertools.pairwise(points))
             window = total if keep is None else min(total, keep * layout.cell)
             gap = total + window + layout.cell
             samples = [(tick_time, _n(window - travelled)) for tick_time, travelled in self._distances(index)]
@@ -446,7 +447,7 @@ class _SvgRun:
         frames = simplify(self.tracks[index], ("x", "y"))
         travelled = 0.0
         samples = [(frames[0].t, 0.0)]
-        for before, after in zip(frames, frames[1:]):
+        for before, after in itertools.pairwise(frames):
             travelled += math.dist(self.layout.point(before.x, before.y), self.layout.point(after.x, after.y))
             samples.append((after.t, travelled))
         return samples

@@ -31,6 +31,7 @@ A→· b◦
 
 from __future__ import annotations
 
+import contextlib
 import math
 import time
 from collections.abc import Callable, Sequence
@@ -133,8 +134,8 @@ def render_grid(
     for index, cell in enumerate(cells):
         robots_in.setdefault(_block(grid, cell, k), []).append(index)
     goal_in: dict[tuple[int, int], int] = {}
-    for index, goal in enumerate(goals or ()):
-        goal_in.setdefault(_block(grid, goal, k), index)
+    for goal_index, goal in enumerate(goals or ()):
+        goal_in.setdefault(_block(grid, goal, k), goal_index)
     text = Text(no_wrap=True, overflow="crop")
     for row in range(rows):
         if row:
@@ -143,15 +144,15 @@ def render_grid(
             here = robots_in.get((row, column))
             if here:
                 if len(here) == 1:
-                    index = here[0]
-                    text.append(robot_letter(ids[index]) + ARROWS[Heading(headings[index])], style=f"bold {styles[index]}")
+                    alone = here[0]
+                    text.append(robot_letter(ids[alone]) + ARROWS[Heading(headings[alone])], style=f"bold {styles[alone]}")
                 else:
                     shown = f"{len(here)}×" if len(here) < 10 else "9+"
                     text.append(shown, style="bold")
                 continue
-            goal = goal_in.get((row, column))
-            if goal is not None:
-                text.append(robot_letter(ids[goal]).lower() + GOAL_MARK, style=f"dim {styles[goal]}")
+            owner = goal_in.get((row, column))
+            if owner is not None:
+                text.append(robot_letter(ids[owner]).lower() + GOAL_MARK, style=f"dim {styles[owner]}")
                 continue
             blocked, total = _blocked_share(grid, row, column, k)
             if blocked == total:
@@ -257,10 +258,8 @@ class TerminalView:
         """Take the robots' cells after ``tick``, redraw, then wait out the frame's time."""
         for index, (before, after) in enumerate(zip(self.cells, cells)):
             if after != before:
-                try:
+                with contextlib.suppress(ValueError):  # not a single step: the heading cannot be told
                     self.headings[index] = Heading.between(before, after)
-                except ValueError:
-                    pass  # not a single step: the heading cannot be told
         self.cells = list(cells)
         self.tick = tick
         if self._live is not None:

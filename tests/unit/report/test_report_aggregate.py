@@ -97,7 +97,7 @@ def test_success_by_faults_pools_n_and_leaves_out_lifelong_runs():
 
 
 def test_overview_lists_every_dimension_and_status():
-    facts = overview(hand_made() + [record_from_dict(make_record(run_id="z", policy="cbs", kind="centralized"))])
+    facts = overview([*hand_made(), record_from_dict(make_record(run_id="z", policy="cbs", kind="centralized"))])
     assert facts.central_policies == ("cbs",)
     facts = overview(hand_made())
     assert facts.runs == 11 and facts.successes == 8 and facts.runs_with_collisions == 1

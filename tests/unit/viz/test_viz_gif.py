@@ -80,7 +80,7 @@ def test_obstacles_costs_and_collisions(walled: tuple[Grid, RunResult], tmp_path
     layout = make_layout(grid, len(result.robots))
     for cell in grid.blocked_cells():
         assert sum(frames[0].getpixel(tuple(map(round, layout.centre(cell))))) < 250, f"blocked {cell} not dark"
-    red, green, blue = frames[0].getpixel(tuple(map(round, layout.centre((2, 4)))))
+    red, _green, blue = frames[0].getpixel(tuple(map(round, layout.centre((2, 4)))))
     assert red > blue + 40, "a costly cell is tinted amber"
     left, top, _, _ = layout.cell_box((0, 2))
     corner = (left + round(layout.cell * 0.08), top + round(layout.cell * 0.08))
