@@ -110,6 +110,7 @@ from mrmp.centralized.plan import (
     as_problem,
     pad_headings,
     pad_paths,
+    tick_grid,
 )
 from mrmp.centralized.space_time_astar import (
     Reservations,
@@ -387,7 +388,7 @@ def mdd_layers(
     )
 
     if heading_aware:
-        table = heading_distance_table(grid if not grid.has_costs else Grid(grid.x_size, grid.y_size, grid.blocked_cells()), goal)
+        table = heading_distance_table(tick_grid(grid), goal)
 
         def estimate(state: tuple[Cell, int]) -> float:
             return table.get((state[0], Heading(state[1])), float("inf"))

@@ -87,20 +87,13 @@ import time
 from collections import deque
 from collections.abc import Sequence
 
-from mrmp.centralized.pibt_step import (
-    NO_CELL,
-    PIBT,
-    cell_of,
-    distance_list,
-    flat_neighbours,
-    index_of,
-    tick_grid,
-)
-from mrmp.centralized.plan import MapfProblem, PlanningResult, as_problem
+from mrmp.centralized.pibt_step import NO_CELL, PIBT
+from mrmp.centralized.plan import MapfProblem, PlanningResult, as_problem, tick_grid
 from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
 from mrmp.core.scenario import Scenario
 from mrmp.search.distance import distance_table
+from mrmp.search.flat_grid import flat_grid
 
 __all__ = ["lacam"]
 
@@ -234,20 +227,19 @@ def lacam(
         return _result("solved", start_time, 0, "no robots", ())
 
     plain = tick_grid(grid)
-    size = grid.x_size * grid.y_size
-    unreachable = size
+    flat = flat_grid(grid)
     tables = [distance_table(plain, goal) for goal in instance.goals]
     for robot_id, start, goal, table in zip(instance.ids, instance.starts, instance.goals, tables):
         if not table.reachable(start):
             return _result("infeasible", start_time, 0, f"robot {robot_id} cannot reach its goal {goal} from {start}")
-    distances = [distance_list(table, unreachable) for table in tables]
-    neighbours = flat_neighbours(grid)
-    start_config = tuple(index_of(grid, cell) for cell in instance.starts)
-    goal_config = tuple(index_of(grid, cell) for cell in instance.goals)
+    distances = [table.as_list() for table in tables]
+    neighbours = flat.neighbours
+    start_config = tuple(flat.index(cell) for cell in instance.starts)
+    goal_config = tuple(flat.index(cell) for cell in instance.goals)
     rng = random.Random(seed) if seed is not None else None
     pibt = PIBT(neighbours, distances, list(goal_config), swap=swap, rng=rng, rotations=False)
     candidates = [(*row, cell) for cell, row in enumerate(neighbours)]
-    scale = 1.0 / (unreachable + 1)
+    scale = 1.0 / (flat.size + 1)
     robot_range = range(count)
 
     def heuristic(config: tuple[int, ...]) -> int:
@@ -354,7 +346,7 @@ def lacam(
         configs.append(cursor.config)
         cursor = cursor.parent
     configs.reverse()
-    paths = tuple(tuple(cell_of(grid, config[robot]) for config in configs) for robot in robot_range)
+    paths = tuple(tuple(flat.cell(config[robot]) for config in configs) for robot in robot_range)
     if not anytime:
         message = f"first solution after {iterations} iterations"
     elif stopped:

@@ -77,6 +77,7 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
 
+from mrmp.centralized.plan import tick_grid
 from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
 from mrmp.core.heading import HEADINGS, Heading
@@ -281,20 +282,13 @@ class SpaceTimeResult:
         return len(self.path) - 1
 
 
-def _plain_grid(grid: Grid) -> Grid:
-    """The same grid with every entry cost 1 (planners count ticks)."""
-    if not grid.has_costs:
-        return grid
-    return Grid(grid.x_size, grid.y_size, grid.blocked_cells(), name=grid.name)
-
-
 def hop_distance_table(grid: Grid, goal: Cell) -> DistanceTable:
     """The number of moves from every cell to ``goal``, ignoring entry costs.
 
     >>> hop_distance_table(Grid(2, 2, costs={(0, 1): 9.0}), (0, 1)).distance((1, 0))
     2.0
     """
-    return distance_table(_plain_grid(grid), goal)
+    return distance_table(tick_grid(grid), goal)
 
 
 @lru_cache(maxsize=64)
