@@ -69,8 +69,8 @@ class FlatGrid:
     free:
         The obstacle mask: ``free[i]`` is 1 where cell ``i`` is free, 0 where blocked.
     costs:
-        For every flat cell, the cost of entering it (1.0 on blocked cells,
-        which are never entered).
+        For every flat cell, the cost of entering it, as the grid states it
+        (searches never read it on blocked cells, which are never entered).
     uniform_cost:
         The entry cost shared by every free cell, or ``None`` when they differ.
     cells:
@@ -107,7 +107,7 @@ class FlatGrid:
                 free_costs.add(cost)
             else:
                 self.neighbours.append(())
-                self.costs.append(1.0)
+                self.costs.append(float(grid.cost(cell)))  # never entered: kept as the grid states it
         self.uniform_cost: float | None = next(iter(free_costs)) if len(free_costs) == 1 else None
 
     def index(self, cell: Cell) -> int:

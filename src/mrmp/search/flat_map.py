@@ -46,7 +46,7 @@ class FlatMap(FlatGrid):
     """A grid's flat form and its distance lists, computed on demand (module docstring).
 
     ``entry_costs`` is :attr:`~mrmp.search.flat_grid.FlatGrid.costs`, or
-    ``None`` when every free cell costs 1 (the plain grids of the thesis).
+    ``None`` when every cell costs 1 (the plain grids of the thesis).
     """
 
     __slots__ = ("_heading_tables", "_tables", "entry_costs", "grid", "table_seconds")
@@ -54,7 +54,7 @@ class FlatMap(FlatGrid):
     def __init__(self, grid: Grid) -> None:
         super().__init__(grid)
         self.grid = grid
-        self.entry_costs: list[float] | None = None if self.uniform_cost == 1.0 else self.costs
+        self.entry_costs: list[float] | None = self.costs if grid.has_costs else None
         self._tables: dict[int, list[float]] = {}
         self._heading_tables: dict[tuple[int, float], list[float]] = {}
         self.table_seconds = 0.0
