@@ -102,6 +102,7 @@ import heapq
 import time
 from collections.abc import Sequence
 from dataclasses import dataclass
+from typing import Any
 
 from mrmp.centralized.dependencies import rotations_at
 from mrmp.centralized.plan import (
@@ -110,6 +111,7 @@ from mrmp.centralized.plan import (
     as_problem,
     pad_headings,
     pad_paths,
+    tick_grid,
 )
 from mrmp.centralized.space_time_astar import (
     Reservations,
@@ -387,7 +389,7 @@ def mdd_layers(
     )
 
     if heading_aware:
-        table = heading_distance_table(grid if not grid.has_costs else Grid(grid.x_size, grid.y_size, grid.blocked_cells()), goal)
+        table = heading_distance_table(tick_grid(grid), goal)
 
         def estimate(state: tuple[Cell, int]) -> float:
             return table.get((state[0], Heading(state[1])), float("inf"))
@@ -493,70 +495,209 @@ def cbs(
     """
     began = time.perf_counter()
     instance = as_problem(problem, starts, goals)
-    deadline = None if time_limit_s is None else began + time_limit_s
+    search = _ConflictSearch(instance, began, time_limit_s, max_nodes, heading_aware, improved)
+    proof = infeasibility_proof(instance)
+    if proof is not None:
+        return search.result("infeasible", proof, 0)
+    return search.run()
 
-    def result(status: str, message: str, nodes: int, node: _Node | None = None) -> PlanningResult:
-        elapsed = time.perf_counter() - began
+
+_Split = tuple[int, _Constraint]
+"""A child of a split: the robot and the constraint it gets."""
+
+
+def _splits(conflict: Conflict) -> tuple[_Split, ...]:
+    """The children of a split on ``conflict``: each forbids the conflict to one of its robots."""
+    if conflict.kind == "vertex":
+        cell = conflict.cells[0]
+        return ((conflict.first, ("v", cell, conflict.tick)), (conflict.second, ("v", cell, conflict.tick)))
+    if conflict.kind == "rotation":
+        cycle = conflict.cells
+        return tuple(
+            (robot, ("e", cycle[k], cycle[(k + 1) % len(cycle)], conflict.tick)) for k, robot in enumerate(conflict.robots)
+        )
+    source, target = conflict.cells
+    return ((conflict.first, ("e", source, target, conflict.tick)), (conflict.second, ("e", target, source, conflict.tick)))
+
+
+def _replaced(row: tuple[Any, ...], index: int, value: Any) -> tuple[Any, ...]:
+    """``row`` with entry ``index`` replaced by ``value``."""
+    return (*row[:index], value, *row[index + 1 :])
+
+
+class _ConflictSearch:
+    """One CBS run: the root, the best-first loop over the constraint tree, conflict choice and splits."""
+
+    def __init__(
+        self,
+        instance: MapfProblem,
+        began: float,
+        time_limit_s: float | None,
+        max_nodes: int | None,
+        heading_aware: bool,
+        improved: bool,
+    ) -> None:
+        self.instance = instance
+        self.grid = instance.grid
+        self.count = len(instance)
+        self.began = began
+        self.time_limit_s = time_limit_s
+        self.deadline = None if time_limit_s is None else began + time_limit_s
+        self.max_nodes = max_nodes
+        self.heading_aware = heading_aware
+        self.improved = improved
+        self.nodes = 0
+        self.open_list: list[tuple[tuple[int, int, int], _Node]] = []
+
+    # -- results ---------------------------------------------------------------------
+
+    def result(self, status: str, message: str, nodes: int, node: _Node | None = None) -> PlanningResult:
+        """A :class:`PlanningResult` of CBS, timed from the start, with ``node``'s paths when given."""
+        elapsed = time.perf_counter() - self.began
         paths = headings = None
         if node is not None:
             paths = pad_paths(node.paths)
-            if heading_aware:
+            if self.heading_aware:
                 headings = pad_headings([row for row in node.headings if row is not None])
         return PlanningResult(status, paths, elapsed, "cbs", nodes=nodes, message=message, headings=headings)
 
-    def out_of_time(nodes: int) -> PlanningResult:
-        return result("limit", f"time limit of {time_limit_s:g} s reached after {nodes} nodes", nodes)
+    def _out_of_time(self) -> PlanningResult:
+        return self.result("limit", f"time limit of {self.time_limit_s:g} s reached after {self.nodes} nodes", self.nodes)
 
-    proof = infeasibility_proof(instance)
-    if proof is not None:
-        return result("infeasible", proof, 0)
+    # -- the high level ---------------------------------------------------------------
 
-    grid = instance.grid
-    count = len(instance)
+    def run(self) -> PlanningResult:
+        """Best-first search of the constraint tree from the root (module docstring, steps 1 to 3)."""
+        root = self._root()
+        if isinstance(root, PlanningResult):
+            return root
+        self.nodes = 1
+        self._push(root)
+        open_list = self.open_list
+        while open_list:
+            _, node = heapq.heappop(open_list)
+            if not node.conflicts:
+                return self.result("solved", f"optimal sum of costs {node.cost} after {self.nodes} nodes", self.nodes, node)
+            if self.deadline is not None and time.perf_counter() > self.deadline:
+                return self._out_of_time()
+            if not node.evaluated:
+                bound = node.f
+                self._evaluate(node)
+                if node.f > bound:
+                    self._push(node)
+                    continue
+            stopped = self._split(node)
+            if stopped is not None:
+                return stopped
+        return self.result("infeasible", f"constraint tree exhausted after {self.nodes} nodes: no plan exists", self.nodes)
 
-    def replan(index: int, constraints: Sequence[_Constraint], paths: Sequence[Sequence[Cell] | None]) -> SpaceTimeResult:
+    def _push(self, node: _Node) -> None:
+        heapq.heappush(self.open_list, (node.key(), node))
+
+    def _root(self) -> _Node | PlanningResult:
+        """The root: every robot's cheapest path without constraints (avoiding the paths planned before it)."""
+        count = self.count
+        empty: tuple[_Constraint, ...] = ()
+        root_paths: list[tuple[Cell, ...] | None] = [None] * count
+        root_headings: list[tuple[Heading, ...] | None] = [None] * count
+        for index in range(count):
+            found = self._replan(index, empty, root_paths)
+            if found.status == "deadline":
+                return self.result("limit", f"time limit of {self.time_limit_s:g} s reached while planning the root", 0)
+            if not found.found:  # pragma: no cover - excluded by infeasibility_proof
+                return self.result("infeasible", f"robot {self.instance.ids[index]} cannot reach its goal", 0)
+            root_paths[index] = found.path
+            root_headings[index] = found.headings
+        paths = tuple(path for path in root_paths if path is not None)
+        cost = sum(len(path) - 1 for path in paths)
+        conflicts = all_conflicts(paths, rotations=True)
+        return _Node(cost, cost, conflicts, 0, (empty,) * count, paths, tuple(root_headings), [None] * count)
+
+    def _split(self, node: _Node) -> PlanningResult | None:
+        """Split ``node`` on its chosen conflict (or bypass it); a result when a limit stops the search."""
+        conflict = node.chosen
+        assert conflict is not None
+        children: list[_Node] = []
+        for robot, constraint in _splits(conflict):
+            if self.max_nodes is not None and self.nodes >= self.max_nodes:
+                return self.result("limit", f"node limit of {self.max_nodes} reached", self.nodes)
+            constraints = (*node.constraints[robot], constraint)
+            found = self._replan(robot, constraints, node.paths)
+            if found.status == "deadline":
+                return self._out_of_time()
+            self.nodes += 1
+            if not found.found or found.path is None:
+                continue
+            child_paths = _replaced(node.paths, robot, found.path)
+            child_headings = _replaced(node.headings, robot, found.headings)
+            child_conflicts = all_conflicts(child_paths, rotations=True)
+            cost = node.cost - (len(node.paths[robot]) - 1) + (len(found.path) - 1)
+            if self.improved and cost == node.cost and len(child_conflicts) < len(node.conflicts):
+                # bypass (Boyarski et al. 2015): the new path is as cheap and also respects the
+                # node's own constraints; adopt it instead of splitting
+                node.paths, node.headings, node.conflicts = child_paths, child_headings, child_conflicts
+                node.evaluated, node.chosen = False, None
+                self._push(node)
+                return None
+            mdds = list(node.mdds)
+            mdds[robot] = None
+            child_constraints = _replaced(node.constraints, robot, constraints)
+            children.append(
+                _Node(cost, max(cost, node.f), child_conflicts, self.nodes, child_constraints, child_paths, child_headings, mdds)
+            )
+        for child in children:
+            self._push(child)
+        return None
+
+    # -- the low level and the improvements --------------------------------------------
+
+    def _replan(self, index: int, constraints: Sequence[_Constraint], paths: Sequence[Sequence[Cell] | None]) -> SpaceTimeResult:
+        """Robot ``index``'s cheapest path under its constraints, fewest conflicts with ``paths`` among them."""
+        instance = self.instance
         return space_time_astar(
-            grid,
+            self.grid,
             instance.starts[index],
             instance.goals[index],
             _reservations(constraints),
-            heading_aware=heading_aware,
+            heading_aware=self.heading_aware,
             heading=instance.headings[index],
             avoid=_avoidance(paths, index),
-            deadline=deadline,
+            deadline=self.deadline,
         )
 
-    def mdd(node: _Node, robot: int) -> _Layers:
+    def _mdd(self, node: _Node, robot: int) -> _Layers:
+        """The MDD of ``robot``'s cheapest paths in ``node``, computed once per node and robot."""
         layers = node.mdds[robot]
         if layers is None:
+            instance = self.instance
             layers = mdd_layers(
-                grid,
+                self.grid,
                 instance.starts[robot],
                 instance.goals[robot],
                 len(node.paths[robot]) - 1,
                 _reservations(node.constraints[robot]),
-                heading_aware=heading_aware,
+                heading_aware=self.heading_aware,
                 heading=instance.headings[robot],
             )
             node.mdds[robot] = layers
         return layers
 
-    def forced(node: _Node, robot: int, conflict: Conflict) -> bool:
+    def _forced(self, node: _Node, robot: int, conflict: Conflict) -> bool:
         """Whether every cheapest path of ``robot`` has the conflict (splitting raises its cost)."""
         tick = conflict.tick
         cost = len(node.paths[robot]) - 1
         if conflict.kind == "vertex":
             if tick >= cost:
                 return True  # settled on its goal: it must leave and come back later
-            layer = mdd(node, robot)[tick]
+            layer = self._mdd(node, robot)[tick]
             return len(layer) == 1
-        layers = mdd(node, robot)
+        layers = self._mdd(node, robot)
         return len(layers[tick - 1]) == 1 and len(layers[tick]) == 1
 
-    def evaluate(node: _Node) -> None:
+    def _evaluate(self, node: _Node) -> None:
         """Choose the conflict to split (cardinal, then semi-cardinal, then the earliest) and bound ``f``."""
         node.evaluated = True
-        if not improved:
+        if not self.improved:
             node.chosen = node.conflicts[0]
             return
         best: tuple[int, int] | None = None
@@ -568,7 +709,7 @@ def cbs(
             if conflict.kind == "rotation":
                 kind = 2  # not a pair: never cardinal, never in the conflict graph
             else:
-                kind = 2 - forced(node, conflict.first, conflict) - forced(node, conflict.second, conflict)
+                kind = 2 - self._forced(node, conflict.first, conflict) - self._forced(node, conflict.second, conflict)
             if kind == 0:
                 cardinal_pairs.add(pair)
             if best is None or kind < best[0]:
@@ -576,87 +717,3 @@ def cbs(
         node.chosen = node.conflicts[best[1] if best is not None else 0]
         if cardinal_pairs:
             node.f = max(node.f, node.cost + min_vertex_cover_size(sorted(cardinal_pairs)))
-
-    empty: tuple[_Constraint, ...] = ()
-    root_paths: list[tuple[Cell, ...] | None] = [None] * count
-    root_headings: list[tuple[Heading, ...] | None] = [None] * count
-    for index in range(count):
-        found = replan(index, empty, root_paths)
-        if found.status == "deadline":
-            return result("limit", f"time limit of {time_limit_s:g} s reached while planning the root", 0)
-        if not found.found:  # pragma: no cover - excluded by infeasibility_proof
-            return result("infeasible", f"robot {instance.ids[index]} cannot reach its goal", 0)
-        root_paths[index] = found.path
-        root_headings[index] = found.headings
-    paths = tuple(path for path in root_paths if path is not None)
-    cost = sum(len(path) - 1 for path in paths)
-    root_conflicts = all_conflicts(paths, rotations=True)
-    root = _Node(cost, cost, root_conflicts, 0, (empty,) * count, paths, tuple(root_headings), [None] * count)
-    nodes = 1
-    open_list: list[tuple[tuple[int, int, int], _Node]] = [(root.key(), root)]
-
-    while open_list:
-        _, node = heapq.heappop(open_list)
-        if not node.conflicts:
-            return result("solved", f"optimal sum of costs {node.cost} after {nodes} nodes", nodes, node)
-        if deadline is not None and time.perf_counter() > deadline:
-            return out_of_time(nodes)
-        if not node.evaluated:
-            bound = node.f
-            evaluate(node)
-            if node.f > bound:
-                heapq.heappush(open_list, (node.key(), node))
-                continue
-        conflict = node.chosen
-        assert conflict is not None
-        splits: tuple[tuple[int, _Constraint], ...]
-        if conflict.kind == "vertex":
-            cell = conflict.cells[0]
-            splits = ((conflict.first, ("v", cell, conflict.tick)), (conflict.second, ("v", cell, conflict.tick)))
-        elif conflict.kind == "rotation":
-            cycle = conflict.cells
-            splits = tuple(
-                (robot, ("e", cycle[k], cycle[(k + 1) % len(cycle)], conflict.tick))
-                for k, robot in enumerate(conflict.robots)
-            )
-        else:
-            source, target = conflict.cells
-            splits = (
-                (conflict.first, ("e", source, target, conflict.tick)),
-                (conflict.second, ("e", target, source, conflict.tick)),
-            )
-        children: list[_Node] = []
-        bypassed = False
-        for robot, constraint in splits:
-            if max_nodes is not None and nodes >= max_nodes:
-                return result("limit", f"node limit of {max_nodes} reached", nodes)
-            constraints = node.constraints[robot] + (constraint,)
-            found = replan(robot, constraints, node.paths)
-            if found.status == "deadline":
-                return out_of_time(nodes)
-            nodes += 1
-            if not found.found or found.path is None:
-                continue
-            child_paths = node.paths[:robot] + (found.path,) + node.paths[robot + 1 :]
-            child_headings = node.headings[:robot] + (found.headings,) + node.headings[robot + 1 :]
-            child_conflicts = all_conflicts(child_paths, rotations=True)
-            cost = node.cost - (len(node.paths[robot]) - 1) + (len(found.path) - 1)
-            if improved and cost == node.cost and len(child_conflicts) < len(node.conflicts):
-                # bypass (Boyarski et al. 2015): the new path is as cheap and also respects the
-                # node's own constraints; adopt it instead of splitting
-                node.paths, node.headings, node.conflicts = child_paths, child_headings, child_conflicts
-                node.evaluated, node.chosen = False, None
-                bypassed = True
-                break
-            child_constraints = node.constraints[:robot] + (constraints,) + node.constraints[robot + 1 :]
-            mdds = list(node.mdds)
-            mdds[robot] = None
-            children.append(
-                _Node(cost, max(cost, node.f), child_conflicts, nodes, child_constraints, child_paths, child_headings, mdds)
-            )
-        if bypassed:
-            heapq.heappush(open_list, (node.key(), node))
-            continue
-        for child in children:
-            heapq.heappush(open_list, (child.key(), child))
-    return result("infeasible", f"constraint tree exhausted after {nodes} nodes: no plan exists", nodes)

@@ -87,20 +87,13 @@ import time
 from collections import deque
 from collections.abc import Sequence
 
-from mrmp.centralized.pibt_step import (
-    NO_CELL,
-    PIBT,
-    cell_of,
-    distance_list,
-    flat_neighbours,
-    index_of,
-    tick_grid,
-)
-from mrmp.centralized.plan import MapfProblem, PlanningResult, as_problem
+from mrmp.centralized.pibt_step import NO_CELL, PIBT
+from mrmp.centralized.plan import MapfProblem, PlanningResult, as_problem, tick_grid
 from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
 from mrmp.core.scenario import Scenario
 from mrmp.search.distance import distance_table
+from mrmp.search.flat_grid import flat_grid
 
 __all__ = ["lacam"]
 
@@ -124,7 +117,7 @@ class _Node:
         parent: _Node | None,
         priorities: list[float],
         g: int = 0,
-        h: int = 0,
+        h: float = 0,
     ) -> None:
         self.config = config
         self.parent = parent
@@ -228,137 +221,173 @@ def lacam(
     start_time = time.perf_counter()
     deadline = None if time_limit_s is None else start_time + time_limit_s
     instance = as_problem(problem, starts, goals)
-    grid = instance.grid
-    count = len(instance)
-    if count == 0:
+    if len(instance) == 0:
         return _result("solved", start_time, 0, "no robots", ())
-
-    plain = tick_grid(grid)
-    size = grid.x_size * grid.y_size
-    unreachable = size
+    plain = tick_grid(instance.grid)
     tables = [distance_table(plain, goal) for goal in instance.goals]
     for robot_id, start, goal, table in zip(instance.ids, instance.starts, instance.goals, tables):
         if not table.reachable(start):
             return _result("infeasible", start_time, 0, f"robot {robot_id} cannot reach its goal {goal} from {start}")
-    distances = [distance_list(table, unreachable) for table in tables]
-    neighbours = flat_neighbours(grid)
-    start_config = tuple(index_of(grid, cell) for cell in instance.starts)
-    goal_config = tuple(index_of(grid, cell) for cell in instance.goals)
-    rng = random.Random(seed) if seed is not None else None
-    pibt = PIBT(neighbours, distances, list(goal_config), swap=swap, rng=rng, rotations=False)
-    candidates = [(*row, cell) for cell, row in enumerate(neighbours)]
-    scale = 1.0 / (unreachable + 1)
-    robot_range = range(count)
+    search = _Search(instance, [table.as_list() for table in tables], seed, swap, anytime)
+    stopped = search.run(deadline, time_limit_s, max_nodes)
+    return search.result(start_time, stopped)
 
-    def heuristic(config: tuple[int, ...]) -> int:
-        return sum(distances[robot][config[robot]] for robot in robot_range)
 
-    def edge_cost(before: tuple[int, ...], after: tuple[int, ...]) -> int:
-        return sum(1 for robot in robot_range if not (before[robot] == after[robot] == goal_config[robot]))
+class _Search:
+    """One LaCAM (or LaCAM*) search: the high-level stack of configurations and its lazy low-level queues."""
 
-    def make_node(config: tuple[int, ...], parent: _Node | None) -> _Node:
+    def __init__(
+        self, instance: MapfProblem, distances: list[list[float]], seed: int | None, swap: bool, anytime: bool
+    ) -> None:
+        self.flat = flat_grid(instance.grid)
+        self.count = len(instance)
+        self.robot_range = range(self.count)
+        self.distances = distances
+        self.anytime = anytime
+        neighbours = self.flat.neighbours
+        self.goal_config = tuple(self.flat.index(cell) for cell in instance.goals)
+        self.rng = random.Random(seed) if seed is not None else None
+        self.pibt = PIBT(neighbours, distances, list(self.goal_config), swap=swap, rng=self.rng, rotations=False)
+        self.candidates = [(*row, cell) for cell, row in enumerate(neighbours)]
+        self.scale = 1.0 / (self.flat.size + 1)
+        start_config = tuple(self.flat.index(cell) for cell in instance.starts)
+        root = self._make_node(start_config, None)
+        self.stack: deque[_Node] = deque((root,))
+        self.explored: dict[tuple[int, ...], _Node] = {start_config: root}
+        self.goal_node: _Node | None = None
+        self.iterations = 0
+
+    # -- costs and nodes -------------------------------------------------------------
+
+    def _heuristic(self, config: tuple[int, ...]) -> float:
+        distances = self.distances
+        return sum(distances[robot][config[robot]] for robot in self.robot_range)
+
+    def _edge_cost(self, before: tuple[int, ...], after: tuple[int, ...]) -> int:
+        goal_config = self.goal_config
+        return sum(1 for robot in self.robot_range if not (before[robot] == after[robot] == goal_config[robot]))
+
+    def _priorities(self, config: tuple[int, ...], parent: _Node | None) -> list[float]:
+        """PIBT's dynamic priorities: distance scaled below 1 at the start, +1 per step away from the goal."""
         if parent is None:
-            priorities = [distances[robot][config[robot]] * scale for robot in robot_range]
-        else:
-            old = parent.priorities
-            priorities = [
-                old[robot] + 1 if config[robot] != goal_config[robot] else old[robot] - int(old[robot])
-                for robot in robot_range
-            ]
-        if not anytime:
+            return [self.distances[robot][config[robot]] * self.scale for robot in self.robot_range]
+        old, goal_config = parent.priorities, self.goal_config
+        return [
+            old[robot] + 1 if config[robot] != goal_config[robot] else old[robot] - int(old[robot])
+            for robot in self.robot_range
+        ]
+
+    def _make_node(self, config: tuple[int, ...], parent: _Node | None) -> _Node:
+        priorities = self._priorities(config, parent)
+        if not self.anytime:
             return _Node(config, parent, priorities)
-        g = 0 if parent is None else parent.g + edge_cost(parent.config, config)
-        node = _Node(config, parent, priorities, g, heuristic(config))
+        g = 0 if parent is None else parent.g + self._edge_cost(parent.config, config)
+        node = _Node(config, parent, priorities, g, self._heuristic(config))
         if parent is not None:
             node.neighbours.add(parent)
             parent.neighbours.add(node)
         return node
 
-    root = make_node(start_config, None)
-    stack: deque[_Node] = deque((root,))
-    explored: dict[tuple[int, ...], _Node] = {start_config: root}
-    goal_node: _Node | None = None
-    iterations = 0
-    stopped = ""
-
-    def rewrite(origin: _Node, reached: _Node) -> None:
+    def _rewrite(self, origin: _Node, reached: _Node) -> None:
         """LaCAM*'s Dijkstra-like update of g-values from ``origin`` after it met ``reached``."""
         origin.neighbours.add(reached)
         queue = deque((origin,))
         while queue:
             node = queue.popleft()
             for other in node.neighbours:
-                g = node.g + edge_cost(node.config, other.config)
+                g = node.g + self._edge_cost(node.config, other.config)
                 if g < other.g:
                     other.g = g
                     other.f = g + other.h
                     other.parent = node
                     queue.append(other)
-                    if goal_node is not None and other.f < goal_node.f:
-                        stack.appendleft(other)
+                    if self.goal_node is not None and other.f < self.goal_node.f:
+                        self.stack.appendleft(other)
 
-    while stack:
-        if deadline is not None and time.perf_counter() > deadline:
-            stopped = f"time limit {time_limit_s} s reached"
-            break
-        iterations += 1
-        node = stack[0]
-        if anytime and goal_node is not None and node.f >= goal_node.f:
-            stack.popleft()
-            continue
-        if goal_node is None and node.config == goal_config:
-            goal_node = node
-            if not anytime:
-                break
-            continue
+    # -- the search --------------------------------------------------------------------
+
+    def run(self, deadline: float | None, time_limit_s: float | None, max_nodes: int | None) -> str:
+        """Search until the goal (LaCAM) or exhaustion or a limit (LaCAM*); return why it stopped early, or ``""``."""
+        stack = self.stack
+        while stack:
+            if deadline is not None and time.perf_counter() > deadline:
+                return f"time limit {time_limit_s} s reached"
+            self.iterations += 1
+            node = stack[0]
+            if self._settle(node):
+                if self.goal_node is node and not self.anytime:
+                    return ""
+                continue
+            config = self._successor(node)
+            if config is None:
+                continue
+            known = self.explored.get(config)
+            if known is not None:
+                if self.anytime:
+                    self._rewrite(node, known)
+                stack.appendleft(known)
+                continue
+            if max_nodes is not None and len(self.explored) >= max_nodes:
+                return f"node limit {max_nodes} reached"
+            new = self._make_node(config, node)
+            self.explored[config] = new
+            stack.appendleft(new)
+        return ""
+
+    def _settle(self, node: _Node) -> bool:
+        """Handle the top ``node`` when it needs no successor: pruned, the goal, or exhausted (then popped)."""
+        goal_node = self.goal_node
+        if self.anytime and goal_node is not None and node.f >= goal_node.f:
+            self.stack.popleft()
+            return True
+        if goal_node is None and node.config == self.goal_config:
+            self.goal_node = node
+            return True
         if not node.tree:
-            stack.popleft()
-            continue
+            self.stack.popleft()
+            return True
+        return False
+
+    def _successor(self, node: _Node) -> tuple[int, ...] | None:
+        """Take ``node``'s next low-level node, queue its children, and let PIBT complete its constraints."""
         low = node.tree.popleft()
         depth = low[0]
-        if depth < count:
+        if depth < self.count:
             chosen = node.order[depth]
-            options = list(candidates[node.config[chosen]])
-            if rng is not None:
-                rng.shuffle(options)
+            options = list(self.candidates[node.config[chosen]])
+            if self.rng is not None:
+                self.rng.shuffle(options)
             node.tree.extend((depth + 1, chosen, cell, low) for cell in options)
-        target = [NO_CELL] * count
+        target = [NO_CELL] * self.count
         constraint: _LowNode | None = low
         while constraint is not None and constraint[0] > 0:
             target[constraint[1]] = constraint[2]
             constraint = constraint[3]
-        if not pibt.generate(node.config, target, node.order):
-            continue
-        config = tuple(target)
-        known = explored.get(config)
-        if known is not None:
-            if anytime:
-                rewrite(node, known)
-            stack.appendleft(known)
-            continue
-        if max_nodes is not None and len(explored) >= max_nodes:
-            stopped = f"node limit {max_nodes} reached"
-            break
-        new = make_node(config, node)
-        explored[config] = new
-        stack.appendleft(new)
+        if not self.pibt.generate(node.config, target, node.order):
+            return None
+        return tuple(target)
 
-    nodes = len(explored)
-    if goal_node is None:
-        if stopped:
-            return _result("limit", start_time, nodes, f"{stopped} after {iterations} iterations, no solution")
-        return _result("infeasible", start_time, nodes, f"search space exhausted after {iterations} iterations")
-    configs: list[tuple[int, ...]] = []
-    cursor: _Node | None = goal_node
-    while cursor is not None:
-        configs.append(cursor.config)
-        cursor = cursor.parent
-    configs.reverse()
-    paths = tuple(tuple(cell_of(grid, config[robot]) for config in configs) for robot in robot_range)
-    if not anytime:
-        message = f"first solution after {iterations} iterations"
-    elif stopped:
-        message = f"best solution when the {stopped} (LaCAM*, cost {goal_node.g})"
-    else:
-        message = f"optimal for LaCAM*'s cost {goal_node.g} (search space exhausted)"
-    return _result("solved", start_time, nodes, message, paths)
+    # -- the result ----------------------------------------------------------------------
+
+    def result(self, start_time: float, stopped: str) -> PlanningResult:
+        """The plan backtracked from the goal node, or why there is none."""
+        nodes, iterations, goal_node = len(self.explored), self.iterations, self.goal_node
+        if goal_node is None:
+            if stopped:
+                return _result("limit", start_time, nodes, f"{stopped} after {iterations} iterations, no solution")
+            return _result("infeasible", start_time, nodes, f"search space exhausted after {iterations} iterations")
+        configs: list[tuple[int, ...]] = []
+        cursor: _Node | None = goal_node
+        while cursor is not None:
+            configs.append(cursor.config)
+            cursor = cursor.parent
+        configs.reverse()
+        cell = self.flat.cell
+        paths = tuple(tuple(cell(config[robot]) for config in configs) for robot in self.robot_range)
+        if not self.anytime:
+            message = f"first solution after {iterations} iterations"
+        elif stopped:
+            message = f"best solution when the {stopped} (LaCAM*, cost {goal_node.g})"
+        else:
+            message = f"optimal for LaCAM*'s cost {goal_node.g} (search space exhausted)"
+        return _result("solved", start_time, nodes, message, paths)

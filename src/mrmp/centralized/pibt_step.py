@@ -30,9 +30,10 @@ off by default here and turned on with ``swap=True``; it follows
 ``lacam3/src/pibt.cpp`` of Kei18/lacam3 (``is_swap_required``,
 ``is_swap_possible``, the pull after a first-choice move).
 
-The inner loop works on flat cell indices (``x * y_size + y``, the indexing of
-:mod:`mrmp.search.distance`), neighbour tuples precomputed once per grid and
-integer distance lists per robot. Priority inheritance is run with an explicit
+The inner loop works on the flat cells of :mod:`mrmp.search.flat_grid`
+(``x * y_size + y``), its neighbour tuples precomputed once per grid and one
+distance list per robot in its distance convention (``inf`` where the goal
+cannot be reached). Priority inheritance is run with an explicit
 stack, so chains of any length need no deep Python recursion.
 
 Examples
@@ -62,92 +63,19 @@ from __future__ import annotations
 import random
 from collections.abc import Mapping, Sequence
 
-import numpy as np
-
+from mrmp.centralized.plan import tick_grid
 from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
 from mrmp.policies.pibt_rules import sorted_candidates, swap_possible, swap_required
 from mrmp.search.distance import DistanceTable, distance_table
+from mrmp.search.flat_grid import flat_grid
 
-__all__ = [
-    "NO_AGENT",
-    "NO_CELL",
-    "PIBT",
-    "cell_of",
-    "distance_list",
-    "flat_neighbours",
-    "index_of",
-    "pibt_step",
-    "tick_grid",
-]
+__all__ = ["NO_AGENT", "NO_CELL", "PIBT", "pibt_step"]
 
 NO_AGENT = -1
 """Marks a cell that no robot occupies (or reserves)."""
 NO_CELL = -1
 """Marks a robot whose next cell is not decided yet."""
-
-
-def index_of(grid: Grid, cell: Cell) -> int:
-    """The flat index ``x * y_size + y`` of ``cell``.
-
-    >>> index_of(Grid(3, 4), (2, 1))
-    9
-    """
-    return cell[0] * grid.y_size + cell[1]
-
-
-def cell_of(grid: Grid, index: int) -> Cell:
-    """The cell of flat index ``index`` (inverse of :func:`index_of`).
-
-    >>> cell_of(Grid(3, 4), 9)
-    (2, 1)
-    """
-    return divmod(index, grid.y_size)
-
-
-def flat_neighbours(grid: Grid) -> list[tuple[int, ...]]:
-    """For every flat index, the flat indices of its free 4-neighbours (NORTH, EAST, SOUTH, WEST).
-
-    Blocked cells get an empty tuple.
-
-    >>> flat_neighbours(Grid.from_rows(["..", ".#"]))
-    [(2,), (), (3, 0), (2,)]
-    """
-    y_size = grid.y_size
-    result: list[tuple[int, ...]] = []
-    for x in range(grid.x_size):
-        for y in range(y_size):
-            if grid.is_free((x, y)):
-                result.append(tuple(nx * y_size + ny for nx, ny in grid.neighbours((x, y))))
-            else:
-                result.append(())
-    return result
-
-
-def tick_grid(grid: Grid) -> Grid:
-    """``grid`` itself when every cell costs 1 to enter, else a copy without costs.
-
-    Planners that count time in ticks (one move or wait per tick) rank cells by
-    the number of moves to the goal, whatever the entry costs.
-
-    >>> grid = Grid(2, 2, costs={(1, 1): 5.0})
-    >>> tick_grid(grid).has_costs, tick_grid(Grid(2, 2)) is not None
-    (False, True)
-    """
-    if not grid.has_costs:
-        return grid
-    return Grid(grid.x_size, grid.y_size, grid.blocked_cells(), name=grid.name)
-
-
-def distance_list(table: DistanceTable, unreachable: int) -> list[int]:
-    """A distance table as a flat list of ints, ``unreachable`` where it is infinite.
-
-    >>> distance_list(distance_table(Grid.from_rows([".#."]), (0, 0)), 99)
-    [0, 99, 99]
-    """
-    values = table.array.ravel()
-    result: list[int] = np.where(np.isfinite(values), values, unreachable).astype(np.int64).tolist()
-    return result
 
 
 class PIBT:
@@ -157,11 +85,11 @@ class PIBT:
     ----------
     neighbours:
         For every flat cell index, the indices of the cells one move away
-        (see :func:`flat_neighbours`).
+        (:attr:`~mrmp.search.flat_grid.FlatGrid.neighbours`).
     distances:
         For every robot, the distance (number of moves) from every flat cell to
-        its goal, a large number where the goal cannot be reached (see
-        :func:`distance_list`).
+        its goal, ``inf`` where the goal cannot be reached
+        (:meth:`~mrmp.search.distance.DistanceTable.as_list`).
     goals:
         Every robot's goal, as a flat index.
     swap:
@@ -230,7 +158,7 @@ class PIBT:
     def __init__(
         self,
         neighbours: Sequence[tuple[int, ...]],
-        distances: Sequence[Sequence[int]],
+        distances: Sequence[Sequence[float]],
         goals: Sequence[int],
         *,
         swap: bool = False,
@@ -573,28 +501,28 @@ def pibt_step(
         tables = [distance_table(plain, goal) for goal in goals]
     elif len(tables) != len(goals):
         raise ValueError(f"{len(tables)} distance tables for {len(goals)} goals")
-    unreachable = grid.x_size * grid.y_size
-    neighbours = flat_neighbours(grid)
-    current = [index_of(grid, cell) for cell in config]
+    flat = flat_grid(grid)
+    neighbours = flat.neighbours
+    current = [flat.index(cell) for cell in config]
     fixed: dict[int, int] = {}
     for robot, cell in (constraints or {}).items():
-        index = index_of(grid, cell)
+        index = flat.index(cell)
         if not 0 <= robot < len(config):
             raise ValueError(f"constraint on robot {robot}, which does not exist")
         if index != current[robot] and index not in neighbours[current[robot]]:
             raise ValueError(f"robot {robot} cannot reach {cell} from {config[robot]} in one move")
         fixed[robot] = index
     if priorities is None:
-        priorities = [min(table.distance(cell), unreachable) for table, cell in zip(tables, config)]
+        priorities = [min(table.distance(cell), flat.size) for table, cell in zip(tables, config)]
     elif len(priorities) != len(config):
         raise ValueError(f"{len(priorities)} priorities for {len(config)} robots")
     order = sorted(range(len(config)), key=lambda robot: -priorities[robot])
     pibt = PIBT(
         neighbours,
-        [distance_list(table, unreachable) for table in tables],
-        [index_of(grid, goal) for goal in goals],
+        [table.as_list() for table in tables],
+        [flat.index(goal) for goal in goals],
         swap=swap,
         rng=random.Random(seed) if seed is not None else None,
     )
     result = pibt.step(current, order, fixed)
-    return None if result is None else [cell_of(grid, index) for index in result]
+    return None if result is None else [flat.cell(index) for index in result]

@@ -53,6 +53,7 @@ __all__ = [
     "pad_paths",
     "path_cost",
     "plan_size_bytes",
+    "tick_grid",
 ]
 
 STATUSES = ("solved", "limit", "infeasible", "failed")
@@ -361,3 +362,18 @@ def as_problem(
         ids=tuple(str(robot_id) for robot_id in ids),
         headings=tuple(Heading.parse(h) if not isinstance(h, Heading) else h for h in headings),
     )
+
+
+def tick_grid(grid: Grid) -> Grid:
+    """``grid`` itself when every cell costs 1 to enter, else a copy without costs.
+
+    Planners that count time in ticks (one move or wait per tick) rank cells by
+    the number of moves to the goal, whatever the entry costs.
+
+    >>> grid = Grid(2, 2, costs={(1, 1): 5.0})
+    >>> tick_grid(grid).has_costs, tick_grid(Grid(2, 2)) is not None
+    (False, True)
+    """
+    if not grid.has_costs:
+        return grid
+    return Grid(grid.x_size, grid.y_size, grid.blocked_cells(), name=grid.name)

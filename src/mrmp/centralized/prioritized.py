@@ -66,6 +66,7 @@ from mrmp.centralized.plan import (
 )
 from mrmp.centralized.space_time_astar import (
     Reservations,
+    SpaceTimeResult,
     hop_distance_table,
     space_time_astar,
 )
@@ -172,60 +173,94 @@ def prioritized(
     """
     began = time.perf_counter()
     instance = as_problem(problem, starts, goals)
-    deadline = None if time_limit_s is None else began + time_limit_s
     proof = infeasibility_proof(instance)
     if proof is not None:
         return PlanningResult("infeasible", None, time.perf_counter() - began, "pp", message=proof)
-    ranking = priority_order(instance, order)
-    reservations = Reservations()
-    paths: list[tuple[Cell, ...] | None] = [None] * len(instance)
-    headings: list[tuple[Heading, ...] | None] = [None] * len(instance)
-    expansions = 0
+    planner = _Prioritized(instance, began, time_limit_s, max_time, heading_aware)
+    return planner.run(priority_order(instance, order))
 
-    def time_limit(when: str) -> PlanningResult:
-        message = f"time limit of {time_limit_s:g} s reached {when} robot {robot_id}"
-        return PlanningResult("limit", None, time.perf_counter() - began, "pp", nodes=expansions, message=message)
 
-    for rank, index in enumerate(ranking):
-        robot_id = instance.ids[index]
-        if deadline is not None and time.perf_counter() > deadline:
-            return time_limit("before planning")
+class _Prioritized:
+    """One run of prioritized planning: plan each robot in turn around the paths reserved before it."""
+
+    def __init__(
+        self, instance: MapfProblem, began: float, time_limit_s: float | None, max_time: int | None, heading_aware: bool
+    ) -> None:
+        self.instance = instance
+        self.began = began
+        self.time_limit_s = time_limit_s
+        self.deadline = None if time_limit_s is None else began + time_limit_s
+        self.max_time = max_time
+        self.heading_aware = heading_aware
+        self.reservations = Reservations()
+        self.paths: list[tuple[Cell, ...] | None] = [None] * len(instance)
+        self.headings: list[tuple[Heading, ...] | None] = [None] * len(instance)
+        self.expansions = 0
+
+    def run(self, ranking: Sequence[int]) -> PlanningResult:
+        """Plan the robots in ``ranking`` order; the first that cannot be planned ends the run."""
+        for rank, index in enumerate(ranking):
+            robot_id = self.instance.ids[index]
+            if self.deadline is not None and time.perf_counter() > self.deadline:
+                return self._time_limit("before planning", robot_id)
+            found = self._plan_robot(index)
+            if found.status == "deadline":
+                return self._time_limit("while planning", robot_id)
+            if not found.found or found.path is None:
+                return self._failed(ranking, rank, found)
+            self.paths[index] = found.path
+            self.headings[index] = found.headings
+            self.reservations.reserve_path(found.path)
+        return self._solved()
+
+    def _plan_robot(self, index: int) -> SpaceTimeResult:
+        """Space-time A* for robot ``index`` around the reservations so far."""
+        instance = self.instance
         found = space_time_astar(
             instance.grid,
             instance.starts[index],
             instance.goals[index],
-            reservations,
-            heading_aware=heading_aware,
+            self.reservations,
+            heading_aware=self.heading_aware,
             heading=instance.headings[index],
-            max_time=max_time,
-            deadline=deadline,
+            max_time=self.max_time,
+            deadline=self.deadline,
         )
-        expansions += found.expansions
-        if found.status == "deadline":
-            return time_limit("while planning")
-        if not found.found or found.path is None:
-            reason = "within the horizon" if found.status == "horizon" else "around the robots planned before it"
-            before = ", ".join(instance.ids[i] for i in ranking[:rank]) or "none"
-            return PlanningResult(
-                "failed",
-                None,
-                time.perf_counter() - began,
-                "pp",
-                nodes=expansions,
-                failed_robot=robot_id,
-                message=f"robot {robot_id} (priority {rank + 1} of {len(instance)}) has no path {reason} "
-                f"(planned before it: {before})",
-            )
-        paths[index] = found.path
-        headings[index] = found.headings
-        reservations.reserve_path(found.path)
-    done = [path for path in paths if path is not None]
-    return PlanningResult(
-        "solved",
-        pad_paths(done),
-        time.perf_counter() - began,
-        "pp",
-        nodes=expansions,
-        message=f"planned {len(done)} robots in priority order",
-        headings=pad_headings([row for row in headings if row is not None]) if heading_aware else None,
-    )
+        self.expansions += found.expansions
+        return found
+
+    def _elapsed(self) -> float:
+        return time.perf_counter() - self.began
+
+    def _time_limit(self, when: str, robot_id: str) -> PlanningResult:
+        message = f"time limit of {self.time_limit_s:g} s reached {when} robot {robot_id}"
+        return PlanningResult("limit", None, self._elapsed(), "pp", nodes=self.expansions, message=message)
+
+    def _failed(self, ranking: Sequence[int], rank: int, found: SpaceTimeResult) -> PlanningResult:
+        instance = self.instance
+        robot_id = instance.ids[ranking[rank]]
+        reason = "within the horizon" if found.status == "horizon" else "around the robots planned before it"
+        before = ", ".join(instance.ids[i] for i in ranking[:rank]) or "none"
+        return PlanningResult(
+            "failed",
+            None,
+            self._elapsed(),
+            "pp",
+            nodes=self.expansions,
+            failed_robot=robot_id,
+            message=f"robot {robot_id} (priority {rank + 1} of {len(instance)}) has no path {reason} "
+            f"(planned before it: {before})",
+        )
+
+    def _solved(self) -> PlanningResult:
+        done = [path for path in self.paths if path is not None]
+        headings = pad_headings([row for row in self.headings if row is not None]) if self.heading_aware else None
+        return PlanningResult(
+            "solved",
+            pad_paths(done),
+            self._elapsed(),
+            "pp",
+            nodes=self.expansions,
+            message=f"planned {len(done)} robots in priority order",
+            headings=headings,
+        )

@@ -77,6 +77,7 @@ from collections.abc import Iterable, Sequence
 from dataclasses import dataclass
 from functools import lru_cache
 
+from mrmp.centralized.plan import tick_grid
 from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
 from mrmp.core.heading import HEADINGS, Heading
@@ -281,20 +282,13 @@ class SpaceTimeResult:
         return len(self.path) - 1
 
 
-def _plain_grid(grid: Grid) -> Grid:
-    """The same grid with every entry cost 1 (planners count ticks)."""
-    if not grid.has_costs:
-        return grid
-    return Grid(grid.x_size, grid.y_size, grid.blocked_cells(), name=grid.name)
-
-
 def hop_distance_table(grid: Grid, goal: Cell) -> DistanceTable:
     """The number of moves from every cell to ``goal``, ignoring entry costs.
 
     >>> hop_distance_table(Grid(2, 2, costs={(0, 1): 9.0}), (0, 1)).distance((1, 0))
     2.0
     """
-    return distance_table(_plain_grid(grid), goal)
+    return distance_table(tick_grid(grid), goal)
 
 
 @lru_cache(maxsize=64)
@@ -414,115 +408,149 @@ def space_time_astar(
         raise ValueError(f"start {start} is not a free cell")
     if not grid.is_free(goal):
         raise ValueError(f"goal {goal} is not a free cell")
-    if reservations is None:
-        reservations = Reservations()
-    if heading_aware:
-        heading_table = heading_distance_table(grid, goal)
-
-        def estimate(cell: Cell, facing: int) -> float:
-            return heading_table.get((cell, Heading(facing)), math.inf)
-
-        start_facing = int(heading)
-    else:
-        hop_table = hop_distance_table(grid, goal)
-        hop = hop_table.distance
-
-        def estimate(cell: Cell, facing: int) -> float:
-            return hop(cell)
-
-        start_facing = 0
-
-    if goal in reservations.parked or reservations.blocks(start, 0) or estimate(start, start_facing) == math.inf:
+    search = _SpaceTimeSearch(grid, goal, reservations or Reservations(), avoid, heading_aware)
+    start_facing = int(heading) if heading_aware else 0
+    if search.hopeless(start, start_facing):
         return SpaceTimeResult("unreachable", None, None, 0)
+    return search.run(start, start_facing, max_time, deadline, max_expansions)
 
-    earliest_final = reservations.last_vertex_time(goal) + 1
-    static_from = max(reservations.last_time, avoid.last_time if avoid is not None else -1) + 1
 
-    vertex, edge, parked = reservations.vertex, reservations.edge, reservations.parked
-    entering, closes_rotation = reservations.entering, reservations.closes_rotation
-    if avoid is not None:
-        avoid_vertex, avoid_edge, avoid_parked = avoid.vertex, avoid.edge, avoid.parked
-        avoid_entering, avoid_closes_rotation = avoid.entering, avoid.closes_rotation
-    neighbours = grid.neighbours
-    inf = math.inf
+class _SpaceTimeSearch:
+    """One space-time A* search (the module docstring): its estimate, move rules and open list.
 
-    # state records: cell, facing, tick, parent index
-    cells: list[Cell] = [start]
-    facings: list[int] = [start_facing]
-    ticks: list[int] = [0]
-    parents: list[int] = [-1]
-    h0 = estimate(start, start_facing)
-    open_list: list[tuple[float, int, float, int]] = [(max(h0, earliest_final), 0, h0, 0)]
-    best: dict[tuple[Cell, int, int], tuple[int, int]] = {(start, start_facing, 0): (0, 0)}
-    closed: set[tuple[Cell, int, int]] = set()
-    expansions = 0
-    cut_by_horizon = False
-    pop, push = heapq.heappop, heapq.heappush
+    States are records ``(cell, facing, tick, parent)`` kept in parallel lists;
+    the open list holds ``(f, conflicts with avoid, h, record)``, where ``f``
+    is at least the first tick the goal may be kept for good.
+    """
 
-    while open_list:
-        _, conflicts, _, index = pop(open_list)
-        cell, facing, tick = cells[index], facings[index], ticks[index]
-        key = (cell, facing, min(static_from, tick))
-        if key in closed:
-            continue
-        closed.add(key)
-        expansions += 1
-        if cell == goal and tick >= earliest_final:
-            return _finish(cells, facings, parents, index, heading_aware, expansions)
-        if max_expansions is not None and expansions >= max_expansions:
-            return SpaceTimeResult("expansions", None, None, expansions)
-        if deadline is not None and expansions % _DEADLINE_CHECK_EVERY == 0 and time.perf_counter() > deadline:
-            return SpaceTimeResult("deadline", None, None, expansions)
-        next_tick = tick + 1
-        if max_time is not None and next_tick > max_time:
-            cut_by_horizon = True
-            continue
+    def __init__(
+        self, grid: Grid, goal: Cell, reservations: Reservations, avoid: Reservations | None, heading_aware: bool
+    ) -> None:
+        self.grid = grid
+        self.goal = goal
+        self.reservations = reservations
+        self.avoid = avoid
+        self.heading_aware = heading_aware
         if heading_aware:
+            heading_table = heading_distance_table(grid, goal)
+            self.estimate = lambda cell, facing: heading_table.get((cell, Heading(facing)), math.inf)
+        else:
+            hop = hop_distance_table(grid, goal).distance
+            self.estimate = lambda cell, facing: hop(cell)
+        self.earliest_final = reservations.last_vertex_time(goal) + 1
+        self.static_from = max(reservations.last_time, avoid.last_time if avoid is not None else -1) + 1
+        self.cells: list[Cell] = []
+        self.facings: list[int] = []
+        self.ticks: list[int] = []
+        self.parents: list[int] = []
+        self.open_list: list[tuple[float, int, float, int]] = []
+        self.best: dict[tuple[Cell, int, int], tuple[int, int]] = {}
+        self.closed: set[tuple[Cell, int, int]] = set()
+
+    def hopeless(self, start: Cell, facing: int) -> bool:
+        """Whether the search cannot succeed: the goal is parked on, the start taken, or the goal out of reach."""
+        reservations = self.reservations
+        return self.goal in reservations.parked or reservations.blocks(start, 0) or self.estimate(start, facing) == math.inf
+
+    def run(
+        self, start: Cell, facing: int, max_time: int | None, deadline: float | None, max_expansions: int | None
+    ) -> SpaceTimeResult:
+        """Expand states best first until the goal is kept for good, or a limit or the state space ends."""
+        h0 = self.estimate(start, facing)
+        self._record(start, facing, 0, -1)
+        self.open_list.append((max(h0, self.earliest_final), 0, h0, 0))
+        self.best[(start, facing, 0)] = (0, 0)
+        goal, earliest_final, static_from, closed = self.goal, self.earliest_final, self.static_from, self.closed
+        cells, facings, ticks, open_list = self.cells, self.facings, self.ticks, self.open_list
+        expansions = 0
+        cut_by_horizon = False
+        pop = heapq.heappop
+        while open_list:
+            _, conflicts, _, index = pop(open_list)
+            cell, facing, tick = cells[index], facings[index], ticks[index]
+            key = (cell, facing, min(static_from, tick))
+            if key in closed:
+                continue
+            closed.add(key)
+            expansions += 1
+            if cell == goal and tick >= earliest_final:
+                return _finish(cells, facings, self.parents, index, self.heading_aware, expansions)
+            if max_expansions is not None and expansions >= max_expansions:
+                return SpaceTimeResult("expansions", None, None, expansions)
+            if deadline is not None and expansions % _DEADLINE_CHECK_EVERY == 0 and time.perf_counter() > deadline:
+                return SpaceTimeResult("deadline", None, None, expansions)
+            if max_time is not None and tick + 1 > max_time:
+                cut_by_horizon = True
+                continue
+            self._expand(index, conflicts)
+        return SpaceTimeResult("horizon" if cut_by_horizon else "unreachable", None, None, expansions)
+
+    def _moves(self, cell: Cell, facing: int) -> list[tuple[Cell, int]]:
+        """The ``(cell, facing)`` pairs one tick can lead to: wait, (turn right,) move."""
+        if self.heading_aware:
             ahead = Heading(facing).ahead(cell)
             moves = [(cell, facing), (cell, facing % 4 + 1)]
-            if grid.is_free(ahead):
+            if self.grid.is_free(ahead):
                 moves.append((ahead, facing))
-        else:
-            moves = [(cell, 0)]
-            moves.extend((n, 0) for n in neighbours(cell))
-        next_key_tick = min(static_from, next_tick)
-        for next_cell, next_facing in moves:
-            if (next_cell, next_tick) in vertex or parked.get(next_cell, inf) <= next_tick:
+            return moves
+        moves = [(cell, 0)]
+        moves.extend((n, 0) for n in self.grid.neighbours(cell))
+        return moves
+
+    def _expand(self, index: int, conflicts: int) -> None:
+        """Offer every allowed successor of state ``index`` to the open list."""
+        cell, facing, next_tick = self.cells[index], self.facings[index], self.ticks[index] + 1
+        next_key_tick = min(self.static_from, next_tick)
+        closed, best, estimate, avoid = self.closed, self.best, self.estimate, self.avoid
+        for next_cell, next_facing in self._moves(cell, facing):
+            if _forbidden(self.reservations, cell, next_cell, next_tick):
                 continue
-            if next_cell != cell and (cell, next_cell, next_tick) in edge:
-                continue
-            if next_cell != cell and (cell, next_tick) in entering and closes_rotation(cell, next_cell, next_tick):
-                continue  # someone enters our cell as we leave it: no cycle of such moves
             next_key = (next_cell, next_facing, next_key_tick)
             if next_key in closed:
                 continue
             h = estimate(next_cell, next_facing)
-            if h == inf:
+            if h == math.inf:
                 continue
             next_conflicts = conflicts
             if avoid is not None:
-                if (next_cell, next_tick) in avoid_vertex or avoid_parked.get(next_cell, inf) <= next_tick:
-                    next_conflicts += 1
-                if next_cell != cell and (cell, next_cell, next_tick) in avoid_edge:
-                    next_conflicts += 1
-                if (
-                    next_cell != cell
-                    and (cell, next_tick) in avoid_entering
-                    and avoid_closes_rotation(cell, next_cell, next_tick)
-                ):
-                    next_conflicts += 1
+                next_conflicts += _conflicts(avoid, cell, next_cell, next_tick)
             rank = (next_tick, next_conflicts)
             previous = best.get(next_key)
             if previous is not None and previous <= rank:
                 continue
             best[next_key] = rank
-            cells.append(next_cell)
-            facings.append(next_facing)
-            ticks.append(next_tick)
-            parents.append(index)
-            f = next_tick + h
-            push(open_list, (max(earliest_final, f), next_conflicts, h, len(cells) - 1))
-    return SpaceTimeResult("horizon" if cut_by_horizon else "unreachable", None, None, expansions)
+            self._record(next_cell, next_facing, next_tick, index)
+            heapq.heappush(self.open_list, (max(self.earliest_final, next_tick + h), next_conflicts, h, len(self.cells) - 1))
+
+    def _record(self, cell: Cell, facing: int, tick: int, parent: int) -> None:
+        self.cells.append(cell)
+        self.facings.append(facing)
+        self.ticks.append(tick)
+        self.parents.append(parent)
+
+
+def _forbidden(reservations: Reservations, cell: Cell, next_cell: Cell, next_tick: int) -> bool:
+    """Whether ``reservations`` forbid the move ``cell -> next_cell`` arriving at ``next_tick``."""
+    if (next_cell, next_tick) in reservations.vertex or reservations.parked.get(next_cell, math.inf) <= next_tick:
+        return True
+    if next_cell == cell:
+        return False
+    if (cell, next_cell, next_tick) in reservations.edge:
+        return True
+    # someone enters our cell as we leave it: no cycle of such moves
+    return (cell, next_tick) in reservations.entering and reservations.closes_rotation(cell, next_cell, next_tick)
+
+
+def _conflicts(avoid: Reservations, cell: Cell, next_cell: Cell, next_tick: int) -> int:
+    """How many of ``avoid``'s reservations the move ``cell -> next_cell`` at ``next_tick`` collides with."""
+    count = 0
+    if (next_cell, next_tick) in avoid.vertex or avoid.parked.get(next_cell, math.inf) <= next_tick:
+        count += 1
+    if next_cell != cell and (cell, next_cell, next_tick) in avoid.edge:
+        count += 1
+    if next_cell != cell and (cell, next_tick) in avoid.entering and avoid.closes_rotation(cell, next_cell, next_tick):
+        count += 1
+    return count
 
 
 def _finish(

@@ -265,8 +265,7 @@ class PibtRobot:
             self.receive_beacons([message])  # type: ignore[list-item]
             return False
         if kind is ReserveMessage:
-            x, y = message.cell  # type: ignore[union-attr]
-            cell = x * self.flat.y_size + y
+            cell = self.flat.index(message.cell)  # type: ignore[union-attr]
             self._reserved[cell] = sender
             self._targets[sender] = cell
             return False
@@ -281,14 +280,12 @@ class PibtRobot:
         delivers: the simulator delivers the beacon round this way.
         """
         occupants, goals, settled = self._occupants, self._goals, self._settled
-        y_size = self.flat.y_size
+        index = self.flat.index
         for message in beacons:
             sender = message.sender
-            x, y = message.present
-            cell = x * y_size + y
+            cell = index(message.present)
             occupants[cell] = sender
-            x, y = message.goal
-            goal = goals[sender] = x * y_size + y
+            goal = goals[sender] = index(message.goal)
             if cell == goal:
                 settled.add(cell)
 

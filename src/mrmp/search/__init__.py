@@ -12,7 +12,10 @@ paths"). This layer provides them, all with one call shape
   :func:`astar` (Hart, Nilsson & Raphael 1968): one best-first engine
   (:mod:`mrmp.search.best_first_engine`) with three priority functions,
   optionally heading-aware (right turns cost time);
-* :func:`distance_table`: the cost from every cell to one goal.
+* :func:`distance_table`: the cost from every cell to one goal;
+* :class:`FlatGrid` (:mod:`mrmp.search.flat_grid`): the one flat form of a grid
+  (row-major cell numbers, neighbour tables, obstacle mask) that the tables,
+  the PIBTs and LaCAM index by, with one distance convention (:data:`UNREACHABLE`).
 
 :data:`PLANNERS` maps the names ``update_coordinate``, ``dijkstra``,
 ``best_first`` and ``astar`` to the planners.
@@ -36,6 +39,7 @@ from mrmp.search.best_first_engine import (
     best_first_search,
 )
 from mrmp.search.distance import DistanceTable, distance_table
+from mrmp.search.flat_grid import UNREACHABLE, FlatGrid, flat_grid
 from mrmp.search.graph import GridMap, Planner, SizedGridMap, path_cost, path_headings
 from mrmp.search.planners import PLANNERS, astar, dijkstra, greedy_best_first
 from mrmp.search.result import SearchResult
@@ -46,7 +50,9 @@ __all__ = [
     "DIJKSTRA",
     "GREEDY_BEST_FIRST",
     "PLANNERS",
+    "UNREACHABLE",
     "DistanceTable",
+    "FlatGrid",
     "GridMap",
     "Planner",
     "PriorityFunction",
@@ -57,6 +63,7 @@ __all__ = [
     "best_first_search",
     "dijkstra",
     "distance_table",
+    "flat_grid",
     "greedy_best_first",
     "path_cost",
     "path_headings",

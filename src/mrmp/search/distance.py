@@ -17,8 +17,10 @@ Entering cell ``c`` costs ``cost(c)``, so the forward move ``v -> u`` costs
 is offered ``distance(u) + cost(u)``. The distance of the goal is 0 and its own
 cost never counts.
 
-**Speed.** Each grid is converted once (and cached) to flat indices with
-precomputed reverse-neighbour tuples and a reverse-neighbour index array. The
+**Speed.** Each grid is converted once (and cached) to its flat form
+(:mod:`mrmp.search.flat_grid`, whose distance convention the tables follow:
+``inf`` where the goal cannot be reached), with precomputed reverse-neighbour
+tuples and a reverse-neighbour index array. The
 search runs wavefront by wavefront: a small wavefront is expanded in a plain
 Python loop over the tuples, a large one (more than ``_VECTOR_THRESHOLD``
 cells) with a few numpy operations on the index array (gather the neighbours,
@@ -54,6 +56,7 @@ import numpy.typing as npt
 from mrmp.core.cell import Cell
 from mrmp.core.errors import NoPathError
 from mrmp.core.grid import Grid
+from mrmp.search.flat_grid import UNREACHABLE, FlatGrid, flat_grid
 from mrmp.search.graph import SizedGridMap
 
 __all__ = ["DistanceTable", "distance_table"]
@@ -68,52 +71,34 @@ _TABLE_CACHE_CELLS = 1 << 21
 IndexArray = npt.NDArray[np.intp]
 
 
-class _FlatGrid:
-    """A grid as flat indices ``x * y_size + y``, with reverse adjacency, built once.
+class _ReverseSearch:
+    """A grid's flat form (:class:`~mrmp.search.flat_grid.FlatGrid`) with what the reverse searches need, built once.
 
     ``reverse[u]`` lists the cells ``v`` with a move ``v -> u``;
     ``reverse_array`` holds the same rows padded with the sentinel index
-    ``size`` (one past the last cell).
+    ``size`` (one past the last cell); the rows ``*_row`` and ``zero_marks``
+    are the initial contents of each search's scratch arrays; ``tables``
+    caches the tables already computed, per goal.
     """
 
-    def __init__(self, grid: SizedGridMap) -> None:
-        x_size, y_size = grid.x_size, grid.y_size
-        size = x_size * y_size
-        self.x_size = x_size
-        self.y_size = y_size
+    def __init__(self, flat: FlatGrid) -> None:
+        size = flat.size
+        self.flat = flat
         self.size = size
-        forward: list[tuple[int, ...]] = []
-        costs: list[float] = []
-        free_costs: set[float] = set()
-        for x in range(x_size):
-            for y in range(y_size):
-                cell = (x, y)
-                if grid.is_free(cell):
-                    forward.append(
-                        tuple(nx * y_size + ny for nx, ny in grid.neighbours(cell) if 0 <= nx < x_size and 0 <= ny < y_size)
-                    )
-                    cost = float(grid.cost(cell))
-                    costs.append(cost)
-                    free_costs.add(cost)
-                else:
-                    forward.append(())
-                    costs.append(1.0)
         reverse_lists: list[list[int]] = [[] for _ in range(size)]
-        for v, targets in enumerate(forward):
+        for v, targets in enumerate(flat.neighbours):
             for u in targets:
                 reverse_lists[u].append(v)
-        self.forward = forward
         self.reverse = [tuple(row) for row in reverse_lists]
-        self.costs = costs
-        self.cost_array = np.array([*costs, 0.0])
-        self.uniform_cost: float | None = next(iter(free_costs)) if len(free_costs) == 1 else None
+        self.costs = flat.costs
+        self.cost_array = np.array([*flat.costs, 0.0])
         width = max((len(row) for row in self.reverse), default=0) or 1
         reverse_array = np.full((size + 1, width), size, dtype=np.intp)
         for u, row in enumerate(self.reverse):
             reverse_array[u, : len(row)] = row
         self.reverse_array = reverse_array
         self.ranks: IndexArray = np.arange((size + 1) * width, dtype=np.intp)
-        self.inf_row = array("d", [math.inf]) * (size + 1)
+        self.inf_row = array("d", [UNREACHABLE]) * (size + 1)
         self.unseen_row = bytearray(b"\x01") * size + b"\x00"
         self.zero_marks = array("q", [0]) * (size + 1)
         self.tables: OrderedDict[int, DistanceTable] = OrderedDict()
@@ -133,11 +118,11 @@ def _dedupe(cells: IndexArray, owner: IndexArray, ranks: IndexArray) -> IndexArr
     return unique
 
 
-def _breadth_first(flat: _FlatGrid, goal: int, step: float) -> array[float]:
+def _breadth_first(search: _ReverseSearch, goal: int, step: float) -> array[float]:
     """Distances to ``goal`` when entering any free cell costs ``step`` (hybrid wavefront BFS)."""
-    reverse, reverse_array, ranks = flat.reverse, flat.reverse_array, flat.ranks
-    dist = array("d", flat.inf_row)
-    unseen = bytearray(flat.unseen_row)
+    reverse, reverse_array, ranks = search.reverse, search.reverse_array, search.ranks
+    dist = array("d", search.inf_row)
+    unseen = bytearray(search.unseen_row)
     view = np.frombuffer(dist, dtype=np.float64)
     unseen_view = np.frombuffer(unseen, dtype=np.bool_)
     owner: IndexArray | None = None
@@ -165,7 +150,7 @@ def _breadth_first(flat: _FlatGrid, goal: int, step: float) -> array[float]:
             if not candidates.size:
                 break
             if owner is None:
-                owner = np.empty(flat.size + 1, dtype=np.intp)
+                owner = np.empty(search.size + 1, dtype=np.intp)
             candidates = _dedupe(candidates, owner, ranks)
             unseen_view[candidates] = False
             view[candidates] = d
@@ -173,15 +158,15 @@ def _breadth_first(flat: _FlatGrid, goal: int, step: float) -> array[float]:
     return dist
 
 
-def _label_correcting(flat: _FlatGrid, goal: int) -> array[float]:
+def _label_correcting(search: _ReverseSearch, goal: int) -> array[float]:
     """Distances to ``goal`` with per-cell entry costs (hybrid wavefront Bellman-Ford-Moore)."""
-    reverse, reverse_array, ranks = flat.reverse, flat.reverse_array, flat.ranks
-    costs, cost_array = flat.costs, flat.cost_array
+    reverse, reverse_array, ranks = search.reverse, search.reverse_array, search.ranks
+    costs, cost_array = search.costs, search.cost_array
     width = reverse_array.shape[1]
-    dist = array("d", flat.inf_row)
-    dist[flat.size] = -math.inf  # the padding index is never improved
+    dist = array("d", search.inf_row)
+    dist[search.size] = -math.inf  # the padding index is never improved
     view = np.frombuffer(dist, dtype=np.float64)
-    marks = array("q", flat.zero_marks)  # the round in which a cell was last queued
+    marks = array("q", search.zero_marks)  # the round in which a cell was last queued
     owner: IndexArray | None = None
     dist[goal] = 0.0
     frontier: list[int] | IndexArray = [goal]
@@ -211,10 +196,10 @@ def _label_correcting(flat: _FlatGrid, goal: int) -> array[float]:
                 break
             np.minimum.at(view, candidates, offers[better])
             if owner is None:
-                owner = np.empty(flat.size + 1, dtype=np.intp)
+                owner = np.empty(search.size + 1, dtype=np.intp)
             candidates = _dedupe(candidates, owner, ranks)
             frontier = candidates if candidates.size > _VECTOR_THRESHOLD else candidates.tolist()
-    dist[flat.size] = math.inf
+    dist[search.size] = math.inf
     return dist
 
 
@@ -244,7 +229,7 @@ class DistanceTable:
 
     __slots__ = ("_dist", "_flat", "array", "goal")
 
-    def __init__(self, flat: _FlatGrid, goal: Cell, dist: array[float]) -> None:
+    def __init__(self, flat: FlatGrid, goal: Cell, dist: array[float]) -> None:
         self.goal = goal
         self._flat = flat
         self._dist = dist
@@ -261,12 +246,6 @@ class DistanceTable:
         (4, 2)
         """
         return (self._flat.x_size, self._flat.y_size)
-
-    def _index(self, cell: Cell) -> int | None:
-        x, y = cell
-        if 0 <= x < self._flat.x_size and 0 <= y < self._flat.y_size:
-            return x * self._flat.y_size + y
-        return None
 
     def distance(self, cell: Cell) -> float:
         """The cost of a cheapest path from ``cell`` to the goal.
@@ -290,8 +269,8 @@ class DistanceTable:
         >>> table.distance((0, 0)), table.distance((0, 1)), table.distance((9, 9))
         (4.0, 1.0, inf)
         """
-        index = self._index(cell)
-        return math.inf if index is None else self._dist[index]
+        index = self._flat.index_on_grid(cell)
+        return UNREACHABLE if index is None else self._dist[index]
 
     def reachable(self, cell: Cell) -> bool:
         """Whether the goal can be reached from ``cell``.
@@ -301,7 +280,7 @@ class DistanceTable:
         >>> table.reachable((0, 0)), table.reachable((0, 2))
         (True, False)
         """
-        return self.distance(cell) < math.inf
+        return self.distance(cell) < UNREACHABLE
 
     def next_cells(self, cell: Cell) -> list[Cell]:
         """The neighbours of ``cell`` that lead to the goal, best first.
@@ -330,17 +309,26 @@ class DistanceTable:
         >>> table.next_cells((1, 1))
         [(2, 1), (0, 1), (1, 0), (1, 2)]
         """
-        index = self._index(cell)
-        if index is None or self._dist[index] == math.inf:
-            return []
         flat, dist = self._flat, self._dist
+        index = flat.index_on_grid(cell)
+        if index is None or dist[index] == UNREACHABLE:
+            return []
         ranked = sorted(
             (flat.costs[n] + dist[n], position, n)
-            for position, n in enumerate(flat.forward[index])
-            if dist[n] < math.inf
+            for position, n in enumerate(flat.neighbours[index])
+            if dist[n] < UNREACHABLE
         )
-        y_size = flat.y_size
-        return [(n // y_size, n % y_size) for _, _, n in ranked]
+        cells = flat.cells
+        return [cells[n] for _, _, n in ranked]
+
+    def as_list(self) -> list[float]:
+        """The distances as a list indexed by flat cell (:mod:`mrmp.search.flat_grid`), ``inf`` where unreachable.
+
+        >>> from mrmp.core.grid import Grid
+        >>> distance_table(Grid.from_rows([".#."]), (0, 0)).as_list()
+        [0.0, inf, inf]
+        """
+        return self._dist[: self._flat.size].tolist()
 
     def path(self, cell: Cell) -> tuple[Cell, ...]:
         """A cheapest path from ``cell`` to the goal, following :meth:`next_cells`.
@@ -379,30 +367,28 @@ class DistanceTable:
         return f"<DistanceTable to {self.goal} on {self._flat.x_size}x{self._flat.y_size}>"
 
 
-_GRIDS: OrderedDict[Any, _FlatGrid] = OrderedDict()
+_GRIDS: OrderedDict[Any, _ReverseSearch] = OrderedDict()
 _GRIDS_LOCK = threading.Lock()
 
 
-def _flat_grid(grid: SizedGridMap, cache: bool) -> _FlatGrid:
-    """The flat form of ``grid``, from the cache when allowed."""
+def _reverse_search(grid: SizedGridMap, cache: bool) -> _ReverseSearch:
+    """The reverse-search form of ``grid``, from the cache when allowed."""
     if not cache:
-        return _FlatGrid(grid)
+        return _ReverseSearch(FlatGrid(grid))
     try:
         with _GRIDS_LOCK:
-            flat = _GRIDS.get(grid)
-            if flat is not None:
+            search = _GRIDS.get(grid)
+            if search is not None:
                 _GRIDS.move_to_end(grid)
-                return flat
+                return search
     except TypeError:  # unhashable grid
-        return _FlatGrid(grid)
-    flat = _FlatGrid(grid)
+        return _ReverseSearch(FlatGrid(grid))
+    search = _ReverseSearch(flat_grid(grid, cache=True))
     with _GRIDS_LOCK:
-        _GRIDS[grid] = flat
+        _GRIDS[grid] = search
         while len(_GRIDS) > _GRID_CACHE_SIZE:
-            _, evicted = _GRIDS.popitem(last=False)
-            with evicted.lock:  # its tables point back at it: break the cycle, so it is freed at once
-                evicted.tables.clear()
-    return flat
+            _GRIDS.popitem(last=False)
+    return search
 
 
 def distance_table(grid: SizedGridMap, goal: Cell, *, cache: bool | None = None) -> DistanceTable:
@@ -450,22 +436,21 @@ def distance_table(grid: SizedGridMap, goal: Cell, *, cache: bool | None = None)
         cache = isinstance(grid, Grid)
     if not grid.is_free(goal):
         raise NoPathError(f"goal {goal} is not a free cell")
-    flat = _flat_grid(grid, cache)
-    index = goal[0] * flat.y_size + goal[1]
+    search = _reverse_search(grid, cache)
+    flat = search.flat
+    index = flat.index(goal)
     if cache:
-        with flat.lock:
-            table = flat.tables.get(index)
+        with search.lock:
+            table = search.tables.get(index)
             if table is not None:
-                flat.tables.move_to_end(index)
+                search.tables.move_to_end(index)
                 return table
-    if flat.uniform_cost is not None:
-        dist = _breadth_first(flat, index, flat.uniform_cost)
-    else:
-        dist = _label_correcting(flat, index)
+    step = flat.uniform_cost
+    dist = _label_correcting(search, index) if step is None else _breadth_first(search, index, step)
     table = DistanceTable(flat, goal, dist)
     if cache:
-        with flat.lock:
-            flat.tables[index] = table
-            while len(flat.tables) > flat.table_limit:
-                flat.tables.popitem(last=False)
+        with search.lock:
+            search.tables[index] = table
+            while len(search.tables) > search.table_limit:
+                search.tables.popitem(last=False)
     return table

@@ -1,12 +1,15 @@
-"""A grid in flat form, with cached distance lists: what PIBT works on.
+"""A grid's flat form with cached distance lists: what PIBT works on.
 
-Cells are flat indices ``x * y_size + y``; ``neighbours[i]`` lists the free
-4-neighbours of cell ``i`` (NORTH, EAST, SOUTH, WEST). :meth:`FlatMap.distances`
-gives, for one goal, the cost of reaching it from every flat cell (entry costs
-respected: breadth-first search, or label-correcting search with costs, see
-:mod:`mrmp.search.distance`), as a plain list for fast indexing, computed
-once per goal and kept; :meth:`FlatMap.heading_distances` does the same for the
-heading-aware tables (turns cost time). The time spent computing them is counted in
+A :class:`FlatMap` is a :class:`~mrmp.search.flat_grid.FlatGrid` (cells are
+flat indices ``x * y_size + y``; ``neighbours[i]`` lists the free 4-neighbours
+of cell ``i``, NORTH, EAST, SOUTH, WEST) that also keeps distance lists.
+:meth:`FlatMap.distances` gives, for one goal, the cost of reaching it from
+every flat cell (entry costs respected: breadth-first search, or
+label-correcting search with costs, see :mod:`mrmp.search.distance`), as a
+plain list for fast indexing in the flat grid's distance convention (``inf``
+where the goal cannot be reached), computed once per goal and kept;
+:meth:`FlatMap.heading_distances` does the same for the heading-aware tables
+(turns cost time). The time spent computing them is counted in
 :attr:`FlatMap.table_seconds`.
 
 A table is a pure function of the map and the goal, so a fleet simulated in one
@@ -31,54 +34,40 @@ from __future__ import annotations
 
 import time
 
-from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
 from mrmp.search.distance import distance_table
+from mrmp.search.flat_grid import FlatGrid
 from mrmp.search.heading_distance import heading_distances
 
 __all__ = ["FlatMap"]
 
 
-class FlatMap:
-    """A grid's flat form and its distance lists, computed on demand (module docstring)."""
+class FlatMap(FlatGrid):
+    """A grid's flat form and its distance lists, computed on demand (module docstring).
 
-    __slots__ = ("_heading_tables", "_tables", "cells", "entry_costs", "grid", "neighbours", "table_seconds", "y_size")
+    ``entry_costs`` is :attr:`~mrmp.search.flat_grid.FlatGrid.costs`, or
+    ``None`` when every cell costs 1 (the plain grids of the thesis).
+    """
+
+    __slots__ = ("_heading_tables", "_tables", "entry_costs", "grid", "table_seconds")
 
     def __init__(self, grid: Grid) -> None:
+        super().__init__(grid)
         self.grid = grid
-        self.y_size = grid.y_size
-        y_size = grid.y_size
-        self.neighbours: list[tuple[int, ...]] = [
-            tuple(nx * y_size + ny for nx, ny in grid.neighbours((x, y))) if grid.is_free((x, y)) else ()
-            for x in range(grid.x_size)
-            for y in range(y_size)
-        ]
-        # the cell of every flat index (``cells[i] == cell(i)``), for lookups in hot loops
-        self.cells: list[Cell] = [(x, y) for x in range(grid.x_size) for y in range(y_size)]
-        # the entry cost of every flat cell, or None when every cell costs 1
-        self.entry_costs: list[float] | None = [grid.cost(cell) for cell in self.cells] if grid.costs() else None
+        self.entry_costs: list[float] | None = self.costs if grid.has_costs else None
         self._tables: dict[int, list[float]] = {}
         self._heading_tables: dict[tuple[int, float], list[float]] = {}
         self.table_seconds = 0.0
-
-    def index(self, cell: Cell) -> int:
-        """The flat index of ``cell``."""
-        return cell[0] * self.y_size + cell[1]
-
-    def cell(self, index: int) -> Cell:
-        """The cell of flat index ``index``."""
-        return self.cells[index]
 
     def distances(self, goal: int) -> list[float]:
         """For every flat cell, the cost to reach the flat cell ``goal`` (``inf`` where it cannot)."""
         table = self._tables.get(goal)
         if table is None:
             started = time.perf_counter()
-            table = distance_table(self.grid, self.cell(goal)).array.ravel().tolist()
+            table = distance_table(self.grid, self.cell(goal)).as_list()
             self.table_seconds += time.perf_counter() - started
             self._tables[goal] = table
         return table
-
     def heading_distances(self, goal: int, turn_cost: float) -> list[float]:
         """For every state (flat cell ``i``, heading ``h``), at ``4 * i + h - 1``, the heading-aware
         cost to reach the flat cell ``goal`` when a right turn costs ``turn_cost``

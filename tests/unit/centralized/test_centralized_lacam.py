@@ -22,14 +22,7 @@ from test_centralized_support import moves_round_a_cycle
 
 from mrmp.centralized.dependencies import find_rotations
 from mrmp.centralized.lacam import lacam
-from mrmp.centralized.pibt_step import (
-    NO_CELL,
-    PIBT,
-    distance_list,
-    flat_neighbours,
-    index_of,
-    pibt_step,
-)
+from mrmp.centralized.pibt_step import NO_CELL, PIBT, pibt_step
 from mrmp.centralized.plan import PlanningResult
 from mrmp.core.cell import Cell
 from mrmp.core.errors import InputError
@@ -37,6 +30,7 @@ from mrmp.core.grid import Grid
 from mrmp.core.scenario import RobotSpec, Scenario
 from mrmp.io.scenario_file import load_movingai_scenario
 from mrmp.search.distance import distance_table
+from mrmp.search.flat_grid import flat_grid
 from mrmp.sim.referee import check_paths
 
 MAPS = Path(__file__).resolve().parents[3] / "maps"
@@ -318,11 +312,11 @@ def flat_pibt(
     grid: Grid, goals: list[Cell], swap: bool = False, rotations: bool = False, rng: random.Random | None = None
 ) -> PIBT:
     """A PIBT generator over the flat cells of ``grid`` for ``goals`` (rotation-free unless ``rotations``)."""
-    size = grid.x_size * grid.y_size
+    flat = flat_grid(grid)
     return PIBT(
-        flat_neighbours(grid),
-        [distance_list(distance_table(grid, goal), size) for goal in goals],
-        [index_of(grid, goal) for goal in goals],
+        flat.neighbours,
+        [distance_table(grid, goal).as_list() for goal in goals],
+        [flat.index(goal) for goal in goals],
         swap=swap,
         rng=rng,
         rotations=rotations,
@@ -333,15 +327,15 @@ def test_pibt_without_rotations_refuses_the_cycle():
     grid = Grid(2, 2)
     cells = [(0, 0), (0, 1), (1, 1), (1, 0)]
     goals = [cells[(i + 1) % 4] for i in range(4)]
-    current = [index_of(grid, cell) for cell in cells]
+    current = [flat_grid(grid).index(cell) for cell in cells]
     pibt = flat_pibt(grid, goals)
     assert pibt.step(current, [0, 1, 2, 3]) == current  # the last robot may not close the cycle: all stay
-    rotation = {robot: index_of(grid, goal) for robot, goal in enumerate(goals)}
+    rotation = {robot: flat_grid(grid).index(goal) for robot, goal in enumerate(goals)}
     assert pibt.step(current, [0, 1, 2, 3], rotation) is None  # constraints forming a rotation fail
     assert pibt.clean
     # three robots: each follows the next into the free cell, a chain, not a cycle
     three = flat_pibt(grid, goals[:3])
-    assert three.step(current[:3], [0, 1, 2]) == [index_of(grid, goal) for goal in goals[:3]]
+    assert three.step(current[:3], [0, 1, 2]) == [flat_grid(grid).index(goal) for goal in goals[:3]]
 
 
 def test_swap_technique_lets_robots_pass_in_a_dead_end_corridor():
@@ -392,7 +386,7 @@ def pibt_cases(draw: st.DrawFn):
 
 def flat_start(grid: Grid, config: list[Cell], priorities: list[float]) -> tuple[list[int], list[int]]:
     """A case's configuration as flat cells, and its robots from the highest priority down."""
-    return [index_of(grid, cell) for cell in config], sorted(range(len(config)), key=lambda robot: -priorities[robot])
+    return [flat_grid(grid).index(cell) for cell in config], sorted(range(len(config)), key=lambda robot: -priorities[robot])
 
 
 @settings(max_examples=300, derandomize=True, deadline=None)
@@ -423,7 +417,7 @@ def test_pibt_generator_leaves_no_trace_between_calls(case, swap):
     current, order = flat_start(grid, config, priorities)
     target = [NO_CELL] * len(config)
     for robot, cell in constraints.items():
-        target[robot] = index_of(grid, cell)
+        target[robot] = flat_grid(grid).index(cell)
     pibt.generate(current, target, order)
     assert pibt.clean
     assert pibt.step(current, order) is not None
@@ -438,7 +432,7 @@ def test_pibt_without_rotations_is_rotation_free_and_respects_constraints(case, 
         return
     pibt = flat_pibt(grid, goals, swap=swap, rng=random.Random(seed) if seed is not None else None)
     current, order = flat_start(grid, config, priorities)
-    fixed = {robot: index_of(grid, cell) for robot, cell in constraints.items()}
+    fixed = {robot: flat_grid(grid).index(cell) for robot, cell in constraints.items()}
     result = pibt.step(current, order, fixed)
     assert pibt.clean
     if not constraints:
