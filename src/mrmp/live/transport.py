@@ -10,7 +10,11 @@ protocol layer's job (:mod:`mrmp.protocol.auth`). Three implementations:
 * ``ZenohTransport`` in :mod:`mrmp.live.zenoh_transport`.
 
 :class:`FaultyTransport` wraps any of them to inject loss, delay, duplication
-and reordering into a live run.
+and reordering into a live run. A transport whose peers must connect before
+they can be reached says so by being a :class:`ConnectedTransport`.
+
+Each of them is one entry of :data:`mrmp.live.transport_table.TRANSPORTS`,
+which says how to configure, open and launch it.
 """
 
 from __future__ import annotations
@@ -23,7 +27,7 @@ import threading
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Protocol, runtime_checkable
 
 from mrmp.core.faults import message_fates
 from mrmp.protocol.auth import MAX_DATAGRAM_BYTES
@@ -44,6 +48,19 @@ class Transport(Protocol):
 
     def close(self) -> None:
         """Release the transport's sockets; ``receive`` then returns None."""
+        ...
+
+
+@runtime_checkable
+class ConnectedTransport(Transport, Protocol):
+    """A transport whose peers connect before datagrams reach them (Zenoh): it can wait for them.
+
+    Connectionless transports (UDP, multicast) are not: a datagram sent to a
+    peer that is up reaches it.
+    """
+
+    def wait_for_peers(self, count: int, timeout: float) -> bool:
+        """Wait until ``count`` other robots are connected, for at most ``timeout`` seconds; whether they are."""
         ...
 
 
@@ -136,7 +153,6 @@ class UdpTransport(_UdpSocket):
                 pass  # an unreachable peer is a lost datagram, as on any network
 
 
-
 class UdpMulticastTransport(_UdpSocket):
     """UDP multicast: every robot joins one group; every datagram goes to all of them.
 
@@ -176,7 +192,6 @@ class UdpMulticastTransport(_UdpSocket):
             self._socket.sendto(data, self.group)
         except OSError:
             pass
-
 
 
 @dataclass(frozen=True)
