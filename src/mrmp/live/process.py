@@ -15,7 +15,7 @@ import sys
 import threading
 import time
 from collections.abc import Callable
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from pathlib import Path
 
 from mrmp.core.errors import InputError, Problem
@@ -47,18 +47,18 @@ def check_key_policy(key: bytes | None, spec: TransportSpec, warn: Callable[[str
     >>> check_key_policy(None, TransportSpec("udp", UdpOptions(("127.0.0.1", 9001))), warn=print)
     WARNING: no fleet key: messages are NOT authenticated; allowed on loopback only
     b''
-    >>> check_key_policy(None, TransportSpec("udp", UdpOptions(("10.0.0.1", 9001))), warn=print)
+    >>> check_key_policy(None, TransportSpec("udp", UdpOptions(("10.0.0.1", 9001))), warn=print)  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
-    mrmp.core.errors.InputError: --key-file: no fleet key: refusing to talk to 10.0.0.1 (only loopback runs may go without a key; set MRMP_FLEET_KEY or --key-file)
+    mrmp.core.errors.InputError: --key-file: no fleet key: refusing to talk to 10.0.0.1 (only loopback runs may go ...)
     """
     if key:
         return key
     outside = [host for host in spec.hosts() if host and not is_loopback(host)]
     if outside:
-        raise InputError(
-            Problem("--key-file", f"no fleet key: refusing to talk to {', '.join(sorted(set(outside)))} (only loopback runs may go without a key; set MRMP_FLEET_KEY or --key-file)")
-        )
+        hosts = ", ".join(sorted(set(outside)))
+        only = "only loopback runs may go without a key; set MRMP_FLEET_KEY or --key-file"
+        raise InputError(Problem("--key-file", f"no fleet key: refusing to talk to {hosts} ({only})"))
     warn("WARNING: no fleet key: messages are NOT authenticated; allowed on loopback only")
     return b""
 
@@ -87,12 +87,12 @@ class AgentOptions:
     session: int
     results: Path
     time_scale: float = 1.0
-    faults: LiveFaults = LiveFaults()
+    faults: LiveFaults = field(default_factory=LiveFaults)
     jitter: float = 0.0
     miss_line: float = 0.0
     guarded: bool = True
     seed: int = 0
-    timing: AgentTiming = AgentTiming()
+    timing: AgentTiming = field(default_factory=AgentTiming)
     plan: Path | None = None
     """This robot's share of a central plan (``mrmp.io.plans.write_share``)."""
 
@@ -161,7 +161,8 @@ def run_referee(scenario: Scenario, results: Path, start_time: float, done_file:
     """
     stop = threading.Event()
     _on_stop_signals(stop.set)
-    referee = IntervalReferee(scenario.grid, [robot.id for robot in scenario.robots], [robot.start for robot in scenario.robots], start_time)
+    ids, starts = [robot.id for robot in scenario.robots], [robot.start for robot in scenario.robots]
+    referee = IntervalReferee(scenario.grid, ids, starts, start_time)
     readers = [TraceReader(results / f"trace-{index}.jsonl") for index in range(len(scenario.robots))]
     reported = 0
     finishing = False

@@ -19,6 +19,7 @@ which says how to configure, open and launch it.
 
 from __future__ import annotations
 
+import contextlib
 import heapq
 import random
 import socket
@@ -115,10 +116,8 @@ class _UdpSocket:
     def close(self) -> None:
         """Close the socket, waking a ``receive`` blocked in another thread; ``receive`` returns None from now on."""
         self._closed = True
-        try:
+        with contextlib.suppress(OSError):
             self._socket.shutdown(socket.SHUT_RDWR)  # wakes a blocked recvfrom on Linux
-        except OSError:
-            pass
         self._socket.close()
 
 
@@ -147,10 +146,8 @@ class UdpTransport(_UdpSocket):
             address = self.peers.get(recipient)
             targets = [address] if address is not None else []  # no address: lost, as on any network
         for address in targets:
-            try:
+            with contextlib.suppress(OSError):  # an unreachable peer is a lost datagram, as on any network
                 self._socket.sendto(data, address)
-            except OSError:
-                pass  # an unreachable peer is a lost datagram, as on any network
 
 
 class UdpMulticastTransport(_UdpSocket):
@@ -188,10 +185,8 @@ class UdpMulticastTransport(_UdpSocket):
         self._closed = False
 
     def send(self, data: bytes, recipient: int | None = None) -> None:
-        try:
+        with contextlib.suppress(OSError):
             self._socket.sendto(data, self.group)
-        except OSError:
-            pass
 
 
 @dataclass(frozen=True)
