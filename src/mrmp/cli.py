@@ -20,6 +20,7 @@ from mrmp.core.errors import InputError, MrmpError, Problem
 from mrmp.core.result import RunResult
 from mrmp.core.scenario import RESOLUTIONS, NetworkFaults, PolicyOptions, Scenario, scenario_problems
 from mrmp.io import load_movingai_scenario, load_scenario, validate_file, write_result_json
+from mrmp.live.transport_table import TRANSPORTS
 from mrmp.policies.registry import ASYNC_POLICIES, POLICY_NAMES, ROUND_POLICIES
 from mrmp.sim.simulator import TickObserver, simulate
 
@@ -294,7 +295,7 @@ def run(
     planner: Annotated[Optional[str], typer.Option(help="Plan centrally first (cbs, pp, lacam), then execute the plan.")] = None,
     time_limit: Annotated[float, typer.Option(help="Seconds a central planner may spend.")] = 30.0,
     live: Annotated[bool, typer.Option("--live", help="One OS process per robot, in real time, over a loopback network.")] = False,
-    transport: Annotated[str, typer.Option(help="Live transport: udp, multicast or zenoh.")] = "udp",
+    transport: Annotated[str, typer.Option(help=f"Live transport: {TRANSPORTS.listed()}.")] = "udp",
     time_scale: Annotated[float, typer.Option(help="Live: run this many times faster than the robots' real speed.")] = 1.0,
     delay_ms: Annotated[Optional[str], typer.Option(help="Live: message delay in milliseconds, N or A..B.")] = None,
     jitter: Annotated[float, typer.Option(help="Live: each move takes its time times 1 +- jitter.")] = 0.0,
@@ -594,7 +595,7 @@ def validate(
 def agent(
     scenario_path: Annotated[Path, typer.Option("--scenario", help="The fleet's scenario (the same file on every robot).")],
     robot: Annotated[str, typer.Option(help="Which robot of the scenario this process is (its id).")],
-    transport: Annotated[str, typer.Option(help="udp, multicast or zenoh.")] = "udp",
+    transport: Annotated[str, typer.Option(help=f"{TRANSPORTS.listed()}.")] = "udp",
     bind: Annotated[str, typer.Option(help="UDP: address to receive on, HOST:PORT.")] = "127.0.0.1:9001",
     peer: Annotated[Optional[list[str]], typer.Option(help="UDP: a peer, ID=HOST:PORT (repeat for each).")] = None,
     group: Annotated[str, typer.Option(help="Multicast: group HOST:PORT.")] = "239.255.77.1:47000",
@@ -623,8 +624,8 @@ def agent(
 
     from mrmp.io.live_files import read_key_file
     from mrmp.live.agent import AgentTiming
-    from mrmp.live.process import AgentOptions, TransportSpec, check_key_policy, die_with_parent, run_agent, warn
-    from mrmp.live.transport import LiveFaults, parse_address
+    from mrmp.live.process import AgentOptions, check_key_policy, die_with_parent, run_agent, warn
+    from mrmp.live.transport import LiveFaults
 
     die_with_parent()
     try:
@@ -633,33 +634,10 @@ def agent(
         if robot not in ids:
             raise InputError(Problem("--robot", f"no robot has the id {robot!r} in {scenario_path}"))
         index = ids.index(robot)
-        peers = {}
-        for item in peer or []:
-            name, separator, address = item.partition("=")
-            if not separator or name not in ids:
-                raise InputError(Problem("--peer", f"expected ID=HOST:PORT with a robot id of the scenario, got {item!r}"))
-            try:
-                peers[ids.index(name)] = parse_address(address)
-            except ValueError as error:
-                raise InputError(Problem("--peer", str(error))) from None
-        missing = [ids[other] for other in range(len(ids)) if other != index and other not in peers]
-        if transport == "udp" and missing:
-            raise InputError(Problem("--peer", f"no address for {', '.join(missing)}: give --peer ID=HOST:PORT for every other robot"))
-        try:
-            spec = TransportSpec(
-                transport,
-                bind=parse_address(bind),
-                peers=peers,
-                group=parse_address(group),
-                interface=interface,
-                listen=listen,
-                connect=tuple(connect or ()),
-                fleet=fleet,
-            )
-        except ValueError as error:
-            raise InputError(Problem("--bind/--group", str(error))) from None
-        if transport not in ("udp", "multicast", "zenoh"):
-            raise InputError(Problem("--transport", f"unknown transport {transport!r}; known: udp, multicast, zenoh"))
+        transport_values = {
+            "bind": bind, "peer": peer, "group": group, "interface": interface, "listen": listen, "connect": connect, "fleet": fleet,
+        }
+        spec = TRANSPORTS.parse(transport, transport_values, ids, index)
         environment_key = os.environ.get("MRMP_FLEET_KEY", "").encode()
         key = read_key_file(key_file) if key_file is not None else environment_key
         key = check_key_policy(key, spec, warn)

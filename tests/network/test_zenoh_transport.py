@@ -1,4 +1,7 @@
-"""The Zenoh transport: three robots in a full mesh of explicit loopback TCP endpoints."""
+"""What only the Zenoh transport does: three robots in a full mesh of explicit loopback TCP endpoints.
+
+What every transport does is checked once for all of them in test_transport_conformance.py.
+"""
 
 import socket
 import time
@@ -8,9 +11,9 @@ import pytest
 
 zenoh = pytest.importorskip("zenoh")
 
-from mrmp.live.zenoh_transport import ZenohTransport, session_config
-from mrmp.protocol.auth import MAX_DATAGRAM_BYTES
-from polling import drain, receive_while_closing, receive_within
+from polling import drain, receive_within  # noqa: E402 (after the skip when Zenoh is missing)
+
+from mrmp.live.zenoh_transport import ZenohTransport, session_config  # noqa: E402
 
 LOOPBACK = "127.0.0.1"
 
@@ -86,40 +89,9 @@ def test_configuration_is_peer_mode_with_explicit_endpoints_only():
     assert config["connect/exit_on_failure"] is False and config["connect/timeout_ms"] == -1
 
 
-def test_broadcast_reaches_the_two_others_not_the_sender(mesh):
+def test_connected_peers_are_the_others(mesh):
     a, b, c = mesh
-    a.send(b"from a to all")
-    assert receive_within(b) == b"from a to all"
-    assert receive_within(c) == b"from a to all"
-    assert drain(a, 0.2) == []
     assert a.peers() == {1, 2} and b.peers() == {0, 2} and c.peers() == {0, 1}
-
-
-def test_everyone_broadcasting_at_once(mesh):
-    for robot in mesh:
-        robot.send(b"hello from %d" % robot.index)
-    for robot in mesh:
-        heard = sorted(drain(robot, 0.3))
-        assert heard == sorted(b"hello from %d" % other for other in range(3) if other != robot.index)
-
-
-def test_addressed_send_reaches_only_the_addressee(mesh):
-    a, b, c = mesh
-    a.send(b"a to c", recipient=2)
-    c.send(b"c to b", recipient=1)
-    assert receive_within(c) == b"a to c"
-    assert receive_within(b) == b"c to b"
-    assert drain(a, 0.2) == [] and drain(b, 0.05) == [] and drain(c, 0.05) == []
-
-
-def test_payloads_pass_through_unchanged_even_oversized(mesh):
-    a, b, _ = mesh
-    oversized = bytes(range(256)) * ((MAX_DATAGRAM_BYTES + 500) // 256)
-    assert len(oversized) > MAX_DATAGRAM_BYTES + 1
-    a.send(oversized, recipient=1)
-    a.send(b"")
-    received = [receive_within(b), receive_within(b)]  # two publishers: no order between them
-    assert sorted(received, key=len) == [b"", oversized]
 
 
 def test_a_robot_started_before_its_peers_still_connects(fleet):
@@ -185,12 +157,6 @@ def test_close_is_prompt_and_peers_see_it(mesh):
     assert time.monotonic() - started < 2.0
 
 
-def test_close_wakes_a_blocked_receive(mesh):
-    data, took, thread = receive_while_closing(mesh[0], timeout=5.0)
-    assert not thread.is_alive()
-    assert data is None and took < 1.0
-
-
 def test_the_queue_is_capped_dropping_the_oldest(fleet):
     two = fleet(2)
     sender = two.start(0)
@@ -205,19 +171,13 @@ def test_the_queue_is_capped_dropping_the_oldest(fleet):
     assert drain(receiver, 0.1) == [b"%d" % number for number in range(15, 20)]
 
 
-def test_receive_times_out_with_none(mesh):
-    started = time.monotonic()
-    assert mesh[0].receive(0.2) is None
-    assert 0.15 <= time.monotonic() - started < 1.0
-
-
 def test_bad_arguments_are_refused(mesh):
     with pytest.raises(ValueError, match="no peer 3"):
         mesh[0].send(b"x", recipient=3)
     with pytest.raises(ValueError, match="no peer 0"):
         mesh[0].send(b"x", recipient=0)
     port = free_ports(1)[0]
-    with pytest.raises(ValueError, match="not in 0..2"):
+    with pytest.raises(ValueError, match=r"not in 0\.\.2"):
         ZenohTransport(3, "mrmp/x", endpoint(port), [], 3)
     with pytest.raises(ValueError, match="Zenoh key"):
         ZenohTransport(0, "mrmp/*", endpoint(port), [], 3)

@@ -6,15 +6,17 @@ per robot (each in its own session, so that Ctrl-C reaches the launcher only,
 which then stops its children in order), waits for them, and turns their files
 into a :class:`~mrmp.core.result.RunResult`. Children also die with the
 launcher (``PR_SET_PDEATHSIG``), so a killed launcher leaves no orphans.
+
+Each robot's transport arguments come from the transport's entry in
+:data:`~mrmp.live.transport_table.TRANSPORTS`, for a fleet laid out on
+loopback (:class:`~mrmp.live.transport_entry.FleetLayout`).
 """
 
 from __future__ import annotations
 
-import importlib.util
 import os
 import random
 import signal
-import socket
 import subprocess
 import sys
 import tempfile
@@ -32,9 +34,10 @@ from mrmp.io.live_files import read_json, write_key_file
 from mrmp.io.plans import write_plan, write_share
 from mrmp.io.scenario_file import save_scenario
 from mrmp.live.agent import AgentTiming
-from mrmp.live.process import TRANSPORTS
 from mrmp.live.results import ideal_makespan, live_result
 from mrmp.live.transport import LiveFaults
+from mrmp.live.transport_entry import FleetLayout
+from mrmp.live.transport_table import FAULTS, TRANSPORTS
 
 
 @dataclass(frozen=True)
@@ -48,81 +51,85 @@ class LiveOptions:
 
     transport: str = "udp"
     time_scale: float = 1.0
-    faults: LiveFaults = LiveFaults()
+    faults: LiveFaults = field(default_factory=LiveFaults)
     jitter: float = 0.0
     miss_line: float = 0.0
     guarded: bool = True
     results: Path | None = None
     timeout: float | None = None
-    timing: AgentTiming = AgentTiming()
+    timing: AgentTiming = field(default_factory=AgentTiming)
     kill: Mapping[str, float] = field(default_factory=dict)
     seed: int = 0
     plan: PlanningResult | None = None
 
 
-def free_ports(count: int) -> list[int]:
-    """``count`` distinct ports free for both UDP and TCP on loopback (bound and released together)."""
-    sockets: list[socket.socket] = []
-    ports: list[int] = []
-    try:
-        while len(ports) < count:
-            tcp = socket.socket(socket.AF_INET, socket.SOCK_STREAM)
-            tcp.bind(("127.0.0.1", 0))
-            sockets.append(tcp)
-            port = tcp.getsockname()[1]
-            udp = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-            sockets.append(udp)
-            try:
-                udp.bind(("127.0.0.1", port))
-            except OSError:
-                continue  # taken for UDP: keep the TCP socket bound so it is not offered again, try another
-            ports.append(port)
-        return ports
-    finally:
-        for sock in sockets:
-            sock.close()
+@dataclass(frozen=True)
+class _RunFiles:
+    """The files of one live run in its results folder, written before any process starts."""
+
+    results: Path
+    scenario: Path
+    key: Path
+    done: Path
+    shares: list[Path]
+    """Each robot's share of the central plan, by index (empty without a plan)."""
 
 
-def transport_arguments(kind: str, index: int, ids: list[str], ports: list[int], group_port: int, fleet: str) -> list[str]:
-    """The ``mrmp agent`` options that connect robot ``index`` to the rest of a loopback fleet."""
-    if kind == "udp":
-        peers = [f"--peer={ids[other]}=127.0.0.1:{port}" for other, port in enumerate(ports) if other != index]
-        return ["--transport=udp", f"--bind=127.0.0.1:{ports[index]}", *peers]
-    if kind == "multicast":
-        return ["--transport=multicast", f"--group=239.255.77.{1 + group_port % 250}:{group_port}", "--interface=127.0.0.1"]
-    connects = [f"--connect=tcp/127.0.0.1:{port}" for other, port in enumerate(ports) if other != index]
-    return ["--transport=zenoh", f"--listen=tcp/127.0.0.1:{ports[index]}", *connects, f"--fleet={fleet}"]
+@dataclass(frozen=True)
+class _Fleet:
+    """One run's fleet: its processes, when they started, and when the launcher gives up on them."""
+
+    ids: list[str]
+    agents: list[subprocess.Popen[bytes]]
+    referee: subprocess.Popen[bytes]
+    started: float
+    timeout: float
+    done: Path
+    """The file whose appearance tells the referee to finish."""
 
 
-def _stop(processes: list[subprocess.Popen[bytes]], grace: float = 3.0) -> None:
-    for process in processes:
-        if process.poll() is None:
-            process.send_signal(signal.SIGTERM)
-    deadline = time.monotonic() + grace
-    for process in processes:
-        try:
-            process.wait(max(0.0, deadline - time.monotonic()))
-        except subprocess.TimeoutExpired:
-            process.kill()
-            process.wait()
+_PYTHON = [sys.executable, "-m", "mrmp"]
+"""How to start the ``mrmp`` command with this interpreter."""
 
 
 def run_live(scenario: Scenario, options: LiveOptions, say: Callable[[str], None] = lambda text: None) -> RunResult:
     """Run ``scenario`` with one process per robot over a loopback network; return the judged result.
 
+    The steps: check the options, write the run's files, lay the fleet out on
+    loopback, start the referee and the robots, watch them until they stop
+    (killing robots on schedule), stop what is left, and judge what they wrote.
+
     Raises
     ------
     InputError
-        For an unknown transport or a robot id in ``options.kill`` that is not in the scenario.
+        For an unknown or unavailable transport, or a robot id in ``options.kill`` that is not in the scenario.
     """
-    if options.transport not in TRANSPORTS:
-        raise InputError(Problem("--transport", f"unknown transport {options.transport!r}; known: {', '.join(TRANSPORTS)}"))
-    if options.transport == "zenoh" and importlib.util.find_spec("zenoh") is None:
-        raise InputError(Problem("--transport", "zenoh needs the eclipse-zenoh package: pip install 'mrmp[zenoh]'"))
     ids = [robot.id for robot in scenario.robots]
+    _check(options, ids)
+    files = _write_run_files(scenario, options, ids)
+    session = random.SystemRandom().randrange(1, 2**31)
+    layout = FleetLayout.on_loopback(ids, fleet=f"mrmp/{session}")
+    timeout = options.timeout or max(30.0, 10.0 * ideal_makespan(scenario, options.time_scale) + 3.0 * len(ids))
+    fleet = _start_fleet(options, files, layout, session, timeout)
+    say(f"live: {len(ids)} robot processes and a referee over {options.transport} on loopback; results in {files.results}")
+    stop_reason = _watch(fleet, options.kill, say)
+    wall_time = time.monotonic() - fleet.started
+    reports = [_read_if_there(files.results / f"agent-{index}.json") for index in range(len(ids))]
+    verdict = _read_if_there(files.results / "referee.json")
+    return _judge(scenario, options, reports, verdict, _overall_stop_reason(stop_reason, reports), wall_time)
+
+
+def _check(options: LiveOptions, ids: list[str]) -> None:
+    problem = TRANSPORTS.entry(options.transport).unavailable()
+    if problem is not None:
+        raise InputError(Problem("--transport", problem))
     for robot_id in options.kill:
         if robot_id not in ids:
             raise InputError(Problem("--kill", f"no robot has the id {robot_id!r}"))
+
+
+def _write_run_files(scenario: Scenario, options: LiveOptions, ids: list[str]) -> _RunFiles:
+    """Clear the results folder of an earlier run's files; write the scenario, the plan's shares and a fresh fleet key."""
     results = options.results or Path(tempfile.mkdtemp(prefix="mrmp-live-"))
     results.mkdir(parents=True, exist_ok=True)
     for stale in [
@@ -140,61 +147,60 @@ def run_live(scenario: Scenario, options: LiveOptions, say: Callable[[str], None
             write_share(shares[-1], ids[index], policy.moves, policy.dependencies)
     key_file = results / "fleet.key"
     write_key_file(key_file, os.urandom(32).hex().encode())
-    session = random.SystemRandom().randrange(1, 2**31)
-    count = len(scenario.robots)
-    ports = free_ports(count)
-    group_port = free_ports(1)[0]
-    fleet = f"mrmp/{session}"
-    ideal = ideal_makespan(scenario, options.time_scale)
-    timeout = options.timeout or max(30.0, 10.0 * ideal + 3.0 * count)
-    python = [sys.executable, "-m", "mrmp"]
+    return _RunFiles(results, scenario_file, key_file, results / "done", shares)
+
+
+def _start_fleet(options: LiveOptions, files: _RunFiles, layout: FleetLayout, session: int, timeout: float) -> _Fleet:
+    """Start the referee, then one ``mrmp agent`` process per robot, each in its own session."""
     started = time.monotonic()
-    done_file = results / "done"
     referee = subprocess.Popen(
-        [*python, "referee", f"--scenario={scenario_file}", f"--results={results}", f"--start-time={started}", f"--done-file={done_file}"],
+        [
+            *_PYTHON, "referee", f"--scenario={files.scenario}", f"--results={files.results}",
+            f"--start-time={started}", f"--done-file={files.done}",
+        ],
         start_new_session=True,
     )
-    faults = options.faults
-    common = [
-        f"--scenario={scenario_file}",
-        f"--key-file={key_file}",
+    common = _agent_arguments(options, files, session, timeout)
+    agents = []
+    for index, robot_id in enumerate(layout.ids):
+        transport = TRANSPORTS.fleet_spec(options.transport, layout, index)
+        plan = [f"--plan={files.shares[index]}"] if files.shares else []
+        command = [*_PYTHON, "agent", f"--robot={robot_id}", *common, *plan, *transport.arguments(layout.ids)]
+        agents.append(subprocess.Popen(command, start_new_session=True))
+    return _Fleet(list(layout.ids), agents, referee, started, timeout, files.done)
+
+
+def _agent_arguments(options: LiveOptions, files: _RunFiles, session: int, timeout: float) -> list[str]:
+    """The ``mrmp agent`` arguments every robot of the run gets."""
+    return [
+        f"--scenario={files.scenario}",
+        f"--key-file={files.key}",
         f"--session={session}",
-        f"--results={results}",
+        f"--results={files.results}",
         f"--time-scale={options.time_scale}",
         f"--jitter={options.jitter}",
         f"--miss-line={options.miss_line}",
-        f"--loss={faults.loss}",
-        f"--delay-ms={faults.delay_min * 1000:g}..{faults.delay_max * 1000:g}",
-        f"--duplicate={faults.duplicate}",
-        f"--reorder={faults.reorder}",
+        *FAULTS.arguments(options.faults),
         f"--seed={options.seed}",
         f"--timeout={timeout}",
         f"--listen-time={options.timing.listen_time}",
         *([] if options.guarded else ["--unsafe"]),
     ]
-    agents = [
-        subprocess.Popen(
-            [
-                *python, "agent", f"--robot={spec.id}", *common,
-                *([f"--plan={shares[index]}"] if shares else []),
-                *transport_arguments(options.transport, index, ids, ports, group_port, fleet),
-            ],
-            start_new_session=True,
-        )
-        for index, spec in enumerate(scenario.robots)
-    ]
-    say(f"live: {count} robot processes and a referee over {options.transport} on loopback; results in {results}")
+
+
+def _watch(fleet: _Fleet, kill: Mapping[str, float], say: Callable[[str], None]) -> str:
+    """Wait for the robots to stop, killing those of ``kill`` on time; then stop every process. Why the run stopped."""
     stop_reason = "all arrived"
-    kills = {ids.index(robot_id): started + seconds for robot_id, seconds in options.kill.items()}
+    kills = {fleet.ids.index(robot_id): fleet.started + seconds for robot_id, seconds in kill.items()}
     try:
-        while any(agent.poll() is None for agent in agents):
+        while any(agent.poll() is None for agent in fleet.agents):
             now = time.monotonic()
             for index, when in list(kills.items()):
-                if now >= when and agents[index].poll() is None:
-                    agents[index].kill()
-                    say(f"live: killed robot {ids[index]} at {now - started:.1f} s")
+                if now >= when and fleet.agents[index].poll() is None:
+                    fleet.agents[index].kill()
+                    say(f"live: killed robot {fleet.ids[index]} at {now - fleet.started:.1f} s")
                     del kills[index]
-            if now - started > timeout + 10.0:
+            if now - fleet.started > fleet.timeout + 10.0:
                 stop_reason = "timeout"
                 break
             time.sleep(0.05)
@@ -202,32 +208,65 @@ def run_live(scenario: Scenario, options: LiveOptions, say: Callable[[str], None
         stop_reason = "interrupted"
         say("live: interrupted; stopping the robots and writing what they have")
     finally:
-        _stop(agents)
-        done_file.touch()
+        _shut_down(fleet)
+    return stop_reason
+
+
+def _shut_down(fleet: _Fleet) -> None:
+    """Stop the robots still running, then tell the referee to finish (and stop it if it does not)."""
+    _stop(fleet.agents)
+    fleet.done.touch()
+    try:
+        fleet.referee.wait(10.0)
+    except subprocess.TimeoutExpired:
+        _stop([fleet.referee])
+
+
+def _stop(processes: list[subprocess.Popen[bytes]], grace: float = 3.0) -> None:
+    for process in processes:
+        if process.poll() is None:
+            process.send_signal(signal.SIGTERM)
+    deadline = time.monotonic() + grace
+    for process in processes:
         try:
-            referee.wait(10.0)
+            process.wait(max(0.0, deadline - time.monotonic()))
         except subprocess.TimeoutExpired:
-            _stop([referee])
-    wall_time = time.monotonic() - started
-    reports = []
-    for index in range(count):
-        path = results / f"agent-{index}.json"
-        reports.append(read_json(path) if path.exists() else None)
-    verdict = read_json(results / "referee.json") if (results / "referee.json").exists() else None
-    if stop_reason == "all arrived":
-        reasons = {report["stop_reason"] if report["stop_reason"] != "running" else "died" for report in reports if report}
-        if any(report is None for report in reports) or reasons - {"all arrived", "arrived; peers silent"}:
-            stop_reason = ", ".join(sorted(reasons | ({"died"} if None in reports else set()))) or "no reports"
-        elif "arrived; peers silent" in reasons:
-            stop_reason = "arrived; peers silent"
-    tick_seconds = scenario.timing.cell_time / options.time_scale / 4
+            process.kill()
+            process.wait()
+
+
+def _read_if_there(path: Path) -> dict | None:
+    return read_json(path) if path.exists() else None
+
+
+def _overall_stop_reason(stop_reason: str, reports: list[dict | None]) -> str:
+    """The launcher's reason, refined by the robots' reports when it saw them all stop by themselves."""
+    if stop_reason != "all arrived":
+        return stop_reason
+    reasons = {report["stop_reason"] if report["stop_reason"] != "running" else "died" for report in reports if report}
+    if any(report is None for report in reports) or reasons - {"all arrived", "arrived; peers silent"}:
+        return ", ".join(sorted(reasons | ({"died"} if None in reports else set()))) or "no reports"
+    if "arrived; peers silent" in reasons:
+        return "arrived; peers silent"
+    return stop_reason
+
+
+def _judge(
+    scenario: Scenario,
+    options: LiveOptions,
+    reports: list[dict | None],
+    verdict: dict | None,
+    stop_reason: str,
+    wall_time: float,
+) -> RunResult:
+    """The run's result from the robots' reports and the referee's verdict (with the plan's figures, if any)."""
     result = live_result(
         scenario,
         reports,
         verdict,
         stop_reason=stop_reason,
         wall_time_s=wall_time,
-        tick_seconds=tick_seconds,
+        tick_seconds=scenario.timing.cell_time / options.time_scale / 4,
         time_scale=options.time_scale,
     )
     if options.plan is not None:

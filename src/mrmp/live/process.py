@@ -14,7 +14,7 @@ import signal
 import sys
 import threading
 import time
-from collections.abc import Callable, Mapping, Sequence
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -22,80 +22,43 @@ from mrmp.core.errors import InputError, Problem
 from mrmp.core.scenario import Scenario
 from mrmp.io.live_files import TraceReader, TraceWriter, write_json
 from mrmp.io.plans import read_share
-from mrmp.policies.plan_following import PlanFollowingPolicy
 from mrmp.live.agent import Agent, AgentReport, AgentTiming
-from mrmp.live.causal_agent import CausalAgent
-from mrmp.policies.registry import ASYNC_POLICIES
 from mrmp.live.body import OccupancyRecorder, SimulatedBody
+from mrmp.live.causal_agent import CausalAgent
 from mrmp.live.referee import IntervalReferee
-from mrmp.live.transport import (
-    Address,
-    FaultyTransport,
-    LiveFaults,
-    Transport,
-    UdpMulticastTransport,
-    UdpTransport,
-    is_loopback,
-)
+from mrmp.live.transport import ConnectedTransport, LiveFaults, Transport, is_loopback
+from mrmp.live.transport_table import FAULTS, TransportSpec
+from mrmp.policies.plan_following import PlanFollowingPolicy
+from mrmp.policies.registry import ASYNC_POLICIES
 from mrmp.protocol.auth import Opener, Sealer
-
-TRANSPORTS = ("udp", "multicast", "zenoh")
-
-
-@dataclass(frozen=True)
-class TransportSpec:
-    """How one robot reaches its peers.
-
-    ``kind`` is ``"udp"`` (``bind`` and ``peers``), ``"multicast"`` (``group``
-    and ``interface``) or ``"zenoh"`` (``listen``, ``connect`` and ``fleet``).
-    """
-
-    kind: str
-    bind: Address = ("127.0.0.1", 0)
-    peers: Mapping[int, Address] = field(default_factory=dict)
-    group: Address = ("239.255.77.1", 47000)
-    interface: str = "127.0.0.1"
-    listen: str = ""
-    connect: Sequence[str] = ()
-    fleet: str = "mrmp"
-
-    def hosts(self) -> list[str]:
-        """Every host this transport binds to or sends to (to check a keyless run stays on loopback)."""
-        if self.kind == "udp":
-            return [self.bind[0], *(address[0] for address in self.peers.values())]
-        if self.kind == "multicast":
-            return [self.interface]
-        return [endpoint.split("/")[-1].rpartition(":")[0] for endpoint in (self.listen, *self.connect)]
-
-
-def open_transport(spec: TransportSpec, index: int, fleet_size: int) -> Transport:
-    """Open the transport ``spec`` describes, for robot ``index``."""
-    if spec.kind == "udp":
-        return UdpTransport(spec.bind, spec.peers)
-    if spec.kind == "multicast":
-        return UdpMulticastTransport(spec.group, spec.interface)
-    if spec.kind == "zenoh":
-        from mrmp.live.zenoh_transport import ZenohTransport
-
-        return ZenohTransport(index, spec.fleet, spec.listen, list(spec.connect), fleet_size)
-    raise InputError(Problem("--transport", f"unknown transport {spec.kind!r}; known: {', '.join(TRANSPORTS)}"))
 
 
 def check_key_policy(key: bytes | None, spec: TransportSpec, warn: Callable[[str], None]) -> bytes:
     """The key to use; without one, refuse anything but loopback and warn loudly.
 
+    The transport's table entry says which hosts it listens on and sends to.
+
     Raises
     ------
     InputError
         If there is no key and the transport reaches beyond loopback.
+
+    >>> from mrmp.live.transport_table import TransportSpec, UdpOptions
+    >>> check_key_policy(None, TransportSpec("udp", UdpOptions(("127.0.0.1", 9001))), warn=print)
+    WARNING: no fleet key: messages are NOT authenticated; allowed on loopback only
+    b''
+    >>> check_key_policy(None, TransportSpec("udp", UdpOptions(("10.0.0.1", 9001))), warn=print)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    mrmp.core.errors.InputError: --key-file: no fleet key: refusing to talk to 10.0.0.1 (only loopback runs may go ...)
     """
     if key:
         return key
     outside = [host for host in spec.hosts() if host and not is_loopback(host)]
     if outside:
-        raise InputError(
-            Problem("--key-file", f"no fleet key: refusing to talk to {', '.join(sorted(set(outside)))} (only loopback runs may go without a key; set MRMP_FLEET_KEY or --key-file)")
-        )
+        hosts = ", ".join(sorted(set(outside)))
+        only = "only loopback runs may go without a key; set MRMP_FLEET_KEY or --key-file"
+        raise InputError(Problem("--key-file", f"no fleet key: refusing to talk to {hosts} ({only})"))
     warn("WARNING: no fleet key: messages are NOT authenticated; allowed on loopback only")
     return b""
 
@@ -124,12 +87,12 @@ class AgentOptions:
     session: int
     results: Path
     time_scale: float = 1.0
-    faults: LiveFaults = LiveFaults()
+    faults: LiveFaults = field(default_factory=LiveFaults)
     jitter: float = 0.0
     miss_line: float = 0.0
     guarded: bool = True
     seed: int = 0
-    timing: AgentTiming = AgentTiming()
+    timing: AgentTiming = field(default_factory=AgentTiming)
     plan: Path | None = None
     """This robot's share of a central plan (``mrmp.io.plans.write_share``)."""
 
@@ -147,9 +110,8 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
     trace = TraceWriter(options.results / f"trace-{index}.jsonl", index)
     transport: Transport | None = None
     try:
-        transport = open_transport(options.transport, index, len(scenario.robots))
-        if not options.faults.is_perfect:
-            transport = FaultyTransport(transport, options.faults, seed=options.seed * 7919 + index)
+        transport = opened = options.transport.open(index, len(scenario.robots))
+        transport = FAULTS.wrap(opened, options.faults, seed=options.seed * 7919 + index)
         body = SimulatedBody(
             spec.start,
             spec.heading,
@@ -180,10 +142,8 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
                 policy=policy,
             )
         _on_stop_signals(agent.stop_requested.set)
-        inner = getattr(transport, "inner", transport)
-        wait_for_peers = getattr(inner, "wait_for_peers", None)
-        if wait_for_peers is not None:
-            wait_for_peers(len(scenario.robots) - 1, timeout=10.0)
+        if isinstance(opened, ConnectedTransport):
+            opened.wait_for_peers(len(scenario.robots) - 1, timeout=10.0)
         report = agent.run(on_progress=lambda report: write_json(report_path, report.as_dict()))
     finally:
         if transport is not None:
@@ -201,7 +161,8 @@ def run_referee(scenario: Scenario, results: Path, start_time: float, done_file:
     """
     stop = threading.Event()
     _on_stop_signals(stop.set)
-    referee = IntervalReferee(scenario.grid, [robot.id for robot in scenario.robots], [robot.start for robot in scenario.robots], start_time)
+    ids, starts = [robot.id for robot in scenario.robots], [robot.start for robot in scenario.robots]
+    referee = IntervalReferee(scenario.grid, ids, starts, start_time)
     readers = [TraceReader(results / f"trace-{index}.jsonl") for index in range(len(scenario.robots))]
     reported = 0
     finishing = False

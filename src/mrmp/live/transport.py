@@ -10,11 +10,16 @@ protocol layer's job (:mod:`mrmp.protocol.auth`). Three implementations:
 * ``ZenohTransport`` in :mod:`mrmp.live.zenoh_transport`.
 
 :class:`FaultyTransport` wraps any of them to inject loss, delay, duplication
-and reordering into a live run.
+and reordering into a live run. A transport whose peers must connect before
+they can be reached says so by being a :class:`ConnectedTransport`.
+
+Each of them is one entry of :data:`mrmp.live.transport_table.TRANSPORTS`,
+which says how to configure, open and launch it.
 """
 
 from __future__ import annotations
 
+import contextlib
 import heapq
 import random
 import socket
@@ -23,7 +28,7 @@ import threading
 import time
 from collections.abc import Mapping
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Protocol, runtime_checkable
 
 from mrmp.core.faults import message_fates
 from mrmp.protocol.auth import MAX_DATAGRAM_BYTES
@@ -44,6 +49,19 @@ class Transport(Protocol):
 
     def close(self) -> None:
         """Release the transport's sockets; ``receive`` then returns None."""
+        ...
+
+
+@runtime_checkable
+class ConnectedTransport(Transport, Protocol):
+    """A transport whose peers connect before datagrams reach them (Zenoh): it can wait for them.
+
+    Connectionless transports (UDP, multicast) are not: a datagram sent to a
+    peer that is up reaches it.
+    """
+
+    def wait_for_peers(self, count: int, timeout: float) -> bool:
+        """Wait until ``count`` other robots are connected, for at most ``timeout`` seconds; whether they are."""
         ...
 
 
@@ -98,10 +116,8 @@ class _UdpSocket:
     def close(self) -> None:
         """Close the socket, waking a ``receive`` blocked in another thread; ``receive`` returns None from now on."""
         self._closed = True
-        try:
+        with contextlib.suppress(OSError):
             self._socket.shutdown(socket.SHUT_RDWR)  # wakes a blocked recvfrom on Linux
-        except OSError:
-            pass
         self._socket.close()
 
 
@@ -130,11 +146,8 @@ class UdpTransport(_UdpSocket):
             address = self.peers.get(recipient)
             targets = [address] if address is not None else []  # no address: lost, as on any network
         for address in targets:
-            try:
+            with contextlib.suppress(OSError):  # an unreachable peer is a lost datagram, as on any network
                 self._socket.sendto(data, address)
-            except OSError:
-                pass  # an unreachable peer is a lost datagram, as on any network
-
 
 
 class UdpMulticastTransport(_UdpSocket):
@@ -172,11 +185,8 @@ class UdpMulticastTransport(_UdpSocket):
         self._closed = False
 
     def send(self, data: bytes, recipient: int | None = None) -> None:
-        try:
+        with contextlib.suppress(OSError):
             self._socket.sendto(data, self.group)
-        except OSError:
-            pass
-
 
 
 @dataclass(frozen=True)

@@ -83,6 +83,7 @@ b'hello'
 
 from __future__ import annotations
 
+import contextlib
 import json
 import threading
 import time
@@ -360,10 +361,8 @@ class ZenohTransport:
                 raise ValueError(f"robot {self.index} has no peer {recipient} (fleet of {self.fleet_size})") from None
         if self._closed:
             return
-        try:
+        with contextlib.suppress(self._zenoh.ZError):  # closed concurrently, or refused: a lost datagram
             publisher.put(data)
-        except self._zenoh.ZError:
-            pass  # closed concurrently, or refused: a lost datagram
 
     def receive(self, timeout: float) -> bytes | None:
         """The next datagram from a peer, or None after ``timeout`` seconds (at once once closed)."""
@@ -388,14 +387,10 @@ class ZenohTransport:
                 self._queue.clear()
                 self._ready.notify_all()
             for entity in reversed(self._entities):
-                try:
+                with contextlib.suppress(self._zenoh.ZError):
                     entity.undeclare()
-                except self._zenoh.ZError:
-                    pass
-            try:
+            with contextlib.suppress(self._zenoh.ZError):
                 self._session.close()
-            except self._zenoh.ZError:
-                pass
 
     # -- readiness ---------------------------------------------------------------------
 
