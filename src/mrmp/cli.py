@@ -362,7 +362,7 @@ def run(
             )
             result = run_live(scenario, options, say=lambda text: console.print(text, markup=False))
         elif plan is not None:
-            from mrmp.centralized.execution import execute_in_simulator
+            from mrmp.experiments.execution import execute_in_simulator
 
             executed_plan = plan
             result = _watched(
@@ -408,7 +408,7 @@ def compare(
     json_path: Annotated[Optional[str], typer.Option("--json", help="Write the rows as JSON (- for stdout).")] = None,
 ) -> None:
     """Solve one scenario every way: each decentralized policy, and each central planner plus execution."""
-    from mrmp.centralized.compare import compare_methods
+    from mrmp.experiments.compare import compare_methods
 
     console = Console(stderr=json_path == "-", highlight=False)
     try:
@@ -532,7 +532,7 @@ def bench(
     """Run a benchmark matrix (maps x robots x methods x seeds x faults); resumes where it stopped."""
     from mrmp.bench.runner import run_bench
     from mrmp.bench.summary import summary_rows
-    from mrmp.io.bench_config import load_bench_config
+    from mrmp.experiments.bench_config import load_bench_config
 
     console = Console(highlight=False, width=None if sys.stdout.isatty() else 140)
     err = Console(stderr=True, highlight=False, soft_wrap=True)

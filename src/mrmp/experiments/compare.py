@@ -16,9 +16,9 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 
-from mrmp.centralized.execution import execute_in_simulator
 from mrmp.centralized.registry import PLANNER_NAMES, plan_with
 from mrmp.core.scenario import PolicyOptions, Scenario
+from mrmp.experiments.execution import execute_in_simulator
 from mrmp.policies.registry import POLICY_NAMES
 from mrmp.sim.simulator import simulate
 

@@ -58,12 +58,12 @@ from typing import Any
 
 from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
-from mrmp.bench.matrix import BenchRun
 from mrmp.centralized.registry import PLANNER_NAMES
 from mrmp.core.errors import InputError
 from mrmp.core.grid import Grid
 from mrmp.core.map_generators import GENERATORS, complete_spec, generate, largest_region
 from mrmp.core.scenario import NetworkFaults, _fault_problems
+from mrmp.experiments.matrix import BenchRun
 from mrmp.io._files import PathLike, read_text
 from mrmp.io.movingai import read_map, read_scen_entries, scen_map_problems
 from mrmp.io.scenario_file import (
