@@ -16,7 +16,7 @@ from hypothesis import strategies as st
 
 from mrmp.core import Grid, NetworkFaults, PolicyOptions, RobotSpec, Scenario
 from mrmp.core.scenario import scenario_problems
-from mrmp.policies.registry import POLICY_NAMES
+from mrmp.sim.policy_table import policy_names
 from mrmp.sim.referee import check_paths
 from mrmp.sim.simulator import simulate
 
@@ -70,7 +70,7 @@ def pairwise_violations(grid, paths):
     return found
 
 
-@pytest.mark.parametrize("policy", POLICY_NAMES)
+@pytest.mark.parametrize("policy", policy_names())
 @settings(max_examples=80, derandomize=True, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(data=st.data())
 def test_policy_conformance(policy, data):

@@ -25,7 +25,7 @@ from mrmp.io.plans import read_share
 from mrmp.policies.plan_following import PlanFollowingPolicy
 from mrmp.live.agent import Agent, AgentReport, AgentTiming
 from mrmp.live.causal_agent import CausalAgent
-from mrmp.policies.registry import ASYNC_POLICIES
+from mrmp.sim.policy_table import policy_entry
 from mrmp.live.body import OccupancyRecorder, SimulatedBody
 from mrmp.live.referee import IntervalReferee
 from mrmp.live.transport import (
@@ -164,7 +164,7 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
         sealer = Sealer(options.key, options.session)
         opener = Opener(options.key, options.session, fleet_size=len(scenario.robots))
         agent: Agent | CausalAgent
-        if scenario.policy.name in ASYNC_POLICIES:  # Causal-PIBT: always through the safety layer
+        if policy_entry(scenario.policy.name).live_driver == "causal":  # Causal-PIBT: always through the safety layer
             agent = CausalAgent(scenario, index, transport, body, sealer, opener, timing=options.timing, seed=options.seed)
         else:
             agent = Agent(
