@@ -17,6 +17,7 @@ import time
 from dataclasses import dataclass
 
 from mrmp.centralized.registry import PLANNER_NAMES, plan_with
+from mrmp.core.result import RunResult
 from mrmp.core.scenario import PolicyOptions, Scenario
 from mrmp.experiments.execution import execute_in_simulator
 from mrmp.sim.policy_table import policy_names
@@ -64,7 +65,7 @@ def compare_methods(scenario: Scenario, time_limit_s: float = 30.0) -> list[Comp
     return rows
 
 
-def _row(method: str, kind: str, result, status: str) -> ComparisonRow:  # type: ignore[no-untyped-def]
+def _row(method: str, kind: str, result: RunResult, status: str) -> ComparisonRow:
     ratio = result.sum_of_costs / result.lower_bound if result.success and result.lower_bound else None
     return ComparisonRow(
         method,
