@@ -7,22 +7,30 @@ printed and written); 2 for bad input (each problem on one line, no traceback).
 
 from __future__ import annotations
 
+import functools
+import inspect
 import sys
 from collections.abc import Callable
+from dataclasses import dataclass, replace
 from pathlib import Path
-from typing import Annotated, Optional
+from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
 from rich.console import Console
 from rich.table import Table
 
 from mrmp.core.errors import InputError, MrmpError, Problem
+from mrmp.core.options import setting_types, settings
 from mrmp.core.result import RunResult
-from mrmp.core.scenario import RESOLUTIONS, NetworkFaults, PolicyOptions, Scenario, scenario_problems
+from mrmp.core.scenario import NetworkFaults, PolicyOptions, Scenario, scenario_problems
 from mrmp.io import load_movingai_scenario, load_scenario, validate_file, write_result_json
 from mrmp.live.transport_table import TRANSPORTS
-from mrmp.policies.registry import ASYNC_POLICIES, POLICY_NAMES, ROUND_POLICIES
+from mrmp.sim.policy_table import policy_entry, policy_names
 from mrmp.sim.simulator import TickObserver, simulate
+
+if TYPE_CHECKING:
+    from mrmp.centralized.plan import PlanningResult
+    from mrmp.live.transport import LiveFaults
 
 app = typer.Typer(
     add_completion=False,
@@ -61,12 +69,12 @@ def parse_range(text: str, option: str, unit: str = "ticks", whole: bool = True)
 
 
 def _load(
-    scenario_path: Optional[Path], map_path: Optional[Path], scen_path: Optional[Path], agents: Optional[int]
+    scenario_path: Path | None, map_path: Path | None, scen_path: Path | None, agents: int | None
 ) -> Scenario:
     if scenario_path is not None:
         if map_path or scen_path:
             raise InputError(Problem("--map/--scen", "give either a scenario file or --map and --scen, not both"))
-        return load_scenario(scenario_path, known_policies=POLICY_NAMES)
+        return load_scenario(scenario_path, known_policies=policy_names())
     if map_path is None or scen_path is None:
         raise InputError(Problem("SCENARIO", "give a scenario file, or --map and --scen (with --agents)"))
     if agents is not None and agents <= 0:
@@ -74,13 +82,23 @@ def _load(
     return load_movingai_scenario(map_path, scen_path, agents)
 
 
-def _apply_options(scenario: Scenario, **options: object) -> Scenario:
-    policy = scenario.policy
-    policy_changes = {
-        key: options[key] for key in ("name", "resolve", "heading_aware", "radius", "swap") if options.get(key) is not None
-    }
-    if policy_changes:
-        policy = PolicyOptions(**{**policy.__dict__, **policy_changes})
+def _with_policy(scenario: Scenario, name: str | None, policy_settings: dict[str, Any]) -> tuple[PolicyOptions, list[Problem]]:
+    """The scenario's policy with ``--policy`` and the setting flags given applied, and the problems found."""
+    changes = {key: value for key, value in policy_settings.items() if value is not None}
+    if name is not None:
+        changes["name"] = name
+    if not changes:
+        return scenario.policy, []
+    try:
+        return replace(scenario.policy, **changes), []
+    except InputError as error:
+        return scenario.policy, list(error.problems)
+
+
+def _apply_options(
+    scenario: Scenario, policy_name: str | None = None, policy_settings: dict[str, Any] | None = None, **options: object
+) -> Scenario:
+    policy, policy_problems = _with_policy(scenario, policy_name, policy_settings or {})
     network = scenario.network
     network_changes: dict[str, object] = {
         key: options[key] for key in ("loss", "duplicate", "reorder") if options.get(key) is not None
@@ -94,12 +112,52 @@ def _apply_options(scenario: Scenario, **options: object) -> Scenario:
         if options.get(key) is not None:
             changes[key] = options[key]
     updated = scenario.with_changes(**changes)
-    problems = scenario_problems(updated)
-    if policy.name not in POLICY_NAMES:
-        problems.append(Problem("--policy", f"unknown policy {policy.name!r}; known: {', '.join(POLICY_NAMES)}"))
+    problems = scenario_problems(updated) + policy_problems
+    if policy_name is not None and policy_name not in policy_names():
+        problems.append(Problem("--policy", f"unknown policy {policy_name!r}; known: {', '.join(policy_names())}"))
     if problems:
         raise InputError(problems)
     return updated
+
+
+def with_policy_flags(command: Callable[..., None]) -> Callable[..., None]:
+    """``command`` with one ``mrmp run`` option per policy setting, in place of its ``policy_settings`` parameter.
+
+    The options are derived from the fields of
+    :class:`~mrmp.core.scenario.PolicyOptions` (flag, help text and type, from
+    :mod:`mrmp.core.options`); each is None when not given, and ``command``
+    receives them as one ``policy_settings`` dict by field name.
+
+    >>> def show(policy_settings: dict[str, Any]) -> None:
+    ...     print(policy_settings)
+    >>> list(inspect.signature(with_policy_flags(show)).parameters)
+    ['resolve', 'heading_aware', 'radius', 'swap']
+    >>> with_policy_flags(show)(radius=3)
+    {'resolve': None, 'heading_aware': None, 'radius': 3, 'swap': None}
+    """
+    types = setting_types(PolicyOptions)
+    flags = [
+        inspect.Parameter(
+            field.name,
+            inspect.Parameter.POSITIONAL_OR_KEYWORD,
+            default=None,
+            annotation=Annotated[types[field.name] | None, typer.Option(setting.flag, help=setting.help)],
+        )
+        for field, setting in settings(PolicyOptions)
+    ]
+    signature = inspect.signature(command, eval_str=True)
+    parameters: list[inspect.Parameter] = []
+    for parameter in signature.parameters.values():
+        parameters.extend(flags if parameter.name == "policy_settings" else [parameter])
+
+    @functools.wraps(command)
+    def with_flags(**arguments: Any) -> None:
+        given = {name: arguments.pop(name, None) for name in types}
+        return command(**arguments, policy_settings=given)
+
+    with_flags.__signature__ = signature.replace(parameters=parameters)  # type: ignore[attr-defined]
+    with_flags.__annotations__ = {parameter.name: parameter.annotation for parameter in parameters} | {"return": None}
+    return with_flags
 
 
 def _positive(value: float, option: str) -> float:
@@ -142,7 +200,7 @@ def parse_kills(items: list[str]) -> dict[str, float]:
     return kills
 
 
-def live_faults(scenario: Scenario, time_scale: float, delay_ms: str | None) -> "LiveFaults":
+def live_faults(scenario: Scenario, time_scale: float, delay_ms: str | None) -> LiveFaults:
     """The scenario's network faults for a live run: probabilities as given, delays in seconds.
 
     A delay of one tick in the simulator is one cell time at the run's speed;
@@ -158,7 +216,7 @@ def live_faults(scenario: Scenario, time_scale: float, delay_ms: str | None) -> 
     return LiveFaults(network.loss, low, high, network.duplicate, network.reorder)
 
 
-def _plan(name: str, scenario: Scenario, time_limit: float, console: Console) -> "PlanningResult":
+def _plan(name: str, scenario: Scenario, time_limit: float, console: Console) -> PlanningResult:
     """Run a central planner; an unsolved plan ends the command with status 1 and its reason."""
     from mrmp.centralized.registry import PLANNER_NAMES, plan_with
 
@@ -269,51 +327,51 @@ def _watched(
 
 
 @app.command()
+@with_policy_flags
 def run(
-    scenario_path: Annotated[Optional[Path], typer.Argument(metavar="SCENARIO", help="A YAML scenario.")] = None,
-    map_path: Annotated[Optional[Path], typer.Option("--map", help="A MovingAI .map file.")] = None,
-    scen_path: Annotated[Optional[Path], typer.Option("--scen", help="A MovingAI .scen file.")] = None,
-    agents: Annotated[Optional[int], typer.Option(help="Robots taken from the .scen (default: all).")] = None,
-    policy: Annotated[Optional[str], typer.Option(help=f"Decision rule: {', '.join(POLICY_NAMES)}.")] = None,
-    resolve: Annotated[Optional[str], typer.Option(help=f"Conflict resolution: {', '.join(RESOLUTIONS)}.")] = None,
-    heading_aware: Annotated[Optional[bool], typer.Option("--heading-aware/--no-heading-aware", help="Charge turns when planning.")] = None,
-    radius: Annotated[Optional[int], typer.Option(help="pibt: how far a robot's beacon reaches, in cells (at least 2).")] = None,
-    swap: Annotated[Optional[bool], typer.Option("--swap/--no-swap", help="pibt: the swap technique for corridors.")] = None,
+    scenario_path: Annotated[Path | None, typer.Argument(metavar="SCENARIO", help="A YAML scenario.")] = None,
+    map_path: Annotated[Path | None, typer.Option("--map", help="A MovingAI .map file.")] = None,
+    scen_path: Annotated[Path | None, typer.Option("--scen", help="A MovingAI .scen file.")] = None,
+    agents: Annotated[int | None, typer.Option(help="Robots taken from the .scen (default: all).")] = None,
+    policy: Annotated[str | None, typer.Option(help=f"Decision rule: {', '.join(policy_names())}.")] = None,
+    policy_settings: dict[str, Any] | None = None,
     unsafe: Annotated[bool, typer.Option("--unsafe", help="Turn the safety layer off: the policy as written.")] = False,
     lifelong: Annotated[bool, typer.Option("--lifelong", help="A robot that reaches its goal gets a new one (seeded); report throughput.")] = False,
-    max_ticks: Annotated[Optional[int], typer.Option(help="Stop after this many ticks.")] = None,
-    seed: Annotated[Optional[int], typer.Option(help="Seed of the simulated network.")] = None,
-    loss: Annotated[Optional[float], typer.Option(help="Probability that a message is lost.")] = None,
-    delay: Annotated[Optional[str], typer.Option(help="Message delay in ticks: N or A..B.")] = None,
-    duplicate: Annotated[Optional[float], typer.Option(help="Probability that a message is duplicated.")] = None,
-    reorder: Annotated[Optional[float], typer.Option(help="Probability that a message overtakes earlier ones.")] = None,
-    json_path: Annotated[Optional[str], typer.Option("--json", help="Write the whole result as JSON (- for stdout).")] = None,
-    animate: Annotated[Optional[Path], typer.Option(help="Write an animation: .gif, .svg or .mp4 (needs ffmpeg).")] = None,
+    max_ticks: Annotated[int | None, typer.Option(help="Stop after this many ticks.")] = None,
+    seed: Annotated[int | None, typer.Option(help="Seed of the simulated network.")] = None,
+    loss: Annotated[float | None, typer.Option(help="Probability that a message is lost.")] = None,
+    delay: Annotated[str | None, typer.Option(help="Message delay in ticks: N or A..B.")] = None,
+    duplicate: Annotated[float | None, typer.Option(help="Probability that a message is duplicated.")] = None,
+    reorder: Annotated[float | None, typer.Option(help="Probability that a message overtakes earlier ones.")] = None,
+    json_path: Annotated[str | None, typer.Option("--json", help="Write the whole result as JSON (- for stdout).")] = None,
+    animate: Annotated[Path | None, typer.Option(help="Write an animation: .gif, .svg or .mp4 (needs ffmpeg).")] = None,
     show_messages: Annotated[bool, typer.Option("--show-messages", help="Record each tick's messages and draw them in the --animate animation (and the --json result).")] = False,
     watch: Annotated[bool, typer.Option("--watch", help="Draw the grid in the terminal as the robots move.")] = False,
     watch_fps: Annotated[float, typer.Option(help="--watch: ticks drawn per second.")] = 10.0,
-    planner: Annotated[Optional[str], typer.Option(help="Plan centrally first (cbs, pp, lacam), then execute the plan.")] = None,
+    planner: Annotated[str | None, typer.Option(help="Plan centrally first (cbs, pp, lacam), then execute the plan.")] = None,
     time_limit: Annotated[float, typer.Option(help="Seconds a central planner may spend.")] = 30.0,
     live: Annotated[bool, typer.Option("--live", help="One OS process per robot, in real time, over a loopback network.")] = False,
     transport: Annotated[str, typer.Option(help=f"Live transport: {TRANSPORTS.listed()}.")] = "udp",
     time_scale: Annotated[float, typer.Option(help="Live: run this many times faster than the robots' real speed.")] = 1.0,
-    delay_ms: Annotated[Optional[str], typer.Option(help="Live: message delay in milliseconds, N or A..B.")] = None,
+    delay_ms: Annotated[str | None, typer.Option(help="Live: message delay in milliseconds, N or A..B.")] = None,
     jitter: Annotated[float, typer.Option(help="Live: each move takes its time times 1 +- jitter.")] = 0.0,
     miss_line: Annotated[float, typer.Option(help="Live: probability that a body misses a grid line.")] = 0.0,
-    results: Annotated[Optional[Path], typer.Option(help="Live: folder for traces and reports (default: a new temporary one).")] = None,
-    kill: Annotated[Optional[list[str]], typer.Option(help="Live: kill robot ID's process after S seconds: ID@S (repeatable).")] = None,
+    results: Annotated[Path | None, typer.Option(help="Live: folder for traces and reports (default: a new temporary one).")] = None,
+    kill: Annotated[list[str] | None, typer.Option(help="Live: kill robot ID's process after S seconds: ID@S (repeatable).")] = None,
+
 ) -> None:
     """Run a scenario (lockstep simulator, or --live processes) and report what happened."""
+    # --resolve, --heading-aware, --radius and --swap come from PolicyOptions' fields (with_policy_flags)
+    request = RunRequest(
+        json_path, animate, show_messages, watch, watch_fps, planner, time_limit, live, transport, time_scale,
+        delay_ms, jitter, miss_line, results, kill or [], unsafe,
+    )
     console = Console(stderr=json_path == "-", highlight=False)
     try:
-        scenario = _load(scenario_path, map_path, scen_path, agents)
         scenario = _apply_options(
-            scenario,
-            name=policy,
-            resolve=resolve,
-            heading_aware=heading_aware,
-            radius=radius,
-            swap=swap,
+            _load(scenario_path, map_path, scen_path, agents),
+            policy,
+            policy_settings,
             loss=loss,
             delay=delay,
             duplicate=duplicate,
@@ -323,76 +381,111 @@ def run(
             safety=False if unsafe else None,
             lifelong=True if lifelong else None,
         )
-        if scenario.lifelong and (live or planner is not None):
-            raise InputError(Problem("--lifelong", "lifelong runs are simulated with a decentralized policy (not --live, not --planner)"))
-        if unsafe and scenario.policy.name in ASYNC_POLICIES:
-            raise InputError(Problem("--unsafe", f"{scenario.policy.name} always enters cells through the safety layer; it has no unsafe form"))
-        if live and scenario.policy.name in ROUND_POLICIES:
-            raise InputError(
-                Problem("--policy", f"{scenario.policy.name} runs in the simulator's synchronous rounds only; its live, asynchronous form is --policy causal")
-            )
-        if animate is not None:
-            from mrmp.viz.animate import animation_problem
-
-            animation_issue = animation_problem(animate)
-            if animation_issue is not None:
-                raise InputError(Problem("--animate", animation_issue))
-        if show_messages:
-            _check_show_messages(scenario, animate is not None or json_path is not None, live, planner is not None)
-        if watch and live:
-            raise InputError(Problem("--watch", "live runs are not drawn in the terminal (--watch is for simulated runs)"))
-        if watch:
-            _positive(watch_fps, "--watch-fps")
-        plan = None
-        if planner is not None:
-            plan = _plan(planner, scenario, time_limit, console)
-        if live:
-            from mrmp.live.launcher import LiveOptions, run_live
-
-            options = LiveOptions(
-                transport=transport,
-                time_scale=_positive(time_scale, "--time-scale"),
-                faults=live_faults(scenario, time_scale, delay_ms),
-                jitter=_fraction(jitter, "--jitter"),
-                miss_line=_fraction(miss_line, "--miss-line"),
-                guarded=scenario.safety,
-                results=results,
-                kill=parse_kills(kill or []),
-                seed=scenario.seed,
-                plan=plan,
-            )
-            result = run_live(scenario, options, say=lambda text: console.print(text, markup=False))
-        elif plan is not None:
-            from mrmp.centralized.execution import execute_in_simulator
-
-            executed_plan = plan
-            result = _watched(
-                scenario,
-                watch_fps if watch else None,
-                console,
-                lambda on_tick: execute_in_simulator(scenario, executed_plan, record_messages=show_messages, on_tick=on_tick),
-            )
-        else:
-            result = _watched(
-                scenario,
-                watch_fps if watch else None,
-                console,
-                lambda on_tick: simulate(scenario, record_messages=show_messages, on_tick=on_tick),
-            )
+        _validate_run(scenario, request)
+        plan = _plan(planner, scenario, time_limit, console) if planner is not None else None
+        result = _live_run(scenario, request, plan, console) if live else _simulated_run(scenario, request, plan, console)
     except InputError as error:
         raise _fail(error.problems) from None
     except MrmpError as error:  # e.g. a plan that cannot be executed (PlanDeadlockError)
         Console(stderr=True).print(f"error: {error}", markup=False)
         raise typer.Exit(2) from None
+    _output_run(result, scenario, request, console)
+
+
+@dataclass(frozen=True)
+class RunRequest:
+    """What ``mrmp run`` was asked to do with its scenario (its options other than the scenario's own)."""
+
+    json_path: str | None
+    animate: Path | None
+    show_messages: bool
+    watch: bool
+    watch_fps: float
+    planner: str | None
+    time_limit: float
+    live: bool
+    transport: str
+    time_scale: float
+    delay_ms: str | None
+    jitter: float
+    miss_line: float
+    results: Path | None
+    kill: list[str]
+    unsafe: bool
+
+
+def _validate_run(scenario: Scenario, request: RunRequest) -> None:
+    """Refuse, before anything runs, the combinations of options that cannot be honoured."""
+    entry = policy_entry(scenario.policy.name)
+    if scenario.lifelong and (request.live or request.planner is not None):
+        raise InputError(Problem("--lifelong", "lifelong runs are simulated with a decentralized policy (not --live, not --planner)"))
+    if request.unsafe and entry.always_guarded:
+        raise InputError(Problem("--unsafe", f"{entry.name} always enters cells through the safety layer; it has no unsafe form"))
+    if request.live and entry.live_driver is None:
+        raise InputError(Problem("--policy", f"{entry.name} {entry.not_live}"))
+    if request.animate is not None:
+        from mrmp.viz.animate import animation_problem
+
+        animation_issue = animation_problem(request.animate)
+        if animation_issue is not None:
+            raise InputError(Problem("--animate", animation_issue))
+    if request.show_messages:
+        written = request.animate is not None or request.json_path is not None
+        _check_show_messages(scenario, written, request.live, request.planner is not None)
+    if request.watch and request.live:
+        raise InputError(Problem("--watch", "live runs are not drawn in the terminal (--watch is for simulated runs)"))
+    if request.watch:
+        _positive(request.watch_fps, "--watch-fps")
+
+
+def _simulated_run(scenario: Scenario, request: RunRequest, plan: PlanningResult | None, console: Console) -> RunResult:
+    """Simulate ``scenario`` (following ``plan`` when given), drawn in the terminal with ``--watch``."""
+    record = request.show_messages
+    if plan is not None:
+        from mrmp.experiments.execution import execute_in_simulator
+
+        executed_plan = plan
+
+        def start(on_tick: TickObserver | None) -> RunResult:
+            return execute_in_simulator(scenario, executed_plan, record_messages=record, on_tick=on_tick)
+    else:
+
+        def start(on_tick: TickObserver | None) -> RunResult:
+            return simulate(scenario, record_messages=record, on_tick=on_tick)
+
+    return _watched(scenario, request.watch_fps if request.watch else None, console, start)
+
+
+def _live_run(scenario: Scenario, request: RunRequest, plan: PlanningResult | None, console: Console) -> RunResult:
+    """Run ``scenario`` live: one OS process per robot over a loopback network."""
+    from mrmp.live.launcher import LiveOptions, run_live
+
+    options = LiveOptions(
+        transport=request.transport,
+        time_scale=_positive(request.time_scale, "--time-scale"),
+        faults=live_faults(scenario, request.time_scale, request.delay_ms),
+        jitter=_fraction(request.jitter, "--jitter"),
+        miss_line=_fraction(request.miss_line, "--miss-line"),
+        guarded=scenario.safety,
+        results=request.results,
+        kill=parse_kills(request.kill),
+        seed=scenario.seed,
+        plan=plan,
+    )
+    return run_live(scenario, options, say=lambda text: console.print(text, markup=False))
+
+
+def _output_run(result: RunResult, scenario: Scenario, request: RunRequest, console: Console) -> None:
+    """Print the result, write its JSON and animation as asked, and exit with the run's status."""
     print_result(result, console)
     try:
-        if json_path is not None:
-            write_result_json(result, json_path, grid=scenario.grid)
-        if animate is not None:
+        if request.json_path is not None:
+            write_result_json(result, request.json_path, grid=scenario.grid)
+        if request.animate is not None:
             from mrmp.viz import write_animation
 
-            write_animation(scenario.grid, result, animate, show_messages=show_messages)
-            console.print(f"animation written to {animate}")
+            write_animation(scenario.grid, result, request.animate, show_messages=request.show_messages)
+            console.print(f"animation written to {request.animate}")
     except (MrmpError, OSError) as error:
         Console(stderr=True).print(f"error: {error}", markup=False)
         raise typer.Exit(2) from None
@@ -401,15 +494,15 @@ def run(
 
 @app.command()
 def compare(
-    scenario_path: Annotated[Optional[Path], typer.Argument(metavar="SCENARIO", help="A YAML scenario.")] = None,
-    map_path: Annotated[Optional[Path], typer.Option("--map", help="A MovingAI .map file.")] = None,
-    scen_path: Annotated[Optional[Path], typer.Option("--scen", help="A MovingAI .scen file.")] = None,
-    agents: Annotated[Optional[int], typer.Option(help="Robots taken from the .scen (default: all).")] = None,
+    scenario_path: Annotated[Path | None, typer.Argument(metavar="SCENARIO", help="A YAML scenario.")] = None,
+    map_path: Annotated[Path | None, typer.Option("--map", help="A MovingAI .map file.")] = None,
+    scen_path: Annotated[Path | None, typer.Option("--scen", help="A MovingAI .scen file.")] = None,
+    agents: Annotated[int | None, typer.Option(help="Robots taken from the .scen (default: all).")] = None,
     time_limit: Annotated[float, typer.Option(help="Seconds each central planner may spend.")] = 30.0,
-    json_path: Annotated[Optional[str], typer.Option("--json", help="Write the rows as JSON (- for stdout).")] = None,
+    json_path: Annotated[str | None, typer.Option("--json", help="Write the rows as JSON (- for stdout).")] = None,
 ) -> None:
     """Solve one scenario every way: each decentralized policy, and each central planner plus execution."""
-    from mrmp.centralized.compare import compare_methods
+    from mrmp.experiments.compare import compare_methods
 
     console = Console(stderr=json_path == "-", highlight=False)
     try:
@@ -450,8 +543,8 @@ def compare(
 def report(
     source: Annotated[Path, typer.Argument(metavar="DIR_OR_JSONL", help="A benchmark's --out folder, or its results.jsonl.")],
     out: Annotated[Path, typer.Option(help="The HTML page to write; its plots go to <stem>_plots/ next to it.")] = Path("report.html"),
-    title: Annotated[Optional[str], typer.Option(help="The page's title (default: named after the benchmark).")] = None,
-    markdown: Annotated[Optional[Path], typer.Option(help="Also write the headline table as Markdown to this file.")] = None,
+    title: Annotated[str | None, typer.Option(help="The page's title (default: named after the benchmark).")] = None,
+    markdown: Annotated[Path | None, typer.Option(help="Also write the headline table as Markdown to this file.")] = None,
 ) -> None:
     """Write an HTML report of a benchmark: what was run, the headline table, plots, timeouts and errors."""
     from mrmp.bench.aggregate import headline_table, summarize
@@ -525,15 +618,15 @@ def animate_command(
 def bench(
     config_path: Annotated[Path, typer.Argument(metavar="CONFIG.yaml", help="A benchmark configuration (see bench/tiny.yaml).")],
     out: Annotated[Path, typer.Option(help="Output folder: results.jsonl (one record per run) and results.csv.")],
-    workers: Annotated[Optional[int], typer.Option(help="Worker processes (default: the number of CPUs).")] = None,
-    dask: Annotated[Optional[str], typer.Option(help="Run on this dask.distributed scheduler (HOST:PORT) instead.")] = None,
-    time_limit: Annotated[Optional[float], typer.Option(help="Seconds per run, replacing the configuration's time_limit.")] = None,
+    workers: Annotated[int | None, typer.Option(help="Worker processes (default: the number of CPUs).")] = None,
+    dask: Annotated[str | None, typer.Option(help="Run on this dask.distributed scheduler (HOST:PORT) instead.")] = None,
+    time_limit: Annotated[float | None, typer.Option(help="Seconds per run, replacing the configuration's time_limit.")] = None,
     only_missing: Annotated[bool, typer.Option("--only-missing", help="Also run again the runs whose last record is an error.")] = False,
 ) -> None:
     """Run a benchmark matrix (maps x robots x methods x seeds x faults); resumes where it stopped."""
     from mrmp.bench.runner import run_bench
     from mrmp.bench.summary import summary_rows
-    from mrmp.io.bench_config import load_bench_config
+    from mrmp.experiments.bench_config import load_bench_config
 
     console = Console(highlight=False, width=None if sys.stdout.isatty() else 140)
     err = Console(stderr=True, highlight=False, soft_wrap=True)
@@ -582,7 +675,7 @@ def validate(
     problems: list[Problem] = []
     console = Console(highlight=False)
     for path in files:
-        found = validate_file(path, known_policies=POLICY_NAMES)
+        found = validate_file(path, known_policies=policy_names())
         if found:
             problems.extend(found)
         else:
@@ -597,13 +690,13 @@ def agent(
     robot: Annotated[str, typer.Option(help="Which robot of the scenario this process is (its id).")],
     transport: Annotated[str, typer.Option(help=f"{TRANSPORTS.listed()}.")] = "udp",
     bind: Annotated[str, typer.Option(help="UDP: address to receive on, HOST:PORT.")] = "127.0.0.1:9001",
-    peer: Annotated[Optional[list[str]], typer.Option(help="UDP: a peer, ID=HOST:PORT (repeat for each).")] = None,
+    peer: Annotated[list[str] | None, typer.Option(help="UDP: a peer, ID=HOST:PORT (repeat for each).")] = None,
     group: Annotated[str, typer.Option(help="Multicast: group HOST:PORT.")] = "239.255.77.1:47000",
     interface: Annotated[str, typer.Option(help="Multicast: IPv4 address of the interface to use.")] = "127.0.0.1",
     listen: Annotated[str, typer.Option(help="Zenoh: this robot's endpoint, e.g. tcp/127.0.0.1:7447.")] = "",
-    connect: Annotated[Optional[list[str]], typer.Option(help="Zenoh: a peer's endpoint (repeat for each).")] = None,
+    connect: Annotated[list[str] | None, typer.Option(help="Zenoh: a peer's endpoint (repeat for each).")] = None,
     fleet: Annotated[str, typer.Option(help="Zenoh: key-expression prefix of the fleet.")] = "mrmp",
-    key_file: Annotated[Optional[Path], typer.Option(help="Fleet key file (or set MRMP_FLEET_KEY).")] = None,
+    key_file: Annotated[Path | None, typer.Option(help="Fleet key file (or set MRMP_FLEET_KEY).")] = None,
     session: Annotated[int, typer.Option(help="Run number shared by the fleet; other runs' messages are dropped.")] = 1,
     results: Annotated[Path, typer.Option(help="Folder for this robot's report and trace.")] = Path("results"),
     time_scale: Annotated[float, typer.Option(help="Run this many times faster than the robot's real speed.")] = 1.0,
@@ -615,7 +708,7 @@ def agent(
     reorder: Annotated[float, typer.Option(help="Inject: probability that a sent message is held back.")] = 0.0,
     listen_time: Annotated[float, typer.Option(help="Seconds between announcing Next and deciding.")] = 0.05,
     unsafe: Annotated[bool, typer.Option("--unsafe", help="No safety layer: the policy as written.")] = False,
-    plan: Annotated[Optional[Path], typer.Option(help="Follow this robot's share of a central plan (plan-<index>.json).")] = None,
+    plan: Annotated[Path | None, typer.Option(help="Follow this robot's share of a central plan (plan-<index>.json).")] = None,
     seed: Annotated[int, typer.Option(help="Seed of the body's and the fault injector's randomness.")] = 0,
     timeout: Annotated[float, typer.Option(help="Give up after this many seconds.")] = 600.0,
 ) -> None:
@@ -629,7 +722,7 @@ def agent(
 
     die_with_parent()
     try:
-        scenario = load_scenario(scenario_path, known_policies=POLICY_NAMES)
+        scenario = load_scenario(scenario_path, known_policies=policy_names())
         ids = [spec.id for spec in scenario.robots]
         if robot not in ids:
             raise InputError(Problem("--robot", f"no robot has the id {robot!r} in {scenario_path}"))
@@ -679,7 +772,7 @@ def referee(
 
     die_with_parent()
     try:
-        scenario = load_scenario(scenario_path, known_policies=POLICY_NAMES)
+        scenario = load_scenario(scenario_path, known_policies=policy_names())
     except InputError as error:
         raise _fail(error.problems) from None
     collisions = run_referee(scenario, results, start_time, done_file, warn)

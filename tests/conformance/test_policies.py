@@ -1,4 +1,8 @@
-"""One conformance suite, run over every policy in the registry (as PettingZoo does for environments).
+"""One conformance suite, run over every policy in the policy table (as PettingZoo does for environments).
+
+The suite is parametrized over the table's contents; :func:`check_policy` is the
+same check for one named policy, for a policy added to the table elsewhere (for
+example ``test_toy_policy.py``).
 
 Whatever a policy decides, the run it produces must be judged consistently by the
 referee: paths have one cell per tick, move at most one cell per tick when the
@@ -16,7 +20,7 @@ from hypothesis import strategies as st
 
 from mrmp.core import Grid, NetworkFaults, PolicyOptions, RobotSpec, Scenario
 from mrmp.core.scenario import scenario_problems
-from mrmp.policies.registry import POLICY_NAMES
+from mrmp.sim.policy_table import policy_entry, policy_names
 from mrmp.sim.referee import check_paths
 from mrmp.sim.simulator import simulate
 
@@ -70,11 +74,25 @@ def pairwise_violations(grid, paths):
     return found
 
 
-@pytest.mark.parametrize("policy", POLICY_NAMES)
-@settings(max_examples=80, derandomize=True, deadline=None, suppress_health_check=[HealthCheck.too_slow])
-@given(data=st.data())
-def test_policy_conformance(policy, data):
-    scenario = data.draw(scenarios(policy))
+@pytest.mark.parametrize("policy", policy_names())
+def test_policy_conformance(policy):
+    check_policy(policy)
+
+
+def check_policy(policy, max_examples=80):
+    """Run the conformance checks on ``max_examples`` drawn scenarios of the table's policy ``policy``."""
+    assert policy_entry(policy).name == policy
+
+    @settings(max_examples=max_examples, derandomize=True, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+    @given(data=st.data())
+    def conforms(data):
+        check_run(data.draw(scenarios(policy)))
+
+    conforms()
+
+
+def check_run(scenario):
+    """One drawn scenario's run obeys every property of the module docstring."""
     if scenario_problems(scenario):  # unreachable goals on random maps: nothing to run
         return
     result = simulate(scenario)

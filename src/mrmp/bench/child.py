@@ -1,7 +1,7 @@
 """The process one benchmark run executes in: ``python -m mrmp.bench.child``.
 
-It reads one :class:`~mrmp.bench.matrix.BenchRun` as JSON on standard input,
-executes it (:func:`mrmp.bench.records.execute_run`) and writes its record as
+It reads one :class:`~mrmp.experiments.matrix.BenchRun` as JSON on standard input,
+executes it (:func:`mrmp.experiments.records.execute_run`) and writes its record as
 one JSON line on standard output. Running each run in a process of its own
 lets the runner kill it when it overruns its time limit, and keeps a crash of
 one run from taking the benchmark down. On Linux the process also ends when
@@ -16,8 +16,8 @@ import os
 import signal
 import sys
 
-from mrmp.bench.matrix import BenchRun
-from mrmp.bench.records import execute_run
+from mrmp.experiments.matrix import BenchRun
+from mrmp.experiments.records import execute_run
 
 PARENT_VARIABLE = "MRMP_BENCH_PARENT"
 """The environment variable naming the process id of the worker that started the run."""

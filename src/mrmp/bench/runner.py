@@ -32,8 +32,8 @@ from pathlib import Path
 from types import FrameType
 from typing import Any
 
-from mrmp.bench.matrix import BenchRun
-from mrmp.bench.records import base_record
+from mrmp.experiments.matrix import BenchRun
+from mrmp.experiments.records import base_record
 
 KILL_GRACE_S = 2.0
 """Seconds a run's process may exceed its time limit before it is killed (start-up, writing the record)."""

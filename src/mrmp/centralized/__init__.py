@@ -17,7 +17,8 @@ collision-free plan (a :class:`PlanningResult`) before anything moves:
 :data:`~mrmp.centralized.registry.PLANNERS` maps the names ``"cbs"``, ``"pp"``
 and ``"lacam"`` to the planners; each is called as ``planner(scenario)`` or
 ``planner(grid, starts, goals)`` with keyword options. Plans are executed by the
-fleet through :mod:`mrmp.centralized.execution`.
+fleet through :mod:`mrmp.centralized.execution` (each robot's share) and
+:mod:`mrmp.experiments.execution` (in the simulator).
 
 Examples
 --------

@@ -1,35 +1,28 @@
-"""Executing a central plan with the fleet: one plan-following policy per robot.
+"""A central plan cut into the fleet's shares: one plan-following policy per robot.
 
 The plan's Action Dependency Graph (:mod:`mrmp.centralized.dependencies`,
 Hönig et al., RA-L 2019) is cut into each robot's share: its own moves and the
 progress of others each move waits for. Every robot then runs
-:class:`~mrmp.policies.plan_following.PlanFollowingPolicy` in the simulator or
-live, learning its peers' progress only from their messages.
+:class:`~mrmp.policies.plan_following.PlanFollowingPolicy` in the simulator
+(:mod:`mrmp.experiments.execution`) or live, learning its peers' progress only
+from their messages.
 
 Examples
 --------
->>> from mrmp.core import Grid, RobotSpec, Scenario
 >>> from mrmp.centralized.plan import PlanningResult, pad_paths
->>> scenario = Scenario(Grid(1, 3), (RobotSpec("A", (0, 0), (0, 1)), RobotSpec("B", (0, 1), (0, 2))))
 >>> plan = PlanningResult("solved", pad_paths([[(0, 0), (0, 1)], [(0, 1), (0, 2)]]), 0.0, "hand")
->>> result = execute_in_simulator(scenario, plan)
->>> result.success, [robot.path for robot in result.robots]
-(True, [[(0, 0), (0, 0), (0, 1)], [(0, 1), (0, 2), (0, 2)]])
+>>> [policy.moves for policy in plan_policies(plan)]
+[[(0, 1)], [(0, 2)]]
 """
 
 from __future__ import annotations
 
 from collections.abc import Sequence
-from dataclasses import replace
 
 from mrmp.centralized.dependencies import action_dependencies
 from mrmp.centralized.plan import PlanningResult
 from mrmp.core.errors import MrmpError
-from mrmp.core.result import RunResult
-from mrmp.core.scenario import Scenario
 from mrmp.policies.plan_following import PlanFollowingPolicy
-from mrmp.sim.metrics import default_max_ticks, network_slowdown, shortest_steps
-from mrmp.sim.simulator import TickObserver, simulate
 
 
 def plan_policies(plan: PlanningResult) -> list[PlanFollowingPolicy]:
@@ -56,44 +49,3 @@ def distributed_bytes(policies: Sequence[PlanFollowingPolicy]) -> int:
     return sum(
         8 * len(policy.moves) + 12 * sum(len(needs) for needs in policy.dependencies.values()) for policy in policies
     )
-
-
-def execution_max_ticks(scenario: Scenario, plan: PlanningResult) -> int:
-    """The tick limit of a plan's execution when the scenario sets none.
-
-    Following robots wait for each other's progress messages, so an execution
-    takes longer than its plan (a crowded 34-tick plan took 127 ticks with the
-    safety layer on): ``64 + 8 * plan length``, times the network's slowdown of a
-    claim's round trip (:func:`~mrmp.sim.metrics.network_slowdown`) when guarded,
-    and never less than the simulator's own default.
-
-    >>> from mrmp.core import Grid, RobotSpec, Scenario
-    >>> from mrmp.centralized.plan import PlanningResult
-    >>> scenario = Scenario(Grid(1, 3), (RobotSpec("A", (0, 0), (0, 2)),))
-    >>> execution_max_ticks(scenario, PlanningResult("solved", [[(0, 0), (0, 1), (0, 2)]], 0.0, "hand"))
-    80
-    """
-    length = max((len(path) - 1 for path in plan.paths or ()), default=0)
-    ticks = 64 + 8 * length
-    if scenario.safety:
-        ticks = int(ticks * network_slowdown(scenario))
-    return max(ticks, default_max_ticks(scenario, shortest_steps(scenario)))
-
-
-def execute_in_simulator(
-    scenario: Scenario,
-    plan: PlanningResult,
-    *,
-    record_messages: bool = False,
-    on_tick: TickObserver | None = None,
-) -> RunResult:
-    """Run the fleet following ``plan`` in the lockstep simulator (with the scenario's network faults).
-
-    ``record_messages`` and ``on_tick`` are passed to :func:`~mrmp.sim.simulator.simulate`.
-    """
-    policies = plan_policies(plan)
-    size = distributed_bytes(policies)
-    if scenario.max_ticks is None:
-        scenario = scenario.with_changes(max_ticks=execution_max_ticks(scenario, plan))
-    result = simulate(scenario, policies=policies, record_messages=record_messages, on_tick=on_tick)
-    return replace(result, planning_time_s=plan.planning_time_s, plan_bytes=size, policy=plan.planner)

@@ -26,10 +26,25 @@ from mrmp.core.cell import Cell
 from mrmp.core.errors import Problem
 from mrmp.core.grid import Grid, connected_regions
 from mrmp.core.heading import Heading
+from mrmp.core.options import (
+    RESOLUTIONS,
+    check_settings,
+    heading_aware_setting,
+    radius_setting,
+    resolve_setting,
+    swap_setting,
+)
 
-RESOLUTIONS = ("divert", "wait")
-"""How a lower-priority robot resolves a conflict: divert (prioritized technique,
-"change of route") or wait (velocity tuning), thesis section 2.1."""
+__all__ = [
+    "RESOLUTIONS",
+    "LinkFaults",
+    "NetworkFaults",
+    "PolicyOptions",
+    "RobotSpec",
+    "Scenario",
+    "Timing",
+    "scenario_problems",
+]
 
 
 @dataclass(frozen=True)
@@ -85,20 +100,32 @@ class LinkFaults:
 
 @dataclass(frozen=True)
 class PolicyOptions:
-    """Which decision rule robots run and its settings.
+    """A scenario's ``policy`` section: which decision rule robots run, and every policy setting.
 
     ``resolve`` chooses the thesis's two collision-avoidance techniques
     (section 2.1); ``heading_aware`` makes planners charge turns (``pibt``:
     prefer fewer turns among equally near cells). ``radius`` (cells,
     Manhattan, at least 2) is how far a ``pibt`` robot's beacon reaches;
-    ``swap`` turns on ``pibt``'s swap technique.
+    ``swap`` turns on ``pibt``'s swap technique. Each setting is declared by
+    its field function in :mod:`mrmp.core.options` (help, YAML key, flag,
+    check); the settings are checked when the options are built. Each policy
+    takes the settings it reads into its own options type (the policy table,
+    :mod:`mrmp.sim.policy_table`).
+
+    >>> PolicyOptions(name="pibt", radius=1)
+    Traceback (most recent call last):
+    ...
+    mrmp.core.errors.InputError: policy.radius: must be at least 2 (cells), got 1
     """
 
     name: str = "thesis"
-    resolve: str = "divert"
-    heading_aware: bool = False
-    radius: int = 2
-    swap: bool = True
+    resolve: str = resolve_setting()
+    heading_aware: bool = heading_aware_setting()
+    radius: int = radius_setting()
+    swap: bool = swap_setting()
+
+    def __post_init__(self) -> None:
+        check_settings(self)
 
 
 @dataclass(frozen=True)
@@ -226,10 +253,6 @@ def scenario_problems(scenario: Scenario) -> list[Problem]:
         if link.sender == link.recipient:
             problems.append(Problem(f"{where}.to", "a link joins two different robots"))
         problems.extend(_fault_problems(link.faults, where))
-    if scenario.policy.radius < 2:
-        problems.append(Problem("policy.radius", f"must be at least 2 (cells), got {scenario.policy.radius}"))
-    if scenario.policy.resolve not in RESOLUTIONS:
-        problems.append(Problem("policy.resolve", f"must be one of {', '.join(RESOLUTIONS)}, got {scenario.policy.resolve!r}"))
     if scenario.max_ticks is not None and scenario.max_ticks <= 0:
         problems.append(Problem("max_ticks", f"must be positive, got {scenario.max_ticks}"))
     return problems

@@ -8,11 +8,14 @@
   moves and, for each, the progress of other robots it must wait for
   (:mod:`mrmp.centralized.dependencies`).
 
+Plans are written from anything shaped like a planner's answer (:class:`Plan`:
+a :class:`mrmp.centralized.plan.PlanningResult` is one) and read back as a
+:class:`PlanFile`, so that this module needs nothing from the planners.
+
 Examples
 --------
 >>> import tempfile, pathlib
->>> from mrmp.centralized.plan import PlanningResult
->>> plan = PlanningResult("solved", (((0, 0), (0, 1)), ((1, 1), (1, 1))), 0.25, "cbs")
+>>> plan = PlanFile("solved", (((0, 0), (0, 1)), ((1, 1), (1, 1))), 0.25, "cbs")
 >>> path = pathlib.Path(tempfile.mkdtemp()) / "plan.json"
 >>> write_plan(path, plan, ["A", "B"])
 >>> read_plan(path, ["A", "B"]).paths
@@ -23,14 +26,44 @@ from __future__ import annotations
 
 import json
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
+from typing import Protocol
 
-from mrmp.centralized.plan import PlanningResult
 from mrmp.core.cell import Cell
 from mrmp.core.errors import InputError, Problem
 from mrmp.io._files import PathLike, atomic_write_text, read_text
 
+Paths = Sequence[Sequence[Cell]]
+"""One path per robot, one cell per tick."""
 
-def write_plan(path: PathLike, plan: PlanningResult, robot_ids: Sequence[str]) -> None:
+
+class Plan(Protocol):
+    """What :func:`write_plan` needs of a plan (a planner's answer)."""
+
+    @property
+    def status(self) -> str: ...
+
+    @property
+    def paths(self) -> Paths | None: ...
+
+    @property
+    def planning_time_s(self) -> float: ...
+
+    @property
+    def planner(self) -> str: ...
+
+
+@dataclass(frozen=True)
+class PlanFile:
+    """A plan as a plan file holds it: always solved, with every robot's path."""
+
+    status: str
+    paths: tuple[tuple[Cell, ...], ...]
+    planning_time_s: float
+    planner: str
+
+
+def write_plan(path: PathLike, plan: Plan, robot_ids: Sequence[str]) -> None:
     """Write a solved plan, atomically.
 
     Raises
@@ -50,7 +83,7 @@ def write_plan(path: PathLike, plan: PlanningResult, robot_ids: Sequence[str]) -
     atomic_write_text(path, json.dumps(data) + "\n")
 
 
-def read_plan(path: PathLike, robot_ids: Sequence[str]) -> PlanningResult:
+def read_plan(path: PathLike, robot_ids: Sequence[str]) -> PlanFile:
     """Read a plan for the robots ``robot_ids`` (the scenario's, in order).
 
     Raises
@@ -71,10 +104,12 @@ def read_plan(path: PathLike, robot_ids: Sequence[str]) -> PlanningResult:
         raise InputError(Problem(where, f"the plan is for robots {ids}, the scenario has {list(robot_ids)}"))
     if any(not path for path in paths) or len({len(path) for path in paths}) > 1:
         raise InputError(Problem(where, "every robot's path must be non-empty and of the same length"))
-    return PlanningResult("solved", paths, seconds, planner)
+    return PlanFile("solved", paths, seconds, planner)
 
 
-def write_share(path: PathLike, robot_id: str, moves: Sequence[Cell], dependencies: Mapping[int, Sequence[tuple[int, int]]]) -> None:
+def write_share(
+    path: PathLike, robot_id: str, moves: Sequence[Cell], dependencies: Mapping[int, Sequence[tuple[int, int]]]
+) -> None:
     """Write one robot's share of a plan, atomically.
 
     >>> import tempfile, pathlib

@@ -75,6 +75,7 @@ from mrmp.core.cell import Cell
 from mrmp.core.errors import InputError, Problem
 from mrmp.core.grid import COST_SYMBOLS, Grid
 from mrmp.core.heading import Heading
+from mrmp.core.options import setting_types, settings
 from mrmp.core.scenario import (
     LinkFaults,
     NetworkFaults,
@@ -122,7 +123,9 @@ NETWORK_KEYS = (*FAULT_KEYS, "links")
 """Keys allowed under ``network``."""
 LINK_KEYS = ("from", "to", *FAULT_KEYS)
 """Keys allowed in each entry of ``network.links``; unset faults are the network's."""
-POLICY_KEYS = ("name", "resolve", "heading_aware", "radius", "swap")
+POLICY_SETTINGS = settings(PolicyOptions)
+"""The settings of the ``policy`` section, with their YAML keys (:mod:`mrmp.core.options`)."""
+POLICY_KEYS = ("name", *(setting.yaml_key for _, setting in POLICY_SETTINGS))
 """Keys allowed under ``policy``."""
 
 _BAD: Any = object()
@@ -511,15 +514,8 @@ class _Reader:
         network_entries = self.section(top, "network", NETWORK_KEYS)
         network = self.faults(network_entries, "network", NetworkFaults())
         links = self.links(network_entries, network)
-        policy_entries = self.section(top, "policy", POLICY_KEYS)
-        policy_values = {
-            "name": self.optional(policy_entries, "name", "policy.name", self.text),
-            "resolve": self.optional(policy_entries, "resolve", "policy.resolve", self.text),
-            "heading_aware": self.optional(policy_entries, "heading_aware", "policy.heading_aware", self.boolean),
-            "radius": self.optional(policy_entries, "radius", "policy.radius", self.integer),
-            "swap": self.optional(policy_entries, "swap", "policy.swap", self.boolean),
-        }
-        policy = PolicyOptions(**_given(policy_values))
+        policy_values = self.policy_values(self.section(top, "policy", POLICY_KEYS))
+        policy = self.policy_options(_given(policy_values))
         if (
             self.known_policies is not None
             and policy_values["name"] not in (None, _BAD)
@@ -530,6 +526,29 @@ class _Reader:
                 self.lines["policy.name"], "policy.name", f"unknown policy {policy.name!r}; known policies: {known}"
             )
         return timing, network, links, policy
+
+    def policy_values(self, entries: dict[str, _Entry] | None) -> dict[str, Any]:
+        """The ``policy`` section's values by field name: its name, then each setting read by its type."""
+        readers: dict[type, Callable[[Node, str], Any]] = {str: self.text, bool: self.boolean, int: self.integer}
+        types = setting_types(PolicyOptions)
+        values = {"name": self.optional(entries, "name", "policy.name", self.text)}
+        for option, setting in POLICY_SETTINGS:
+            values[option.name] = self.optional(entries, setting.yaml_key, setting.path, readers[types[option.name]])
+        return values
+
+    def policy_options(self, given: dict[str, Any]) -> PolicyOptions:
+        """The policy options of the well-formed ``given`` values.
+
+        A setting out of range is reported at its line and left at its default.
+        """
+        try:
+            return PolicyOptions(**given)
+        except InputError as error:
+            wrong = {problem.where for problem in error.problems}
+            for problem in error.problems:
+                self.problems.append(Problem(self.where(problem.where), f"{problem.where}: {problem.reason}"))
+        paths = {option.name: setting.path for option, setting in POLICY_SETTINGS}
+        return PolicyOptions(**{key: value for key, value in given.items() if paths.get(key) not in wrong})
 
     def faults(self, entries: dict[str, _Entry] | None, path: str, defaults: NetworkFaults) -> NetworkFaults:
         """Fault settings under ``path``; the ones not given keep their value in ``defaults``."""
@@ -852,6 +871,24 @@ def _faults_text(faults: NetworkFaults) -> str:
     )
 
 
+def _setting_text(value: object) -> str:
+    """A policy setting's value as YAML: a quoted text, true or false, a number."""
+    if isinstance(value, bool):
+        return "true" if value else "false"
+    return _quote(value) if isinstance(value, str) else str(value)
+
+
+def _policy_text(policy: PolicyOptions) -> str:
+    """The ``policy`` section's items: its name, then every setting by its YAML key.
+
+    >>> _policy_text(PolicyOptions())
+    'name: "thesis", resolve: "divert", heading_aware: false, radius: 2, swap: true'
+    """
+    items = [f"name: {_quote(policy.name)}"]
+    items += [f"{setting.yaml_key}: {_setting_text(getattr(policy, option.name))}" for option, setting in POLICY_SETTINGS]
+    return ", ".join(items)
+
+
 def scenario_to_yaml(scenario: Scenario, map_file: str | None = None) -> str:
     """The YAML text of ``scenario``, readable by :func:`scenario_from_text`.
 
@@ -905,12 +942,7 @@ def scenario_to_yaml(scenario: Scenario, map_file: str | None = None) -> str:
         for link in scenario.links:
             ends = f"from: {_quote(link.sender)}, to: {_quote(link.recipient)}"
             lines.append(f"    - {{{ends}, {_faults_text(link.faults)}}}")
-    heading_aware = "true" if policy.heading_aware else "false"
-    swap = "true" if policy.swap else "false"
-    lines.append(
-        f"policy: {{name: {_quote(policy.name)}, resolve: {_quote(policy.resolve)}, heading_aware: {heading_aware},"
-        f" radius: {policy.radius}, swap: {swap}}}"
-    )
+    lines.append(f"policy: {{{_policy_text(policy)}}}")
     if not scenario.safety:
         lines.append("safety: false")
     if scenario.lifelong:

@@ -38,7 +38,7 @@ from mrmp.live.body import Body
 from mrmp.live.driver import AgentReport, AgentTiming, LiveDriver
 from mrmp.live.transport import Transport
 from mrmp.policies.base import Policy
-from mrmp.policies.registry import make_policy
+from mrmp.sim.policy_table import make_policy
 from mrmp.protocol.auth import Opener, Sealer
 from mrmp.robot.robot import Outgoing, Robot
 

@@ -29,8 +29,8 @@ from mrmp.live.referee import IntervalReferee
 from mrmp.live.transport import ConnectedTransport, LiveFaults, Transport, is_loopback
 from mrmp.live.transport_table import FAULTS, TransportSpec
 from mrmp.policies.plan_following import PlanFollowingPolicy
-from mrmp.policies.registry import ASYNC_POLICIES
 from mrmp.protocol.auth import Opener, Sealer
+from mrmp.sim.policy_table import policy_entry
 
 
 def check_key_policy(key: bytes | None, spec: TransportSpec, warn: Callable[[str], None]) -> bytes:
@@ -126,7 +126,7 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
         sealer = Sealer(options.key, options.session)
         opener = Opener(options.key, options.session, fleet_size=len(scenario.robots))
         agent: Agent | CausalAgent
-        if scenario.policy.name in ASYNC_POLICIES:  # Causal-PIBT: always through the safety layer
+        if policy_entry(scenario.policy.name).live_driver == "causal":  # Causal-PIBT: always through the safety layer
             agent = CausalAgent(scenario, index, transport, body, sealer, opener, timing=options.timing, seed=options.seed)
         else:
             agent = Agent(

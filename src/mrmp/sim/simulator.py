@@ -41,15 +41,13 @@ from mrmp.core.heading import Heading, right_turns
 from mrmp.core.result import RobotResult, RunResult
 from mrmp.core.scenario import Scenario
 from mrmp.policies.base import Decision, Policy
-from mrmp.policies.registry import ASYNC_POLICIES, ROUND_POLICIES, make_policy
 from mrmp.protocol.codec import DecodeError, decode
 from mrmp.protocol.messages import Message
 from mrmp.robot.robot import Outgoing, Robot
 from mrmp.sim.goals import GoalBook
 from mrmp.sim.metrics import default_max_ticks, network_slowdown, shortest_steps
-from mrmp.sim.asynchronous import AsynchronousSimulator
+from mrmp.sim.policy_table import POLICY_TABLE, make_policy, policy_entry
 from mrmp.sim.referee import Referee
-from mrmp.sim.rounds import RoundsSimulator
 from mrmp.sim.ticking import TickObserver, run_result, run_ticks, scenario_network, send_counted
 
 RECURRENCE_LIMIT = 10
@@ -286,11 +284,14 @@ def message_kind(message: object) -> str:
 def records_messages(scenario: Scenario, policies: Sequence[Policy] | None = None) -> bool:
     """Whether :func:`simulate` can keep a message log for ``scenario``.
 
-    Runs in synchronous rounds (policy ``pibt``) exchange their messages
-    inside each step, and asynchronous runs (policy ``causal``) keep no log
-    either.
+    The lockstep simulator can (per-robot policies, or the ``policies`` given);
+    a message-based policy's simulator can when its policy table entry says so
+    (:mod:`mrmp.sim.policy_table`): the synchronous rounds of ``pibt`` exchange
+    their messages inside each step, and asynchronous runs (``causal``) keep
+    no log either.
     """
-    return not (scenario.policy.name in (*ROUND_POLICIES, *ASYNC_POLICIES) and policies is None)
+    entry = POLICY_TABLE.get(scenario.policy.name)
+    return policies is not None or entry is None or entry.per_robot or entry.records_messages
 
 
 def simulate(
@@ -303,10 +304,12 @@ def simulate(
 ) -> RunResult:
     """Run ``scenario`` in the lockstep simulator and return its result.
 
-    Policy ``pibt`` runs in synchronous rounds (:class:`mrmp.sim.rounds.RoundsSimulator`),
-    which calls ``on_tick`` too but keeps no message log (its ``message_log``
-    stays ``None`` even with ``record_messages``; see :func:`records_messages`); policy
-    ``causal`` runs asynchronously (:class:`mrmp.sim.asynchronous.AsynchronousSimulator`),
+    A message-based policy runs in the simulator its policy table entry names
+    (:mod:`mrmp.sim.policy_table`): ``pibt`` in synchronous rounds
+    (:class:`mrmp.sim.rounds.RoundsSimulator`), which calls ``on_tick`` too but
+    keeps no message log (its ``message_log`` stays ``None`` even with
+    ``record_messages``; see :func:`records_messages`), ``causal``
+    asynchronously (:class:`mrmp.sim.asynchronous.AsynchronousSimulator`),
     likewise without a message log.
 
     Parameters
@@ -334,12 +337,11 @@ def simulate(
     >>> sorted(set(result.message_log[1]))
     [('A', 'B', 'claim'), ('A', 'B', 'state'), ('B', 'A', 'reply'), ('B', 'A', 'state')]
     """
-    if not records_messages(scenario, policies):
+    entry = policy_entry(scenario.policy.name) if policies is None else None
+    if entry is not None and not entry.per_robot:
         if record_decisions:
             raise ValueError("decisions are recorded for per-robot policies only")
-        if scenario.policy.name in ASYNC_POLICIES:
-            return AsynchronousSimulator(scenario, on_tick=on_tick).run()
-        return RoundsSimulator(scenario, on_tick=on_tick).run()
+        return entry.simulation(scenario, on_tick=on_tick).run()
     return LockstepSimulator(
         scenario, record_decisions=record_decisions, policies=policies, record_messages=record_messages, on_tick=on_tick
     ).run()

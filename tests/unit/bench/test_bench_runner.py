@@ -11,10 +11,10 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from mrmp.bench.matrix import BenchRun
+from mrmp.experiments.matrix import BenchRun
 from mrmp.bench.runner import run_bench, run_isolated
 from mrmp.cli import app
-from mrmp.io.bench_config import load_bench_config
+from mrmp.experiments.bench_config import load_bench_config
 from mrmp.io.bench_results import read_records
 
 ROOT = Path(__file__).resolve().parents[3]

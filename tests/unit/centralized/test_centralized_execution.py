@@ -7,7 +7,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 
 from mrmp.centralized.dependencies import action_dependencies
-from mrmp.centralized.execution import execute_in_simulator, plan_policies
+from mrmp.centralized.execution import plan_policies
+from mrmp.experiments.execution import execute_in_simulator
 from mrmp.centralized.plan import PlanningResult, pad_paths
 from mrmp.core import Grid, NetworkFaults, PolicyOptions, RobotSpec, Scenario
 from mrmp.sim.referee import check_paths

@@ -24,7 +24,7 @@ from mrmp.centralized.dependencies import (
     check_executable,
     find_rotations,
 )
-from mrmp.centralized.execution import execute_in_simulator
+from mrmp.experiments.execution import execute_in_simulator
 from mrmp.centralized.plan import PlanningResult, pad_paths
 from mrmp.centralized.space_time_astar import Reservations, space_time_astar
 from mrmp.core import Grid, RobotSpec, Scenario

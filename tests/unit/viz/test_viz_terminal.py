@@ -14,7 +14,7 @@ from pathlib import Path
 import pytest
 from rich.console import Console
 
-from mrmp.centralized.execution import execute_in_simulator
+from mrmp.experiments.execution import execute_in_simulator
 from mrmp.centralized.registry import plan_with
 from mrmp.core import Grid, Heading
 from mrmp.core.scenario import PolicyOptions

@@ -16,10 +16,11 @@ from __future__ import annotations
 import time
 from dataclasses import dataclass
 
-from mrmp.centralized.execution import execute_in_simulator
 from mrmp.centralized.registry import PLANNER_NAMES, plan_with
+from mrmp.core.result import RunResult
 from mrmp.core.scenario import PolicyOptions, Scenario
-from mrmp.policies.registry import POLICY_NAMES
+from mrmp.experiments.execution import execute_in_simulator
+from mrmp.sim.policy_table import policy_names
 from mrmp.sim.simulator import simulate
 
 
@@ -44,7 +45,7 @@ class ComparisonRow:
 def compare_methods(scenario: Scenario, time_limit_s: float = 30.0) -> list[ComparisonRow]:
     """Run every decentralized policy and every central planner (with execution) on ``scenario``."""
     rows: list[ComparisonRow] = []
-    for name in POLICY_NAMES:
+    for name in policy_names():
         result = simulate(scenario.with_changes(policy=PolicyOptions(name=name, resolve=scenario.policy.resolve)))
         rows.append(_row(name, "decentralized", result, result.stop_reason))
     for name in PLANNER_NAMES:
@@ -64,7 +65,7 @@ def compare_methods(scenario: Scenario, time_limit_s: float = 30.0) -> list[Comp
     return rows
 
 
-def _row(method: str, kind: str, result, status: str) -> ComparisonRow:  # type: ignore[no-untyped-def]
+def _row(method: str, kind: str, result: RunResult, status: str) -> ComparisonRow:
     ratio = result.sum_of_costs / result.lower_bound if result.success and result.lower_bound else None
     return ComparisonRow(
         method,

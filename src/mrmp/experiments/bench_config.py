@@ -58,12 +58,12 @@ from typing import Any
 
 from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
-from mrmp.bench.matrix import BenchRun
 from mrmp.centralized.registry import PLANNER_NAMES
 from mrmp.core.errors import InputError
 from mrmp.core.grid import Grid
 from mrmp.core.map_generators import GENERATORS, complete_spec, generate, largest_region
 from mrmp.core.scenario import NetworkFaults, _fault_problems
+from mrmp.experiments.matrix import BenchRun
 from mrmp.io._files import PathLike, read_text
 from mrmp.io.movingai import read_map, read_scen_entries, scen_map_problems
 from mrmp.io.scenario_file import (
@@ -75,7 +75,7 @@ from mrmp.io.scenario_file import (
     _line,
     _Reader,
 )
-from mrmp.policies.registry import POLICY_NAMES
+from mrmp.sim.policy_table import policy_names
 
 TOP_KEYS = ("name", "maps", "agents", "policies", "seeds", "faults", "time_limit", "max_ticks", "lifelong")
 """Keys allowed at the top level of a benchmark configuration."""
@@ -84,10 +84,18 @@ FILE_MAP_KEYS = ("map", "scen", "instances", "agents")
 _GENERATOR_SETTINGS = tuple(dict.fromkeys(p.name for g in GENERATORS.values() for p in g.parameters))
 GENERATED_MAP_KEYS = ("generate", "width", "height", *_GENERATOR_SETTINGS, "seeds", "instances", "agents")
 """Keys allowed in a ``maps`` entry describing generated maps."""
-METHOD_NAMES: tuple[str, ...] = (*POLICY_NAMES, *PLANNER_NAMES)
-"""Every name ``policies`` accepts: decentralized policies, then central planners."""
 DEFAULT_TIME_LIMIT_S = 60.0
 """Wall-clock seconds a run may take when the configuration sets no ``time_limit``."""
+
+
+def method_names() -> tuple[str, ...]:
+    """Every name ``policies`` accepts: the policy table's policies, then the central planners.
+
+    >>> method_names()
+    ('thesis', 'astar', 'pibt', 'causal', 'cbs', 'pp', 'lacam')
+    """
+    return (*policy_names(), *PLANNER_NAMES)
+
 
 
 @dataclass(frozen=True)
@@ -346,9 +354,10 @@ class _BenchReader(_Reader):
             value = self.text(node, f"policies[{index}]")
             if value is _BAD:
                 continue
-            if value not in METHOD_NAMES:
+            known = method_names()
+            if value not in known:
                 self.report(_line(node), f"policies[{index}]",
-                            f"unknown policy or planner {value!r}; known: {', '.join(METHOD_NAMES)}")  # fmt: skip
+                            f"unknown policy or planner {value!r}; known: {', '.join(known)}")  # fmt: skip
             elif value in names:
                 self.report(_line(node), f"policies[{index}]", f"{value!r} is listed twice")
             else:

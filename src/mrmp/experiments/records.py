@@ -3,7 +3,7 @@
 A decentralized policy runs with :func:`mrmp.sim.simulator.simulate` (which
 hands ``pibt`` to the synchronous-rounds simulator); a central planner plans
 with :func:`mrmp.centralized.registry.plan_with` under the run's time limit
-and its plan is executed by :func:`mrmp.centralized.execution.execute_in_simulator`.
+and its plan is executed by :func:`mrmp.experiments.execution.execute_in_simulator`.
 Either way the referee's findings are in the result, and the record carries
 their count (``collisions``) next to ``success``.
 
@@ -33,11 +33,11 @@ import time
 import traceback
 from typing import Any
 
-from mrmp.bench.matrix import BenchRun, faults_to_dict
 from mrmp.core.errors import MrmpError
 from mrmp.core.map_generators import generate, random_instance
 from mrmp.core.result import RunResult
 from mrmp.core.scenario import PolicyOptions, Scenario
+from mrmp.experiments.matrix import BenchRun, faults_to_dict
 from mrmp.io.bench_results import RECORD_FORMAT, RESULT_FIELDS
 
 
@@ -139,8 +139,8 @@ def execute_run(run: BenchRun) -> dict[str, Any]:
     try:
         scenario = build_scenario(run)
         if run.kind == "centralized":
-            from mrmp.centralized.execution import execute_in_simulator
             from mrmp.centralized.registry import plan_with
+            from mrmp.experiments.execution import execute_in_simulator
 
             plan = plan_with(run.policy, scenario, time_limit_s=run.time_limit_s)
             if plan.status == "limit":

@@ -1,0 +1,155 @@
+"""Policy settings declared once: each is a dataclass field whose metadata says how it is read, written and checked.
+
+A setting's :class:`Setting` metadata gives its help text, its key under
+``policy`` in a scenario file and its ``mrmp run`` flag, and checks its value.
+The YAML reader and writer (:mod:`mrmp.io.scenario_file`) and the command line
+(:mod:`mrmp.cli`) walk :func:`settings` of
+:class:`~mrmp.core.scenario.PolicyOptions` instead of listing the settings;
+every policy's own options dataclass (:mod:`mrmp.policies.options`) declares
+the settings it reads with the same field functions and checks them when built
+(:func:`check_settings`).
+
+Examples
+--------
+>>> from dataclasses import dataclass
+>>> @dataclass(frozen=True)
+... class Example:
+...     resolve: str = resolve_setting()
+...     def __post_init__(self) -> None:
+...         check_settings(self)
+>>> [(field.name, setting.flag) for field, setting in settings(Example)]
+[('resolve', '--resolve')]
+>>> Example(resolve="wiat")
+Traceback (most recent call last):
+...
+mrmp.core.errors.InputError: policy.resolve: must be one of divert, wait, got 'wiat'
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import typing
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import Any
+
+from mrmp.core.errors import InputError, Problem
+
+RESOLUTIONS = ("divert", "wait")
+"""How a lower-priority robot resolves a conflict: divert (prioritized technique,
+"change of route") or wait (velocity tuning), thesis section 2.1."""
+
+SETTING = "mrmp.setting"
+"""The key of a field's :class:`Setting` in its dataclass metadata."""
+
+Check = Callable[[Any], "str | None"]
+"""Why a setting's value is wrong, or None when it is right."""
+
+
+def _always_right(value: object) -> str | None:
+    return None
+
+
+@dataclass(frozen=True)
+class Setting:
+    """How one policy setting is named, explained and checked.
+
+    Attributes
+    ----------
+    help:
+        One line for ``mrmp run --help``.
+    yaml_key:
+        Its key under ``policy`` in a scenario file; problems are named ``policy.<yaml_key>``.
+    flag:
+        Its ``mrmp run`` option: ``--name``, or ``--name/--no-name`` for a switch.
+    check:
+        Why a value is wrong (None when it is right).
+    """
+
+    help: str
+    yaml_key: str
+    flag: str
+    check: Check = _always_right
+
+    @property
+    def path(self) -> str:
+        """The setting's field path in a scenario, as problems name it.
+
+        >>> Setting("", "radius", "--radius").path
+        'policy.radius'
+        """
+        return f"policy.{self.yaml_key}"
+
+
+def setting(default: Any, *, help: str, yaml_key: str, flag: str, check: Check = _always_right) -> Any:
+    """A dataclass field holding a policy setting (its default, and its :class:`Setting` as metadata)."""
+    return dataclasses.field(default=default, metadata={SETTING: Setting(help, yaml_key, flag, check)})
+
+
+def settings(options_type: type) -> tuple[tuple[dataclasses.Field[Any], Setting], ...]:
+    """The setting fields of an options dataclass, in declaration order, each with its :class:`Setting`."""
+    return tuple((field, field.metadata[SETTING]) for field in dataclasses.fields(options_type) if SETTING in field.metadata)
+
+
+def setting_types(options_type: type) -> dict[str, type]:
+    """The Python type of each setting field of ``options_type``, by field name (annotations resolved).
+
+    >>> from mrmp.core.scenario import PolicyOptions
+    >>> setting_types(PolicyOptions)
+    {'resolve': <class 'str'>, 'heading_aware': <class 'bool'>, 'radius': <class 'int'>, 'swap': <class 'bool'>}
+    """
+    hints = typing.get_type_hints(options_type)
+    return {field.name: hints[field.name] for field, _ in settings(options_type)}
+
+
+def setting_problems(options: object) -> list[Problem]:
+    """Every wrong setting of an options dataclass instance, each named by its field path."""
+    problems = []
+    for field, info in settings(type(options)):
+        reason = info.check(getattr(options, field.name))
+        if reason is not None:
+            problems.append(Problem(info.path, reason))
+    return problems
+
+
+def check_settings(options: object) -> None:
+    """Raise :class:`~mrmp.core.errors.InputError` naming every wrong setting of ``options`` (for ``__post_init__``)."""
+    problems = setting_problems(options)
+    if problems:
+        raise InputError(problems)
+
+
+def _one_of_resolutions(value: object) -> str | None:
+    return None if value in RESOLUTIONS else f"must be one of {', '.join(RESOLUTIONS)}, got {value!r}"
+
+
+def _at_least_two(value: int) -> str | None:
+    return None if value >= 2 else f"must be at least 2 (cells), got {value}"
+
+
+def resolve_setting() -> Any:
+    """``resolve``: the thesis's two collision-avoidance techniques (section 2.1), ``divert`` or ``wait``."""
+    return setting(
+        "divert", help=f"Conflict resolution: {', '.join(RESOLUTIONS)}.", yaml_key="resolve", flag="--resolve",
+        check=_one_of_resolutions,
+    )
+
+
+def heading_aware_setting() -> Any:
+    """``heading_aware``: planners charge turns (``pibt``: prefer fewer turns among equally near cells)."""
+    return setting(
+        False, help="Charge turns when planning.", yaml_key="heading_aware", flag="--heading-aware/--no-heading-aware"
+    )
+
+
+def radius_setting() -> Any:
+    """``radius``: how far a ``pibt`` robot's beacon reaches (cells, Manhattan, at least 2)."""
+    return setting(
+        2, help="pibt: how far a robot's beacon reaches, in cells (at least 2).", yaml_key="radius", flag="--radius",
+        check=_at_least_two,
+    )
+
+
+def swap_setting() -> Any:
+    """``swap``: ``pibt``'s swap technique for corridors."""
+    return setting(True, help="pibt: the swap technique for corridors.", yaml_key="swap", flag="--swap/--no-swap")

@@ -1,0 +1,241 @@
+"""The one table of policies: everything the rest of mrmp asks about a policy, by name.
+
+Each :class:`PolicyEntry` says what its options are, how its robots' brains are
+built and which simulator drives them, which live driver runs it in ``mrmp
+agent`` (if any), whether its bodies always enter cells through the safety
+layer, and whether its simulator records the messages sent. :func:`simulate
+<mrmp.sim.simulator.simulate>`, the command line, ``mrmp agent``
+(:mod:`mrmp.live.process`), the benchmarks, ``mrmp compare`` and the
+conformance suite ask this table; nothing else tests a policy's name.
+
+The table lives in the simulator layer because its entries name simulators
+(which live here) and brains and decision rules (the layers below). A live
+driver lives above, in :mod:`mrmp.live`, so an entry names it by a kind that
+:mod:`mrmp.live.process` resolves.
+
+Two shapes of policy:
+
+* *per-robot*: a :class:`~mrmp.policies.base.Policy` decides for each robot
+  alone; ``decision_rule`` builds it, the lockstep simulator
+  (:class:`~mrmp.sim.simulator.LockstepSimulator`, ``simulator`` None) and the
+  live :class:`~mrmp.live.agent.Agent` run it inside a
+  :class:`~mrmp.robot.robot.Robot`;
+* *message-based*: the robots decide together with messages of their own;
+  ``simulator`` builds the brains (of type ``brain``) and runs them.
+
+Examples
+--------
+>>> policy_names()
+('thesis', 'astar', 'pibt', 'causal')
+>>> policy_entry("pibt").simulator.__name__, policy_entry("pibt").live_driver
+('RoundsSimulator', None)
+>>> make_policy(PolicyOptions(name="thesis", resolve="wait")).resolve
+'wait'
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Iterator
+from contextlib import contextmanager
+from dataclasses import dataclass
+from typing import Any, Protocol
+
+from mrmp.core.errors import InputError, Problem
+from mrmp.core.result import RunResult
+from mrmp.core.scenario import PolicyOptions, Scenario, Timing
+from mrmp.policies.astar import AstarPolicy
+from mrmp.policies.base import Policy
+from mrmp.policies.options import AstarOptions, CausalOptions, PibtOptions, ThesisOptions, options_from
+from mrmp.policies.thesis import ThesisPolicy
+from mrmp.robot.causal_pibt import CausalRobot
+from mrmp.robot.pibt_robot import PibtRobot
+from mrmp.robot.robot import Robot
+from mrmp.sim.asynchronous import AsynchronousSimulator
+from mrmp.sim.rounds import RoundsSimulator
+from mrmp.sim.ticking import TickObserver
+
+
+class Simulation(Protocol):
+    """What a message-based policy's simulator gives: its brains, and a run to the end."""
+
+    robots: Any
+
+    def run(self) -> RunResult:
+        """Run to the end and return the result."""
+        ...
+
+
+SimulatorFactory = Callable[..., Simulation]
+"""A simulator class (or function) called as ``simulator(scenario, on_tick=on_tick)``."""
+
+DecisionRule = Callable[[Any, Timing], Policy]
+"""Builds one robot's per-robot :class:`~mrmp.policies.base.Policy` from the policy's options and the robots' timing."""
+
+
+@dataclass(frozen=True)
+class PolicyEntry:
+    """One policy: the answers to everything the rest of mrmp asks about it.
+
+    Attributes
+    ----------
+    name:
+        What a scenario's ``policy.name`` and ``--policy`` say.
+    options:
+        Its options dataclass (:mod:`mrmp.policies.options`), built from the
+        scenario's :class:`~mrmp.core.scenario.PolicyOptions` by :meth:`options_of`.
+    brain:
+        The type of its robots' brains.
+    decision_rule:
+        Per-robot policies: builds one robot's decision rule. None for a
+        message-based policy (its simulator builds its brains).
+    simulator:
+        Message-based policies: the simulator that builds and runs its brains.
+        None for a per-robot policy (the lockstep simulator runs it).
+    live_driver:
+        The kind of live driver that runs it in ``mrmp agent`` (``"agent"``:
+        the per-robot :class:`~mrmp.live.agent.Agent`; ``"causal"``:
+        :class:`~mrmp.live.causal_agent.CausalAgent`), or None when it is simulated only.
+    runs:
+        Message-based policies: how they run, for the error of asking them for a per-robot rule.
+    not_live:
+        With no live driver: why, for the ``--live`` error message.
+    always_guarded:
+        Its bodies always enter cells through the safety layer (it has no ``--unsafe`` form).
+    records_messages:
+        Its simulator can keep a message log (``--show-messages``).
+    """
+
+    name: str
+    options: type
+    brain: type
+    decision_rule: DecisionRule | None = None
+    simulator: SimulatorFactory | None = None
+    live_driver: str | None = None
+    runs: str = ""
+    not_live: str = ""
+    always_guarded: bool = False
+    records_messages: bool = False
+
+    @property
+    def per_robot(self) -> bool:
+        """Whether each robot decides alone with a :class:`~mrmp.policies.base.Policy`."""
+        return self.decision_rule is not None
+
+    def options_of(self, policy: PolicyOptions) -> Any:
+        """This policy's options, from the settings of a scenario's ``policy`` section."""
+        return options_from(self.options, policy)
+
+    def make_policy(self, policy: PolicyOptions, timing: Timing) -> Policy:
+        """A fresh per-robot decision rule for one robot.
+
+        Raises
+        ------
+        InputError
+            If this is a message-based policy (it has no per-robot form).
+        """
+        if self.decision_rule is None:
+            raise InputError(Problem("policy.name", f"{self.name!r} {self.runs}, not as a per-robot policy"))
+        return self.decision_rule(self.options_of(policy), timing)
+
+    def simulation(self, scenario: Scenario, on_tick: TickObserver | None = None) -> Simulation:
+        """This message-based policy's simulator, set up for ``scenario``."""
+        if self.simulator is None:
+            raise ValueError(f"{self.name} is a per-robot policy: the lockstep simulator runs it")
+        return self.simulator(scenario, on_tick=on_tick)
+
+
+POLICY_TABLE: dict[str, PolicyEntry] = {
+    "thesis": PolicyEntry(
+        "thesis",
+        ThesisOptions,
+        Robot,
+        decision_rule=lambda options, timing: ThesisPolicy(resolve=options.resolve),
+        live_driver="agent",
+        records_messages=True,
+    ),
+    "astar": PolicyEntry(
+        "astar",
+        AstarOptions,
+        Robot,
+        decision_rule=lambda options, timing: AstarPolicy(
+            resolve=options.resolve, heading_aware=options.heading_aware, timing=timing
+        ),
+        live_driver="agent",
+        records_messages=True,
+    ),
+    "pibt": PolicyEntry(
+        "pibt",
+        PibtOptions,
+        PibtRobot,
+        simulator=RoundsSimulator,
+        runs="runs in synchronous rounds (mrmp.sim.rounds)",
+        not_live="runs in the simulator's synchronous rounds only; its live, asynchronous form is --policy causal",
+    ),
+    "causal": PolicyEntry(
+        "causal",
+        CausalOptions,
+        CausalRobot,
+        simulator=AsynchronousSimulator,
+        runs="runs asynchronously (mrmp.sim.asynchronous)",
+        live_driver="causal",
+        always_guarded=True,
+    ),
+}
+"""Every policy a scenario or ``--policy`` may name, in the order they are listed and compared."""
+
+
+def policy_names() -> tuple[str, ...]:
+    """Every policy's name, in table order."""
+    return tuple(POLICY_TABLE)
+
+
+def policy_entry(name: str) -> PolicyEntry:
+    """The table's entry for ``name``.
+
+    Raises
+    ------
+    InputError
+        If no policy has that name.
+
+    >>> policy_entry("greedy")
+    Traceback (most recent call last):
+    ...
+    mrmp.core.errors.InputError: policy.name: unknown policy 'greedy'; known: thesis, astar, pibt, causal
+    """
+    try:
+        return POLICY_TABLE[name]
+    except KeyError:
+        raise InputError(
+            Problem("policy.name", f"unknown policy {name!r}; known: {', '.join(policy_names())}")
+        ) from None
+
+
+def make_policy(options: PolicyOptions, timing: Timing | None = None) -> Policy:
+    """A fresh per-robot decision rule for one robot, for the policy ``options.name``.
+
+    Raises
+    ------
+    InputError
+        If ``options.name`` is not a known per-robot policy.
+    """
+    return policy_entry(options.name).make_policy(options, timing or Timing())
+
+
+@contextmanager
+def registered(entry: PolicyEntry) -> Iterator[PolicyEntry]:
+    """Add ``entry`` to the table for the duration of a ``with`` block (for a policy defined outside mrmp, or a test).
+
+    >>> toy = PolicyEntry("toy", ThesisOptions, Robot, decision_rule=POLICY_TABLE["thesis"].decision_rule)
+    >>> with registered(toy):
+    ...     policy_names()[-1]
+    'toy'
+    >>> "toy" in policy_names()
+    False
+    """
+    if entry.name in POLICY_TABLE:
+        raise ValueError(f"a policy named {entry.name!r} is already in the table")
+    POLICY_TABLE[entry.name] = entry
+    try:
+        yield entry
+    finally:
+        del POLICY_TABLE[entry.name]
