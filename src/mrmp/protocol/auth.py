@@ -158,6 +158,7 @@ class Opener:
         self.accepted += 1
         return message
 
-    def _reject(self, reason: str) -> None:
+    def _reject(self, reason: str) -> Message | None:
+        """Count a datagram rejected for ``reason``; :meth:`open` answers it with what this returns, None."""
         self.rejected[reason] += 1
         return None

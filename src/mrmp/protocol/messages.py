@@ -32,7 +32,8 @@ Examples
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
+from typing import Self
 
 from mrmp.core.cell import Cell
 from mrmp.core.heading import Heading
@@ -41,8 +42,33 @@ NO_CELL: Cell = (-(2**31), -(2**31))
 """Placeholder cell on the wire where a message has no cell to give."""
 
 
+class Message:
+    """What every message carries first: its sender's index and the sender's sequence number.
+
+    Every message type derives from it, as a frozen dataclass that declares
+    ``sender`` and ``seq`` as its first two fields;
+    :mod:`mrmp.protocol.wire` keeps the table of the types the codec puts on
+    the wire.
+    """
+
+    __slots__ = ()
+    sender: int
+    seq: int
+
+    def with_seq(self, seq: int) -> Self:
+        """This message with sequence number ``seq``."""
+        return replace(self, seq=seq)  # type: ignore[type-var]
+
+
+class PibtMessage(Message):
+    """A message of decentralized PIBT (:mod:`mrmp.robot.pibt_robot`): it belongs to one ``step``, its third field."""
+
+    __slots__ = ()
+    step: int
+
+
 @dataclass(frozen=True, slots=True)
-class StateMessage:
+class StateMessage(Message):
     """A robot's Present and Next cells (thesis section 3.4) and its safety state.
 
     Attributes
@@ -91,7 +117,7 @@ class StateMessage:
 
 
 @dataclass(frozen=True, slots=True)
-class ClaimMessage:
+class ClaimMessage(Message):
     """A request to register ``cell`` to the sender, for its claim number ``claim``."""
 
     sender: int
@@ -101,7 +127,7 @@ class ClaimMessage:
 
 
 @dataclass(frozen=True, slots=True)
-class ReplyMessage:
+class ReplyMessage(Message):
     """The answer to claim ``claim`` of robot ``claimant`` for ``cell``: granted or refused."""
 
     sender: int
@@ -113,7 +139,7 @@ class ReplyMessage:
 
 
 @dataclass(frozen=True, slots=True)
-class BeaconMessage:
+class BeaconMessage(PibtMessage):
     """PIBT, one step: the sender's cell, goal and priority, to every robot within the radio radius.
 
     The priority of a robot is ``(elapsed, tie, -index)``, compared as a tuple:
@@ -132,7 +158,7 @@ class BeaconMessage:
 
 
 @dataclass(frozen=True, slots=True)
-class InheritMessage:
+class InheritMessage(PibtMessage):
     """PIBT priority inheritance: the sender reserved ``cell``, the recipient's cell; the recipient must decide."""
 
     sender: int
@@ -142,7 +168,7 @@ class InheritMessage:
 
 
 @dataclass(frozen=True, slots=True)
-class AnswerMessage:
+class AnswerMessage(PibtMessage):
     """The answer to an :class:`InheritMessage`: whether the sender could leave its cell (``moved``)."""
 
     sender: int
@@ -152,7 +178,7 @@ class AnswerMessage:
 
 
 @dataclass(frozen=True, slots=True)
-class ReserveMessage:
+class ReserveMessage(PibtMessage):
     """The sender reserved ``cell`` for the end of step ``step`` (its latest reservation replaces earlier ones)."""
 
     sender: int
@@ -162,7 +188,7 @@ class ReserveMessage:
 
 
 @dataclass(frozen=True, slots=True)
-class PullMessage:
+class PullMessage(PibtMessage):
     """The swap technique: the sender leaves ``cell`` and asks the recipient to follow into it."""
 
     sender: int
@@ -191,7 +217,7 @@ RELEASE_OPERATIONS = CLEAR_PARENT | REMOVE_CHILD | ADD_CHILD | CONTRACT | SET_VI
 
 
 @dataclass(frozen=True, slots=True)
-class LockRequestMessage:
+class LockRequestMessage(Message):
     """Causal-PIBT: lock the recipient for the sender's activation number ``session``."""
 
     sender: int
@@ -200,7 +226,7 @@ class LockRequestMessage:
 
 
 @dataclass(frozen=True, slots=True)
-class LockGrantMessage:
+class LockGrantMessage(Message):
     """Causal-PIBT: the sender is locked for activation ``session`` of robot ``locker``; its state.
 
     ``mode`` is 0 contracted, 1 requesting, 2 extended; ``head`` is None when
@@ -225,7 +251,7 @@ class LockGrantMessage:
 
 
 @dataclass(frozen=True, slots=True)
-class LockReleaseMessage:
+class LockReleaseMessage(Message):
     """Causal-PIBT: the end of activation ``session`` of the sender, with what it wrote into the recipient.
 
     ``operations`` is a set of bits (:data:`RELEASE_OPERATIONS`): clear the
@@ -244,20 +270,10 @@ class LockReleaseMessage:
 
 
 @dataclass(frozen=True, slots=True)
-class LockAckMessage:
+class LockAckMessage(Message):
     """Causal-PIBT: the sender took in the release of activation ``session`` of robot ``locker``."""
 
     sender: int
     seq: int
     locker: int
     session: int
-
-
-CausalMessage = LockRequestMessage | LockGrantMessage | LockReleaseMessage | LockAckMessage
-"""The messages of Causal-PIBT's locks (:mod:`mrmp.robot.causal_pibt`)."""
-
-PibtMessage = BeaconMessage | InheritMessage | AnswerMessage | ReserveMessage | PullMessage
-"""The messages of decentralized PIBT (:mod:`mrmp.robot.pibt_robot`)."""
-
-Message = StateMessage | ClaimMessage | ReplyMessage | PibtMessage | CausalMessage
-"""Every message type the codec knows."""

@@ -97,7 +97,7 @@ from mrmp.protocol.messages import (
     StateMessage,
 )
 from mrmp.protocol.safety import SafetyLayer
-from mrmp.robot.messaging import MessageEndpoint, Outgoing
+from mrmp.robot.messaging import Handlers, MessageEndpoint, Outgoing
 from mrmp.search.flat_map import FlatMap
 
 __all__ = [
@@ -593,25 +593,45 @@ class CausalRobot(MessageEndpoint):
         if sender == self.index or not 0 <= sender < self.safety.fleet_size:
             self.dropped["own" if sender == self.index else "unknown_sender"] += 1
             return []
-        if isinstance(message, StateMessage):
-            self._take_state(message, now)
+        handler = self.handlers.get(message)
+        if handler is None:
+            self.dropped["other_type"] += 1
             return []
-        if isinstance(message, ClaimMessage):
-            _, cells = self.known.get(sender, (0, (message.cell,)))
-            return self._answer_claim(message, cells[0], self.tail)
-        if isinstance(message, ReplyMessage):
-            self.safety.handle_reply(message, now)
-            return []
-        if isinstance(message, LockRequestMessage):
-            return self._take_request(message)
-        if isinstance(message, LockGrantMessage):
-            return self._take_grant(message, now)
-        if isinstance(message, LockReleaseMessage):
-            return self._take_release(message, now)
-        if isinstance(message, LockAckMessage):
-            self._take_ack(message)
-            return []
-        self.dropped["other_type"] += 1
+        return handler(self, message, now)
+
+    handlers = Handlers()
+    """What the robot does with each type of message (others are dropped and counted)."""
+
+    @handlers.on(StateMessage)
+    def _on_state(self, message: StateMessage, now: float) -> list[Outgoing]:
+        self._take_state(message, now)
+        return []
+
+    @handlers.on(ClaimMessage)
+    def _on_claim(self, message: ClaimMessage, now: float) -> list[Outgoing]:
+        _, cells = self.known.get(message.sender, (0, (message.cell,)))
+        return self._answer_claim(message, cells[0], self.tail)
+
+    @handlers.on(ReplyMessage)
+    def _on_reply(self, message: ReplyMessage, now: float) -> list[Outgoing]:
+        self.safety.handle_reply(message, now)
+        return []
+
+    @handlers.on(LockRequestMessage)
+    def _on_lock_request(self, message: LockRequestMessage, now: float) -> list[Outgoing]:
+        return self._take_request(message)
+
+    @handlers.on(LockGrantMessage)
+    def _on_lock_grant(self, message: LockGrantMessage, now: float) -> list[Outgoing]:
+        return self._take_grant(message, now)
+
+    @handlers.on(LockReleaseMessage)
+    def _on_lock_release(self, message: LockReleaseMessage, now: float) -> list[Outgoing]:
+        return self._take_release(message, now)
+
+    @handlers.on(LockAckMessage)
+    def _on_lock_ack(self, message: LockAckMessage, now: float) -> list[Outgoing]:
+        self._take_ack(message)
         return []
 
     def _take_state(self, message: StateMessage, now: float) -> None:

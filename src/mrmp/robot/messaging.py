@@ -1,6 +1,9 @@
 """What every robot brain does with messages alike: numbering what it sends, answering claims, decoding.
 
-What a brain sends is a list of :class:`Outgoing`. Every message a robot
+What every brain sends is a list of :class:`Outgoing`: a message, and to
+whom (named robots, every robot within a radio radius, or every peer).
+Every brain takes in what it receives through a :class:`Handlers` table, from
+message type to the method that takes messages of that type in. Every message a robot
 sends carries the next number of the robot's sequence (``seq``), so that
 receivers can tell newer states from older ones; its state message carries the
 safety layer's part (:meth:`~mrmp.protocol.safety.SafetyLayer.state_fields`).
@@ -25,7 +28,8 @@ Examples
 from __future__ import annotations
 
 from collections import Counter
-from dataclasses import dataclass, replace
+from collections.abc import Callable
+from typing import Any, NamedTuple, TypeVar
 
 from mrmp.core.cell import Cell
 from mrmp.core.heading import Heading
@@ -34,13 +38,55 @@ from mrmp.protocol.codec import DecodeError, decode
 from mrmp.protocol.messages import ClaimMessage, Message, StateMessage
 from mrmp.protocol.safety import SafetyLayer
 
+M = TypeVar("M", bound=Message)
+F = TypeVar("F", bound=Callable[..., Any])
 
-@dataclass(frozen=True, slots=True)
-class Outgoing:
-    """A message to send; ``recipients`` None means every peer."""
+
+class Outgoing(NamedTuple):
+    """A message to send, to ``recipients``; when None, to every robot within ``radius`` cells (None: every peer).
+
+    >>> Outgoing(ClaimMessage(0, 1, 1, (0, 1)), (2,)).recipients
+    (2,)
+    """
 
     message: Message
     recipients: tuple[int, ...] | None = None
+    radius: int | None = None
+
+
+class Handlers:
+    """A brain's table from message type to the method that takes messages of that type in.
+
+    >>> class Echo:
+    ...     handlers = Handlers()
+    ...     @handlers.on(ClaimMessage)
+    ...     def _take_claim(self, message, now):
+    ...         return [Outgoing(message, (message.sender,))]
+    >>> handler = Echo.handlers.get(ClaimMessage(3, 1, 1, (0, 1)))
+    >>> [sent.recipients for sent in handler(Echo(), ClaimMessage(3, 1, 1, (0, 1)), 0.0)]
+    [(3,)]
+    >>> Echo.handlers.get(StateMessage(3, 1, (0, 0), (0, 0))) is None
+    True
+    """
+
+    __slots__ = ("_table",)
+
+    def __init__(self) -> None:
+        self._table: dict[type, Callable[..., Any]] = {}
+
+    def on(self, *kinds: type[Message]) -> Callable[[F], F]:
+        """Decorate the method that takes in messages of the types ``kinds``."""
+
+        def register(method: F) -> F:
+            for kind in kinds:
+                self._table[kind] = method
+            return method
+
+        return register
+
+    def get(self, message: Message) -> Callable[..., Any] | None:
+        """The method (unbound) that takes in ``message``, or None when the brain has none for its type."""
+        return self._table.get(type(message))
 
 
 class MessageEndpoint:
@@ -55,9 +101,10 @@ class MessageEndpoint:
     dropped: Counter[str]
     safety: SafetyLayer
 
-    def _stamp(self, message: Message) -> Message:
+    def _stamp(self, message: M) -> M:
+        """``message`` with this robot's next sequence number."""
         self.seq += 1
-        return replace(message, seq=self.seq)
+        return message.with_seq(self.seq)
 
     def _state(self, present: Cell, next: Cell, heading: Heading, arrived: bool, progress: int = 0) -> StateMessage:
         """A fresh state message with the next sequence number and the safety layer's state."""

@@ -74,7 +74,6 @@ from __future__ import annotations
 
 import random
 from collections import Counter
-from typing import NamedTuple
 
 from mrmp.core.heading import Heading
 from mrmp.policies.pibt_rules import heading_candidates, sorted_candidates, swap_possible, swap_required
@@ -82,26 +81,20 @@ from mrmp.protocol.messages import (
     AnswerMessage,
     BeaconMessage,
     InheritMessage,
+    Message,
     PibtMessage,
     PullMessage,
     ReserveMessage,
 )
+from mrmp.robot.messaging import Handlers, Outgoing
 from mrmp.search.flat_map import FlatMap
 
-__all__ = ["MIN_RADIUS", "RESERVE_RADIUS", "PibtRobot", "Transmission"]
+__all__ = ["MIN_RADIUS", "RESERVE_RADIUS", "PibtRobot"]
 
 MIN_RADIUS = 2
 """The smallest radio radius PIBT works with: two robots two cells apart may want the same cell."""
 RESERVE_RADIUS = 2
 """Reservations go to every robot within 2 cells: all that could want the cell, or push the sender."""
-
-
-class Transmission(NamedTuple):
-    """A message to send: to robot ``recipient``, or (``recipient`` None) to every robot within ``radius`` cells."""
-
-    message: PibtMessage
-    recipient: int | None = None
-    radius: int = 0
 
 
 class PibtRobot:
@@ -183,7 +176,7 @@ class PibtRobot:
         self._reserved: dict[int, int] = {}
         self._targets: dict[int, int] = {}
         self._seen: set[tuple[int, int]] = set()
-        self._control: list[PibtMessage] = []
+        self._control: list[Message] = []
         self._settled: set[int] = set()  # cells where, as far as the robot heard, a robot stands on its own goal
         # the robot's own PIBT call, while it runs
         self._candidates: list[int] = []
@@ -215,7 +208,7 @@ class PibtRobot:
 
     # -- the step ------------------------------------------------------------------
 
-    def begin_step(self, step: int) -> list[Transmission]:
+    def begin_step(self, step: int) -> list[Outgoing]:
         """Start step ``step``: forget the last step's view and announce cell, goal and priority."""
         self.step = step
         self.target = None
@@ -232,7 +225,7 @@ class PibtRobot:
         beacon = BeaconMessage(
             self.index, self.seq, step, cells[self.present], cells[self.goal], self.elapsed, self.tie, self.heading
         )
-        return [Transmission(beacon, None, self.radius)]
+        return [Outgoing(beacon, None, self.radius)]
 
     def receive(self, message: PibtMessage) -> bool:
         """Take in a message delivered this round; act on it in :meth:`act`.
@@ -253,24 +246,31 @@ class PibtRobot:
         seen.add(key)
         return self.receive_once(message)
 
-    def receive_once(self, message: PibtMessage) -> bool:
+    def receive_once(self, message: Message) -> bool:
         """:meth:`receive` for a driver that delivers every message exactly once, in its step (a perfect network).
 
         The same effect and answer, without the checks for stale messages and
         second copies, which such a driver never delivers.
         """
-        sender = message.sender
-        kind = type(message)
-        if kind is BeaconMessage:
-            self.receive_beacons([message])  # type: ignore[list-item]
-            return False
-        if kind is ReserveMessage:
-            cell = self.flat.index(message.cell)  # type: ignore[union-attr]
-            self._reserved[cell] = sender
-            self._targets[sender] = cell
+        inform = self.informing.get(message)
+        if inform is not None:
+            inform(self, message)
             return False
         self._control.append(message)
         return True
+
+    informing = Handlers()
+    """Messages that only inform (taken in on receipt); the others wait for :meth:`act`."""
+
+    @informing.on(BeaconMessage)
+    def _take_beacon(self, message: BeaconMessage) -> None:
+        self.receive_beacons([message])
+
+    @informing.on(ReserveMessage)
+    def _take_reservation(self, message: ReserveMessage) -> None:
+        cell = self.flat.index(message.cell)
+        self._reserved[cell] = message.sender
+        self._targets[message.sender] = cell
 
     def receive_beacons(self, beacons: list[BeaconMessage]) -> None:
         """Take in this step's beacons, each delivered exactly once (a perfect network), in one call.
@@ -289,42 +289,54 @@ class PibtRobot:
             if cell == goal:
                 settled.add(cell)
 
-    def act(self) -> list[Transmission]:
+    def act(self) -> list[Outgoing]:
         """Act on the requests and answers of this round; return what to send."""
         if not self._control:
             return []
         control, self._control = self._control, []
-        out: list[Transmission] = []
+        out: list[Outgoing] = []
+        requests = self.requests
         for message in control:
-            kind = type(message)
-            if kind is InheritMessage:
-                if self.target is not None:
-                    self.dropped["late_inherit"] += 1  # cannot happen in synchronous rounds; refuse
-                    out.append(Transmission(AnswerMessage(self.index, self._seq(), self.step, False), message.sender))
-                    continue
-                self._reserved[self.present] = message.sender
-                self._targets[message.sender] = self.present
-                self._parent = message.sender
-                self._begin_call(out)
-            elif kind is AnswerMessage:
-                if message.sender != self._waiting:
-                    self.dropped["unexpected_answer"] += 1
-                    continue
-                self._waiting = None
-                if message.moved:  # type: ignore[union-attr]
-                    self._finish(True, out)
-                else:
-                    self._next += 1  # backtracking: the pushed robot stays; try the next cell
-                    self._continue(out)
-            elif kind is PullMessage:
-                cell = self.flat.index(message.cell)  # type: ignore[union-attr]
-                if self.target is None and cell not in self._reserved:
-                    self._reserve(cell, out)
+            handler = requests.get(message)
+            if handler is not None:
+                handler(self, message, out)
         return out
 
-    def start(self) -> list[Transmission]:
+    requests = Handlers()
+    """Messages that ask the robot to act (taken in by :meth:`act`)."""
+
+    @requests.on(InheritMessage)
+    def _take_inherit(self, message: InheritMessage, out: list[Outgoing]) -> None:
+        if self.target is not None:
+            self.dropped["late_inherit"] += 1  # cannot happen in synchronous rounds; refuse
+            out.append(Outgoing(AnswerMessage(self.index, self._seq(), self.step, False), (message.sender,)))
+            return
+        self._reserved[self.present] = message.sender
+        self._targets[message.sender] = self.present
+        self._parent = message.sender
+        self._begin_call(out)
+
+    @requests.on(AnswerMessage)
+    def _take_answer(self, message: AnswerMessage, out: list[Outgoing]) -> None:
+        if message.sender != self._waiting:
+            self.dropped["unexpected_answer"] += 1
+            return
+        self._waiting = None
+        if message.moved:
+            self._finish(True, out)
+        else:
+            self._next += 1  # backtracking: the pushed robot stays; try the next cell
+            self._continue(out)
+
+    @requests.on(PullMessage)
+    def _take_pull(self, message: PullMessage, out: list[Outgoing]) -> None:
+        cell = self.flat.index(message.cell)
+        if self.target is None and cell not in self._reserved:
+            self._reserve(cell, out)
+
+    def start(self) -> list[Outgoing]:
         """This robot's turn to decide (it is the highest-priority robot not yet decided)."""
-        out: list[Transmission] = []
+        out: list[Outgoing] = []
         if self.target is None:
             self._begin_call(out)
         return out
@@ -341,14 +353,14 @@ class PibtRobot:
 
     # -- PIBT's call, by messages -------------------------------------------------------
 
-    def _reserve(self, cell: int, out: list[Transmission]) -> None:
+    def _reserve(self, cell: int, out: list[Outgoing]) -> None:
         self.target = cell
         self._reserved[cell] = self.index
         self._targets[self.index] = cell
         self.seq += 1
-        out.append(Transmission(ReserveMessage(self.index, self.seq, self.step, self.flat.cells[cell]), None, RESERVE_RADIUS))
+        out.append(Outgoing(ReserveMessage(self.index, self.seq, self.step, self.flat.cells[cell]), None, RESERVE_RADIUS))
 
-    def _begin_call(self, out: list[Transmission]) -> None:
+    def _begin_call(self, out: list[Outgoing]) -> None:
         flat = self.flat
         distances = flat.distances(self.goal)
         if self.heading_aware:
@@ -375,7 +387,7 @@ class PibtRobot:
         self._next = 0
         self._continue(out)
 
-    def _continue(self, out: list[Transmission]) -> None:
+    def _continue(self, out: list[Outgoing]) -> None:
         here = self.present
         reserved, occupants, targets = self._reserved, self._occupants, self._targets
         candidates = self._candidates
@@ -391,23 +403,23 @@ class PibtRobot:
             self._reserve(cell, out)
             if occupant is not None and occupant != self.index and occupant not in targets:
                 self._waiting = occupant  # priority inheritance
-                out.append(Transmission(InheritMessage(self.index, self._seq(), self.step, self.flat.cell(cell)), occupant))
+                out.append(Outgoing(InheritMessage(self.index, self._seq(), self.step, self.flat.cell(cell)), (occupant,)))
                 return
             self._finish(True, out)
             return
         self._reserve(here, out)  # no candidate left: stay
         self._finish(False, out)
 
-    def _finish(self, moved: bool, out: list[Transmission]) -> None:
+    def _finish(self, moved: bool, out: list[Outgoing]) -> None:
         pulled = self._pulled
         if moved and self._next == 0 and pulled is not None:
             here = self.present
             if pulled not in self._targets and here not in self._reserved:
                 self._reserved[here] = pulled
                 self._targets[pulled] = here
-                out.append(Transmission(PullMessage(self.index, self._seq(), self.step, self.flat.cell(here)), pulled))
+                out.append(Outgoing(PullMessage(self.index, self._seq(), self.step, self.flat.cell(here)), (pulled,)))
         if self._parent is not None:
-            out.append(Transmission(AnswerMessage(self.index, self._seq(), self.step, moved), self._parent))
+            out.append(Outgoing(AnswerMessage(self.index, self._seq(), self.step, moved), (self._parent,)))
             self._parent = None
 
     def _swap_partner(self, candidates: list[int], distances: list[float]) -> int | None:

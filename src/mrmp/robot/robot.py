@@ -54,7 +54,7 @@ from mrmp.policies.base import Decision, Policy, Situation
 from mrmp.protocol.messages import ClaimMessage, Message, ReplyMessage, StateMessage
 from mrmp.protocol.safety import SafetyLayer
 from mrmp.robot.belief import Belief
-from mrmp.robot.messaging import MessageEndpoint, Outgoing
+from mrmp.robot.messaging import Handlers, MessageEndpoint, Outgoing
 
 __all__ = ["Outgoing", "Robot"]
 
@@ -197,18 +197,29 @@ class Robot(MessageEndpoint):
 
     # -- messages in ----------------------------------------------------------------------
 
+    handlers = Handlers()
+    """What the robot does with each type of message (others it ignores)."""
+
     def receive(self, message: Message, now: float) -> list[Outgoing]:
         """Take in a decoded message from a peer; return the answer to a claim, if any."""
         if message.sender == self.index:
             self.dropped["own"] += 1
             return []
-        if isinstance(message, StateMessage):
-            self.belief.update(message, now)
-            self.safety.handle_state(message)
-            return []
-        if isinstance(message, ClaimMessage):
-            peer = self.belief.peers.get(message.sender)
-            return self._answer_claim(message, peer.present if peer is not None else message.cell, self.present)
-        if isinstance(message, ReplyMessage):
-            self.safety.handle_reply(message, now)
+        handler = self.handlers.get(message)
+        return handler(self, message, now) if handler is not None else []
+
+    @handlers.on(StateMessage)
+    def _take_state(self, message: StateMessage, now: float) -> list[Outgoing]:
+        self.belief.update(message, now)
+        self.safety.handle_state(message)
+        return []
+
+    @handlers.on(ClaimMessage)
+    def _take_claim(self, message: ClaimMessage, now: float) -> list[Outgoing]:
+        peer = self.belief.peers.get(message.sender)
+        return self._answer_claim(message, peer.present if peer is not None else message.cell, self.present)
+
+    @handlers.on(ReplyMessage)
+    def _take_reply(self, message: ReplyMessage, now: float) -> list[Outgoing]:
+        self.safety.handle_reply(message, now)
         return []

@@ -49,13 +49,14 @@ from collections import Counter
 from collections.abc import Sequence
 from operator import attrgetter
 
-from mrmp.core.heading import right_turns
 from mrmp.core.faults import message_fates
+from mrmp.core.heading import right_turns
 from mrmp.core.result import RobotResult, RunResult
 from mrmp.core.scenario import NetworkFaults, Scenario
-from mrmp.protocol.codec import encode
-from mrmp.protocol.messages import AnswerMessage, BeaconMessage, InheritMessage, PullMessage, ReserveMessage
-from mrmp.robot.pibt_robot import RESERVE_RADIUS, PibtRobot, Transmission
+from mrmp.protocol.codec import fixed_sizes
+from mrmp.protocol.messages import BeaconMessage, Message, ReserveMessage  # noqa: F401  (ReserveMessage: doctest)
+from mrmp.robot.messaging import Outgoing
+from mrmp.robot.pibt_robot import RESERVE_RADIUS, PibtRobot
 from mrmp.search.flat_map import FlatMap
 from mrmp.sim.goals import GoalBook
 from mrmp.sim.metrics import default_max_ticks, network_slowdown, shortest_steps
@@ -69,25 +70,13 @@ MAX_TRIES = 64
 NO_ROBOT = -1
 """No robot on a cell."""
 
-_SIZES = {
-    kind: len(encode(sample))
-    for kind, sample in (
-        (BeaconMessage, BeaconMessage(0, 0, 0, (0, 0), (0, 0), 0, 0)),
-        (InheritMessage, InheritMessage(0, 0, 0, (0, 0))),
-        (AnswerMessage, AnswerMessage(0, 0, 0, False)),
-        (ReserveMessage, ReserveMessage(0, 0, 0, (0, 0))),
-        (PullMessage, PullMessage(0, 0, 0, (0, 0))),
-    )
-}
-
-
 def message_size(message: object) -> int:
     """Bytes of ``message`` on the wire (every message of a PIBT type has the same size).
 
     >>> message_size(ReserveMessage(3, 1, 7, (2, 2)))
     22
     """
-    return _SIZES[type(message)]
+    return fixed_sizes()[type(message)]
 
 
 class _CutLink(Exception):
@@ -167,6 +156,7 @@ class RoundsSimulator:
         self._receivers = [robot.receive_once for robot in self.robots]  # the perfect network's deliveries
         self._group_of: list[int] = []
         self.stats: Counter[str] = Counter()
+        self._sizes = fixed_sizes()  # bytes of each message type on the wire, from the message table
         self._goals = GoalBook(scenario.seed, grid.free_cells() if scenario.lifelong else [])
 
     def _default_max_ticks(self) -> int:
@@ -306,7 +296,7 @@ class RoundsSimulator:
             if (dx or dy) and grid.in_bounds((x + dx, y + dy)) and grid.is_free((x + dx, y + dy))
         )
 
-    def _rounds(self, outbox: list[tuple[int, Transmission]]) -> int:
+    def _rounds(self, outbox: list[tuple[int, Outgoing]]) -> int:
         """Run rounds until no message is in flight; return the ticks they took.
 
         A robot acts in a round when it was sent something in the round
@@ -321,30 +311,27 @@ class RoundsSimulator:
         results = self._results
         occupant = self._occupant
         near = self._near
-        sizes = _SIZES
+        sizes = self._sizes
         rounds = 0
         while outbox:
             rounds += 1
             acting: dict[int, None] = {}
             ready: set[int] = set()
-            for sender, (message, recipient, radius) in outbox:
+            for sender, (message, recipients, radius) in outbox:
                 result = results[sender]
-                if recipient is not None:
-                    result.messages_sent += 1
-                    result.bytes_sent += sizes[type(message)]
-                    acting[recipient] = None
-                    if receivers[recipient](message):
-                        ready.add(recipient)
-                    continue
-                present = robots[sender].present
-                table = near.get(radius)
-                cells = table[present] if table is not None else None
-                if cells is None:
-                    cells = self._within(present, radius)
-                recipients = [other for cell in cells if (other := occupant[cell]) != NO_ROBOT]
-                result.messages_sent += len(recipients)
-                result.bytes_sent += sizes[type(message)] * len(recipients)
-                for recipient in recipients:
+                if recipients is not None:
+                    hearers: Sequence[int] = recipients
+                else:
+                    assert radius is not None, "a PIBT robot broadcasts within a radius"
+                    present = robots[sender].present
+                    table = near.get(radius)
+                    cells = table[present] if table is not None else None
+                    if cells is None:
+                        cells = self._within(present, radius)
+                    hearers = [other for cell in cells if (other := occupant[cell]) != NO_ROBOT]
+                result.messages_sent += len(hearers)
+                result.bytes_sent += sizes[type(message)] * len(hearers)
+                for recipient in hearers:
                     acting[recipient] = None
                     if receivers[recipient](message):
                         ready.add(recipient)
@@ -354,7 +341,7 @@ class RoundsSimulator:
         self.stats["rounds"] += rounds
         return 0
 
-    def _beacon_round(self, outbox: list[tuple[int, Transmission]]) -> bool:
+    def _beacon_round(self, outbox: list[tuple[int, Outgoing]]) -> bool:
         """The beacon round over a perfect network, one call per recipient; False (nothing done) if it does not apply.
 
         Applies when every robot broadcasts one beacon with the same radius:
@@ -365,14 +352,16 @@ class RoundsSimulator:
         if len(outbox) != len(robots) or not outbox:
             return False
         radius = outbox[0][1].radius
+        if radius is None:
+            return False
         beacons: list[BeaconMessage] = []
-        for index, (sender, (message, recipient, sent_radius)) in enumerate(outbox):
-            if sender != index or recipient is not None or sent_radius != radius or type(message) is not BeaconMessage:
+        for index, (sender, (message, recipients, sent_radius)) in enumerate(outbox):
+            if sender != index or recipients is not None or sent_radius != radius or type(message) is not BeaconMessage:
                 return False
             beacons.append(message)
         occupant = self._occupant
         results = self._results
-        size = _SIZES[BeaconMessage]
+        size = self._sizes[BeaconMessage]
         within = self._within
         table = self._near.get(radius)
         for robot in robots:
@@ -389,7 +378,7 @@ class RoundsSimulator:
         self.stats["rounds"] += 1
         return True
 
-    def _faulty_rounds(self, outbox: list[tuple[int, Transmission]]) -> int:
+    def _faulty_rounds(self, outbox: list[tuple[int, Outgoing]]) -> int:
         """:meth:`_rounds` over faulty links: every try drawn by :meth:`_link`."""
         robots = self.robots
         results = self._results
@@ -399,19 +388,20 @@ class RoundsSimulator:
         while outbox:
             stats["rounds"] += 1
             acting: dict[int, None] = {}
-            late: list[tuple[int, object]] = []
+            late: list[tuple[int, Message]] = []
             round_time = 0
             for sender, sent in outbox:
                 message = sent.message
-                if sent.recipient is not None:
-                    recipients: Sequence[int] = (sent.recipient,)
+                if sent.recipients is not None:
+                    recipients: Sequence[int] = sent.recipients
                 else:
+                    assert sent.radius is not None, "a PIBT robot broadcasts within a radius"
                     recipients = [
                         other
                         for cell in self._within(robots[sender].present, sent.radius)
                         if (other := occupant[cell]) != NO_ROBOT
                     ]
-                size = _SIZES[type(message)]
+                size = self._sizes[type(message)]
                 result = results[sender]
                 result.messages_sent += len(recipients)
                 result.bytes_sent += size * len(recipients)
