@@ -45,10 +45,15 @@ def main() -> int:
             plan = plan_with(planner, scenario, time_limit_s=arguments.time_limit)
             if plan.solved:
                 verdict = check_paths(scenario.grid, {robot.id: path for robot, path in zip(scenario.robots, plan.paths)})
-                ratio, makespan, judged = f"{plan.sum_of_costs() / lower_bound:.3f}", str(plan.makespan()), "ok" if not verdict else f"{len(verdict)} bad"
+                ratio, makespan = f"{plan.sum_of_costs() / lower_bound:.3f}", str(plan.makespan())
+                judged = "ok" if not verdict else f"{len(verdict)} bad"
             else:
                 ratio, makespan, judged = "-", "-", "-"
-            print(f"{name:<24} {agents:>5} {planner:>7} {plan.status:>10} {plan.planning_time_s:>8.3f} {ratio:>7} {makespan:>8} {judged:>8}", flush=True)
+            print(
+                f"{name:<24} {agents:>5} {planner:>7} {plan.status:>10} {plan.planning_time_s:>8.3f}"
+                f" {ratio:>7} {makespan:>8} {judged:>8}",
+                flush=True,
+            )
     return 0
 
 

@@ -241,10 +241,9 @@ def print_result(result: RunResult, console: Console) -> None:
         table.add_column(column, justify="left" if column in ("robot", "start", "goal") else "right")
     live = result.mode == "live"
     for robot in result.robots[:TABLE_ROWS]:
+        arrived = f"yes @{robot.time_s:.2f}s" if live else f"yes @{robot.arrival_tick}"
         if not robot.arrived:
             arrived = "[red]no[/red]"
-        else:
-            arrived = f"yes @{robot.time_s:.2f}s" if live else f"yes @{robot.arrival_tick}"
         table.add_row(
             robot.id,
             _cell(robot.start),

@@ -12,6 +12,7 @@ inside the free space. These properties must hold with and without network fault
 layer on, no run may ever have a vertex or swap collision.
 """
 
+import itertools
 import random
 
 import pytest
@@ -107,7 +108,7 @@ def check_run(scenario):
     if not result.collisions:
         for path in paths.values():
             assert all(scenario.grid.is_free(cell) for cell in path)
-            assert all(abs(a[0] - b[0]) + abs(a[1] - b[1]) <= 1 for a, b in zip(path, path[1:]))
+            assert all(abs(a[0] - b[0]) + abs(a[1] - b[1]) <= 1 for a, b in itertools.pairwise(path))
     if scenario.lifelong:
         assert result.success == (result.stop_reason == "time up" and not result.collisions)
     else:

@@ -216,10 +216,8 @@ def processes() -> Iterator[list[subprocess.Popen[bytes]]]:
 
 def signal_group(process: subprocess.Popen[bytes], signum: int) -> None:
     """Send ``signum`` to the session ``process`` leads (it was started with ``start_new_session``)."""
-    try:
+    with contextlib.suppress(ProcessLookupError):
         os.killpg(process.pid, signum)
-    except ProcessLookupError:
-        pass
 
 
 def write_scenario(folder: Path) -> Path:

@@ -25,7 +25,7 @@ import signal
 import subprocess
 import sys
 import time
-from collections.abc import Callable, Iterator, Sequence
+from collections.abc import Callable, Generator, Sequence
 from concurrent.futures import FIRST_COMPLETED, Future, ProcessPoolExecutor, wait
 from dataclasses import dataclass, field
 from pathlib import Path
@@ -103,7 +103,7 @@ def _init_worker() -> None:
     signal.signal(signal.SIGTERM, _stop_worker)
 
 
-def _pool_records(runs: Sequence[BenchRun], workers: int) -> Iterator[dict[str, Any]]:
+def _pool_records(runs: Sequence[BenchRun], workers: int) -> Generator[dict[str, Any], None, None]:
     """Records of ``runs`` from a local process pool, in the order they finish."""
     executor = ProcessPoolExecutor(max_workers=workers, initializer=_init_worker)
     finished = False
@@ -122,7 +122,7 @@ def _pool_records(runs: Sequence[BenchRun], workers: int) -> Iterator[dict[str, 
         executor.shutdown(wait=True, cancel_futures=True)
 
 
-def _dask_records(runs: Sequence[BenchRun], address: Any) -> Iterator[dict[str, Any]]:
+def _dask_records(runs: Sequence[BenchRun], address: Any) -> Generator[dict[str, Any], None, None]:
     """Records of ``runs`` from a dask.distributed cluster at ``address``, in the order they finish."""
     try:
         from distributed import Client, as_completed
@@ -232,7 +232,7 @@ def run_bench(
     in_main_thread = _in_main_thread()
     if in_main_thread:
         signal.signal(signal.SIGTERM, _raise_interrupt)
-    source: Iterator[dict[str, Any]] | None = None
+    source: Generator[dict[str, Any], None, None] | None = None
     try:
         if pending:
             if dask_address is not None:

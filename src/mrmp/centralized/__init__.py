@@ -40,6 +40,7 @@ from mrmp.centralized.cbs import (
     first_conflict,
     infeasibility_proof,
 )
+from mrmp.centralized.lacam import lacam
 from mrmp.centralized.plan import (
     STATUSES,
     MapfProblem,
@@ -50,7 +51,6 @@ from mrmp.centralized.plan import (
     path_cost,
     plan_size_bytes,
 )
-from mrmp.centralized.lacam import lacam
 from mrmp.centralized.prioritized import prioritized, priority_order
 from mrmp.centralized.registry import PLANNER_NAMES, PLANNERS, plan_with
 from mrmp.centralized.space_time_astar import (

@@ -43,7 +43,7 @@ Four robots turning round a 2x2 block in one tick cannot be executed:
 Traceback (most recent call last):
 ...
 mrmp.centralized.dependencies.PlanDeadlockError: the plan deadlocks when executed: robots 0, 1, 2, 3 wait for each other in a cycle at tick 1 (robot 0 enters (0, 1) after robot 1 leaves it, robot 1 enters (1, 1) after robot 2 leaves it, robot 2 enters (1, 0) after robot 3 leaves it, robot 3 enters (0, 0) after robot 0 leaves it): a rotation, which robots moving one at a time cannot execute
-"""
+"""  # noqa: E501
 
 from __future__ import annotations
 
@@ -288,7 +288,7 @@ def check_executable(
     Traceback (most recent call last):
     ...
     mrmp.centralized.dependencies.PlanDeadlockError: the plan deadlocks when executed: robots 0, 1 wait for each other in a cycle at tick 1 (robot 0 enters (0, 1) after robot 1 leaves it, robot 1 enters (0, 0) after robot 0 leaves it): a swap
-    """
+    """  # noqa: E501
     count = len(moves)
     progress = [0] * count
     waiting: dict[tuple[int, int], list[int]] = {}

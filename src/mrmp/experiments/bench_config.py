@@ -210,7 +210,7 @@ class _BenchReader(_Reader):
                 self.problems.extend(error.problems)
         if "instances" in entries:
             count = self.bounded(entries, "instances", f"{path}.instances", self.integer, 1)
-            if grid is None or count is _BAD or count is None:
+            if map_file is None or grid is None or count is _BAD or count is None:
                 return []
             capacity = len(largest_region(grid))
             return [
@@ -221,7 +221,7 @@ class _BenchReader(_Reader):
         instances = []
         for index, scen_node in enumerate(self.items(entries, "scen", f"{path}.scen") or []):
             scen_file = self.file(scen_node, f"{path}.scen[{index}]", "scenario file")
-            if scen_file is None or grid is None:
+            if scen_file is None or map_file is None or grid is None:
                 continue
             try:
                 scen_entries = read_scen_entries(scen_file)

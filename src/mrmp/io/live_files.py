@@ -34,7 +34,7 @@ class TraceWriter:
 
     def __init__(self, path: PathLike, robot: int) -> None:
         self.robot = robot
-        self._file: IO[str] | None = open(path, "a", encoding="utf-8")
+        self._file: IO[str] | None = open(path, "a", encoding="utf-8")  # noqa: SIM115 (kept open while the robot runs; closed by close())
 
     def write(self, event: str, cell: Cell, t: float) -> None:
         """Append one event."""
@@ -73,7 +73,8 @@ class TraceReader:
         for line in lines:
             try:
                 item = json.loads(line)
-                events.append((int(item["robot"]), str(item["event"]), (int(item["cell"][0]), int(item["cell"][1])), float(item["t"])))
+                cell = (int(item["cell"][0]), int(item["cell"][1]))
+                events.append((int(item["robot"]), str(item["event"]), cell, float(item["t"])))
             except (ValueError, KeyError, TypeError, IndexError):
                 continue
         return events

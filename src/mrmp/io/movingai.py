@@ -130,7 +130,7 @@ def _raise_if_any(problems: list[Problem], source: str) -> None:
         return
     if len(problems) > MAX_PROBLEMS:
         hidden = len(problems) - MAX_PROBLEMS
-        problems = problems[:MAX_PROBLEMS] + [Problem(source, f"{hidden} more problems not shown")]
+        problems = [*problems[:MAX_PROBLEMS], Problem(source, f"{hidden} more problems not shown")]
     raise InputError(problems)
 
 

@@ -283,7 +283,7 @@ def read_bench_results(path: PathLike) -> BenchResults:
     if problems:
         if len(problems) > MAX_PROBLEMS:
             hidden = len(problems) - MAX_PROBLEMS
-            problems = problems[:MAX_PROBLEMS] + [Problem(str(target), f"... and {hidden} more bad lines")]
+            problems = [*problems[:MAX_PROBLEMS], Problem(str(target), f"... and {hidden} more bad lines")]
         raise InputError(problems)
     latest = {record.run_id: record for record in records}  # the last record of each run
     kept = tuple(sorted(latest.values(), key=lambda record: record.line))

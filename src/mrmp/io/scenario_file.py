@@ -776,7 +776,7 @@ def load_scenario(path: PathLike, known_policies: Sequence[str] | None = None) -
     return scenario_from_text(read_text(path), str(path), known_policies, Path(path).parent)
 
 
-def load_movingai_scenario(map_path: PathLike, scen_path: PathLike, agents: int) -> Scenario:
+def load_movingai_scenario(map_path: PathLike, scen_path: PathLike, agents: int | None) -> Scenario:
     """The first ``agents`` agents of a MovingAI ``.scen`` file on its ``.map``, as a scenario.
 
     Robots are named ``"0"``, ``"1"``, ... and face NORTH; the scenario is named
@@ -789,7 +789,7 @@ def load_movingai_scenario(map_path: PathLike, scen_path: PathLike, agents: int)
     scen_path:
         The ``.scen`` file.
     agents:
-        How many agents to take from the top of the ``.scen`` file.
+        How many agents to take from the top of the ``.scen`` file (None: all).
 
     Returns
     -------

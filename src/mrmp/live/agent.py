@@ -38,9 +38,9 @@ from mrmp.live.body import Body
 from mrmp.live.driver import AgentReport, AgentTiming, LiveDriver
 from mrmp.live.transport import Transport
 from mrmp.policies.base import Policy
-from mrmp.sim.policy_table import make_policy
 from mrmp.protocol.auth import Opener, Sealer
 from mrmp.robot.robot import Outgoing, Robot
+from mrmp.sim.policy_table import make_policy
 
 __all__ = ["Agent", "AgentReport", "AgentTiming", "Phase"]
 

@@ -54,7 +54,9 @@ class AstarPolicy:
     def _plan(self, situation: Situation, blocked: frozenset[Cell] = frozenset()) -> list[Cell] | None:
         heading = situation.heading if self.heading_aware else None
         try:
-            result = astar(situation.grid, situation.present, situation.goal, blocked=blocked, heading=heading, timing=self.timing)
+            result = astar(
+                situation.grid, situation.present, situation.goal, blocked=blocked, heading=heading, timing=self.timing
+            )
         except NoPathError:
             return None
         return list(result.path)

@@ -34,7 +34,7 @@ StateMessage(sender=1, seq=3, present=(4, 2), next=(3, 2), heading=<Heading.NORT
 Traceback (most recent call last):
 ...
 mrmp.protocol.wire.DecodeError: truncated: 5 bytes is shorter than the 10-byte header
-"""
+"""  # noqa: E501
 
 from __future__ import annotations
 

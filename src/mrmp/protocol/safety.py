@@ -247,10 +247,10 @@ class SafetyLayer:
             return None  # its sender has made a newer claim since: this one is over
         self._highest_claim[sender] = message.claim
         owner = self.owner_of(cell)
-        if owner == self.index and self.pending is not None and self.pending.cell == cell and cell != self.present:
-            if self.target != cell and claimant_outranks and self.granted_claim is None:
-                self.pending = None
-                owner = self.owner_of(cell)
+        pending_here = self.pending is not None and self.pending.cell == cell and cell != self.present
+        if owner == self.index and pending_here and self.target != cell and claimant_outranks and self.granted_claim is None:
+            self.pending = None
+            owner = self.owner_of(cell)
         if owner is None or owner == sender:
             previous = self._grants.get(cell)
             claim_seq = message.seq if previous is None else max(previous.claim_seq, message.seq)

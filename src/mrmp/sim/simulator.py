@@ -117,7 +117,8 @@ class LockstepSimulator:
             for index, spec in enumerate(scenario.robots)
         ]
         slowdown = network_slowdown(scenario) if scenario.safety else 1.0
-        self.recurrence_limit = int((RECURRENCE_LIMIT + 2 * timeout) * max(1.0, slowdown / (2 * scenario.worst_faults().delay_max + 1)))
+        per_round_trip = slowdown / (2 * scenario.worst_faults().delay_max + 1)
+        self.recurrence_limit = int((RECURRENCE_LIMIT + 2 * timeout) * max(1.0, per_round_trip))
         self.network = scenario_network(scenario)
         self.referee = Referee(grid, [spec.id for spec in scenario.robots])
         self.lengths = shortest_steps(scenario)
@@ -220,8 +221,9 @@ class LockstepSimulator:
             if not batch:
                 return
             for _, recipient, payload in batch:
-                message = decoded.get(payload, False)
-                if message is False:
+                if payload in decoded:
+                    message = decoded[payload]
+                else:
                     try:
                         message = decode(payload)
                     except DecodeError:

@@ -33,7 +33,6 @@ from mrmp.robot.robot import Outgoing
 from mrmp.sim.network import SimulatedNetwork
 from mrmp.sim.referee import Referee
 
-
 TickObserver = Callable[[int, list[Cell]], None]
 """Called after every tick with the tick number and every robot's cell, in scenario order."""
 

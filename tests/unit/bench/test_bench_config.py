@@ -5,10 +5,10 @@ from pathlib import Path
 
 import pytest
 
-from mrmp.experiments.matrix import BenchRun
 from mrmp.core.errors import InputError
 from mrmp.core.scenario import NetworkFaults
 from mrmp.experiments.bench_config import bench_config_from_text, load_bench_config
+from mrmp.experiments.matrix import BenchRun
 
 ROOT = Path(__file__).resolve().parents[3]
 MAPS = ROOT / "maps"

@@ -1,6 +1,5 @@
 """The benchmark runner: records on disk as runs end, resume, time limits, errors, the CLI, dask."""
 
-import json
 import os
 import signal
 import subprocess
@@ -11,10 +10,10 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from mrmp.experiments.matrix import BenchRun
 from mrmp.bench.runner import run_bench, run_isolated
 from mrmp.cli import app
 from mrmp.experiments.bench_config import load_bench_config
+from mrmp.experiments.matrix import BenchRun
 from mrmp.io.bench_results import read_records
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -31,7 +30,7 @@ SCHEMA_KEYS = (
 
 def generated_run(policy="pibt", agents=4, **changes):
     spec = (("density", 0.1), ("height", 12), ("kind", "random"), ("seed", 0), ("width", 12))
-    return BenchRun(f"gen:random-12x12-p0.10-s0", agents, policy, generator=spec, instance=0, time_limit_s=20, **changes)
+    return BenchRun("gen:random-12x12-p0.10-s0", agents, policy, generator=spec, instance=0, time_limit_s=20, **changes)
 
 
 def den520d_run(policy, agents, time_limit_s):

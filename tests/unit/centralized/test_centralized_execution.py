@@ -8,9 +8,9 @@ from hypothesis import strategies as st
 
 from mrmp.centralized.dependencies import action_dependencies
 from mrmp.centralized.execution import plan_policies
-from mrmp.experiments.execution import execute_in_simulator
 from mrmp.centralized.plan import PlanningResult, pad_paths
 from mrmp.core import Grid, NetworkFaults, PolicyOptions, RobotSpec, Scenario
+from mrmp.experiments.execution import execute_in_simulator
 from mrmp.sim.referee import check_paths
 from mrmp.sim.simulator import simulate
 
@@ -23,9 +23,8 @@ def visit_order(paths):
         for robot, path in enumerate(paths):
             cell = path[min(tick, len(path) - 1)]
             sequence = order.setdefault(cell, [])
-            if not sequence or sequence[-1] != robot:
-                if tick == 0 or path[min(tick - 1, len(path) - 1)] != cell:
-                    sequence.append(robot)
+            if (not sequence or sequence[-1] != robot) and (tick == 0 or path[min(tick - 1, len(path) - 1)] != cell):
+                sequence.append(robot)
     return order
 
 

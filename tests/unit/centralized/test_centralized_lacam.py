@@ -12,7 +12,7 @@ from __future__ import annotations
 import random
 import time
 from collections import deque
-from itertools import product
+from itertools import pairwise, product
 from pathlib import Path
 
 import pytest
@@ -221,7 +221,7 @@ def lacam_star_cost(scenario: Scenario, result: PlanningResult) -> int:
     return sum(
         1
         for robot, path in zip(scenario.robots, result.paths)
-        for before, after in zip(path, path[1:])
+        for before, after in pairwise(path)
         if not before == after == robot.goal
     )
 

@@ -24,11 +24,11 @@ from mrmp.centralized.dependencies import (
     check_executable,
     find_rotations,
 )
-from mrmp.experiments.execution import execute_in_simulator
 from mrmp.centralized.plan import PlanningResult, pad_paths
 from mrmp.centralized.space_time_astar import Reservations, space_time_astar
 from mrmp.core import Grid, RobotSpec, Scenario
 from mrmp.core.errors import MrmpError
+from mrmp.experiments.execution import execute_in_simulator
 from mrmp.io.scenario_file import load_movingai_scenario
 
 MAPS = Path(__file__).resolve().parents[3] / "maps"
@@ -78,14 +78,14 @@ def test_following_chains_are_not_rotations_and_execute():
     # three robots follow one another round the block into its free cell, in one tick
     paths = [[cell, goal] for cell, goal in zip(BLOCK[:3], TURNED[:3])]
     assert find_rotations(paths) == []
-    moves, needs = action_dependencies(paths)
+    _moves, needs = action_dependencies(paths)
     assert needs[0] == {0: [(1, 1)]} and needs[1] == {0: [(2, 1)]} and needs[2] == {}
     scenario = scenario_of(Grid(2, 2), BLOCK[:3], TURNED[:3])
     assert_executes(scenario, PlanningResult("solved", pad_paths(paths), 0.0, "hand"))
 
 
 def test_find_rotations_reports_each_cycle_of_a_tick_and_swaps_on_request():
-    two_blocks = [(0, 0), (0, 1), (1, 1), (1, 0)] + [(0, 3), (0, 4), (1, 4), (1, 3)]
+    two_blocks = [(0, 0), (0, 1), (1, 1), (1, 0), (0, 3), (0, 4), (1, 4), (1, 3)]
     turned = two_blocks[1:4] + two_blocks[:1] + two_blocks[5:] + two_blocks[4:5]
     paths = [[cell, goal, goal] for cell, goal in zip(two_blocks, turned)]
     paths.append([(3, 0), (3, 1), (3, 0)])  # a robot going back and forth alone
@@ -108,7 +108,7 @@ def test_check_executable_names_one_cycle_among_waiting_robots():
     with pytest.raises(PlanDeadlockError) as caught:
         check_executable(moves, needs, [[4], [4], [6]])
     assert caught.value.robots == (0, 1) and caught.value.ticks == (4, 4)
-    check_executable(moves[:1] + [[(0, 0)]], [{0: [(1, 1)]}, {}])  # robot 1 goes first: fine
+    check_executable([*moves[:1], [(0, 0)]], [{0: [(1, 1)]}, {}])  # robot 1 goes first: fine
 
 
 # -- space-time A* refuses the move that closes a cycle -----------------------------------

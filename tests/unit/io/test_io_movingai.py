@@ -89,7 +89,7 @@ def test_map_round_trip_keeps_costs_and_shape(tmp_path: Path) -> None:
 
 
 def test_writing_a_fractional_cost_is_refused() -> None:
-    with pytest.raises(ValueError, match="costs 2.5"):
+    with pytest.raises(ValueError, match=r"costs 2\.5"):
         map_to_text(Grid(2, 2, costs={(0, 0): 2.5}))
 
 

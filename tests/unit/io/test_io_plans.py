@@ -27,5 +27,5 @@ def test_each_robot_reads_back_exactly_its_share(tmp_path):
 
 def test_garbage_share_is_a_one_line_input_error(tmp_path):
     (tmp_path / "bad.json").write_text('{"robot": "A", "moves": [[1]]}')
-    with pytest.raises(InputError, match="bad.json: not a robot's share of a plan"):
+    with pytest.raises(InputError, match=r"bad\.json: not a robot's share of a plan"):
         read_share(tmp_path / "bad.json", "A")

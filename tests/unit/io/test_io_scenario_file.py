@@ -222,7 +222,7 @@ def test_writing_with_a_map_file(maps_dir: Path, tmp_path: Path) -> None:
 
 def test_fractional_costs_cannot_be_written() -> None:
     scenario = Scenario(Grid(2, 2, costs={(0, 0): 1.5}), (RobotSpec("A", (0, 1), (1, 1)),))
-    with pytest.raises(ValueError, match="costs 1.5"):
+    with pytest.raises(ValueError, match=r"costs 1\.5"):
         scenario_to_yaml(scenario)
 
 

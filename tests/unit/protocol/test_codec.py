@@ -3,9 +3,9 @@
 import struct
 
 import pytest
+from codec_checks import assert_exact_or_refused, assert_round_trip, mutated
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from codec_checks import assert_exact_or_refused, assert_round_trip, mutated
 
 from mrmp.core.heading import Heading
 from mrmp.protocol.codec import MAX_MESSAGE_BYTES, PROTOCOL_VERSION, DecodeError, decode, encode

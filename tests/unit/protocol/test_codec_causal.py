@@ -1,9 +1,9 @@
 """The codec's Causal-PIBT lock messages: round trips, size bounds, mutations, rejections."""
 
 import pytest
+from codec_checks import assert_exact_or_refused, assert_round_trip, mutated
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from codec_checks import assert_exact_or_refused, assert_round_trip, mutated
 
 from mrmp.protocol.codec import MAX_MESSAGE_BYTES, DecodeError, decode, encode
 from mrmp.protocol.messages import (

@@ -5,9 +5,9 @@ import json
 import pytest
 from report_fixtures import make_record, unfinished, write_jsonl
 
+from mrmp.core.errors import InputError
 from mrmp.experiments.matrix import BenchRun
 from mrmp.experiments.records import base_record, execute_run
-from mrmp.core.errors import InputError
 from mrmp.io.bench_results import append_record
 from mrmp.io.report_input import FaultSetting, read_bench_results, record_from_dict
 

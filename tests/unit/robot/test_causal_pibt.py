@@ -108,9 +108,9 @@ def test_duplicates_late_and_foreign_lock_messages_are_harmless():
     assert replace(again.message, seq=grant.message.seq) == grant.message
     assert (again.message.locker, again.message.session) == (1, 7) and a.locked_by == (1, 7)
     release = LockReleaseMessage(1, 51, 7, ADD_CHILD)
-    (ack,) = a.receive(release, 0)
+    (_ack,) = a.receive(release, 0)
     assert a.children == {1} and a.locked_by is None and a.stats["written"] == 1
-    (ack_again,) = a.receive(release, 0)  # a copy of the release: acknowledged, not applied twice
+    (_ack_again,) = a.receive(release, 0)  # a copy of the release: acknowledged, not applied twice
     assert a.stats["written"] == 1 and a.dropped["duplicate_release"] == 1
     assert a.receive(request, 0) == [] and a.dropped["stale_lock_request"] == 1, "a late copy of the request locks nothing"
     assert a.locked_by is None

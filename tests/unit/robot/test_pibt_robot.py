@@ -14,7 +14,7 @@ from mrmp.search.flat_map import FlatMap
 from mrmp.sim.rounds import RoundsSimulator
 
 
-def random_scenario(seed, swap, radius=2, faults=NetworkFaults()):
+def random_scenario(seed, swap, radius=2, faults=None):
     rng = random.Random(seed)
     x_size, y_size = rng.randint(3, 9), rng.randint(3, 9)
     cells = [(x, y) for x in range(x_size) for y in range(y_size)]
@@ -25,7 +25,7 @@ def random_scenario(seed, swap, radius=2, faults=NetworkFaults()):
     count = rng.randint(1, max(1, len(free) // 2))
     starts, goals = rng.sample(free, count), rng.sample(free, count)
     robots = tuple(RobotSpec(f"r{i}", s, g) for i, (s, g) in enumerate(zip(starts, goals)))
-    return Scenario(grid, robots, network=faults, policy=PolicyOptions(name="pibt", radius=radius, swap=swap), seed=seed)
+    return Scenario(grid, robots, network=faults or NetworkFaults(), policy=PolicyOptions(name="pibt", radius=radius, swap=swap), seed=seed)
 
 
 def central_next(simulator, swap, tie_penalties=False):

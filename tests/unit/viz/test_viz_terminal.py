@@ -14,10 +14,10 @@ from pathlib import Path
 import pytest
 from rich.console import Console
 
-from mrmp.experiments.execution import execute_in_simulator
 from mrmp.centralized.registry import plan_with
 from mrmp.core import Grid, Heading
 from mrmp.core.scenario import PolicyOptions
+from mrmp.experiments.execution import execute_in_simulator
 from mrmp.io import load_scenario
 from mrmp.sim.simulator import simulate
 from mrmp.viz.terminal import TerminalView, render_grid, scale_for
