@@ -21,7 +21,6 @@ or on a stop request.
 from __future__ import annotations
 
 import queue
-import random
 import threading
 import time
 from collections import Counter
@@ -31,6 +30,7 @@ from typing import Any, Protocol
 
 from mrmp.core.cell import Cell
 from mrmp.core.scenario import Scenario
+from mrmp.core.seeds import Stream, stream_random
 from mrmp.live.body import Body
 from mrmp.live.transport import FaultyTransport, Transport
 from mrmp.protocol.auth import Opener, Sealer
@@ -152,7 +152,7 @@ class LiveDriver:
         self.opener = opener
         self.timing = timing
         self.clock = clock
-        self.random = random.Random(seed * 1_000_003 + index)
+        self.random = stream_random(seed, Stream.SCHEDULE, index)
         self.report = AgentReport(spec.id, index, spec.start, spec.goal)
         self.stop_requested = threading.Event()
         self._inbox: queue.SimpleQueue[Message] = queue.SimpleQueue()

@@ -9,7 +9,6 @@ SIGTERM, writing what they have.
 from __future__ import annotations
 
 import ctypes
-import random
 import signal
 import sys
 import threading
@@ -20,6 +19,7 @@ from pathlib import Path
 
 from mrmp.core.errors import InputError, Problem
 from mrmp.core.scenario import Scenario
+from mrmp.core.seeds import Stream, derive_seed, stream_random
 from mrmp.io.live_files import TraceReader, TraceWriter, write_json
 from mrmp.io.plans import read_share
 from mrmp.live.agent import Agent, AgentReport, AgentTiming
@@ -97,6 +97,45 @@ class AgentOptions:
     """This robot's share of a central plan (``mrmp.io.plans.write_share``)."""
 
 
+def _per_robot_agent(
+    scenario: Scenario,
+    index: int,
+    transport: Transport,
+    body: SimulatedBody,
+    sealer: Sealer,
+    opener: Opener,
+    options: AgentOptions,
+    policy: PlanFollowingPolicy | None,
+) -> Agent:
+    """The live driver of a per-robot policy (or of a central plan's share)."""
+    return Agent(
+        scenario, index, transport, body, sealer, opener,
+        timing=options.timing, guarded=options.guarded, seed=options.seed, policy=policy,
+    )  # fmt: skip
+
+
+def _causal_agent(
+    scenario: Scenario,
+    index: int,
+    transport: Transport,
+    body: SimulatedBody,
+    sealer: Sealer,
+    opener: Opener,
+    options: AgentOptions,
+    policy: PlanFollowingPolicy | None,
+) -> CausalAgent:
+    """The live driver of Causal-PIBT (always through the safety layer)."""
+    return CausalAgent(scenario, index, transport, body, sealer, opener, timing=options.timing, seed=options.seed)
+
+
+LiveDriver = Callable[
+    [Scenario, int, Transport, SimulatedBody, Sealer, Opener, "AgentOptions", "PlanFollowingPolicy | None"], "Agent | CausalAgent"
+]
+
+LIVE_DRIVERS: dict[str, LiveDriver] = {"agent": _per_robot_agent, "causal": _causal_agent}
+"""The live drivers by the kind a policy-table entry names (:attr:`mrmp.sim.policy_table.PolicyEntry.live_driver`)."""
+
+
 def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
     """Run one robot until it is done, writing ``agent-<i>.json`` and ``trace-<i>.jsonl`` in ``options.results``."""
     index = options.index
@@ -111,7 +150,7 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
     transport: Transport | None = None
     try:
         transport = opened = options.transport.open(index, len(scenario.robots))
-        transport = FAULTS.wrap(opened, options.faults, seed=options.seed * 7919 + index)
+        transport = FAULTS.wrap(opened, options.faults, seed=derive_seed(options.seed, Stream.LIVE_FAULTS, index))
         body = SimulatedBody(
             spec.start,
             spec.heading,
@@ -120,27 +159,13 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
             time_scale=options.time_scale,
             jitter=options.jitter,
             miss_line=options.miss_line,
-            rng=random.Random(options.seed * 104_729 + index),
+            rng=stream_random(options.seed, Stream.BODY, index),
             recorder=OccupancyRecorder(trace.write),
         )
         sealer = Sealer(options.key, options.session)
         opener = Opener(options.key, options.session, fleet_size=len(scenario.robots))
-        agent: Agent | CausalAgent
-        if policy_entry(scenario.policy.name).live_driver == "causal":  # Causal-PIBT: always through the safety layer
-            agent = CausalAgent(scenario, index, transport, body, sealer, opener, timing=options.timing, seed=options.seed)
-        else:
-            agent = Agent(
-                scenario,
-                index,
-                transport,
-                body,
-                sealer,
-                opener,
-                timing=options.timing,
-                guarded=options.guarded,
-                seed=options.seed,
-                policy=policy,
-            )
+        driver = LIVE_DRIVERS[policy_entry(scenario.policy.name).live_driver or "agent"]
+        agent = driver(scenario, index, transport, body, sealer, opener, options, policy)
         _on_stop_signals(agent.stop_requested.set)
         if isinstance(opened, ConnectedTransport):
             opened.wait_for_peers(len(scenario.robots) - 1, timeout=10.0)
