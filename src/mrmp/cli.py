@@ -197,6 +197,8 @@ def parse_kills(items: list[str]) -> dict[str, float]:
             robot = ""
         if not separator or not robot:
             raise InputError(Problem("--kill", f"expected ROBOT@SECONDS, got {item!r}"))
+        if not 0.0 <= kills[robot] <= 86_400.0:
+            raise InputError(Problem("--kill", f"the seconds of {item!r} must be between 0 and 86400"))
     return kills
 
 
@@ -356,7 +358,7 @@ def run(
     jitter: Annotated[float, typer.Option(help="Live: each move takes its time times 1 +- jitter.")] = 0.0,
     miss_line: Annotated[float, typer.Option(help="Live: probability that a body misses a grid line.")] = 0.0,
     results: Annotated[Path | None, typer.Option(help="Live: folder for traces and reports (default: a new temporary one).")] = None,
-    kill: Annotated[list[str] | None, typer.Option(help="Live: kill robot ID's process after S seconds: ID@S (repeatable).")] = None,
+    kill: Annotated[list[str] | None, typer.Option(help="Live: kill robot ID's process S wall-clock seconds after the fleet's start: ID@S (repeatable).")] = None,
 
 ) -> None:
     """Run a scenario (lockstep simulator, or --live processes) and report what happened."""

@@ -23,6 +23,18 @@ def processes_mentioning(text):
     return found
 
 
+def fleet_started(results, robots):
+    """Whether every robot has written a report saying its run began (it does so at the fleet's start)."""
+    for index in range(robots):
+        try:
+            report = json.loads((results / f"agent-{index}.json").read_text())
+        except (OSError, ValueError):
+            return False
+        if not report.get("started_at"):
+            return False
+    return True
+
+
 def test_ctrl_c_stops_everything_and_writes_results(tmp_path):
     results = tmp_path / "run"
     out = tmp_path / "result.json"
@@ -31,8 +43,8 @@ def test_ctrl_c_stops_everything_and_writes_results(tmp_path):
         "--results", str(results), "--json", str(out),
     ]
     launcher = subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, start_new_session=True)
-    deadline = time.monotonic() + 20
-    while not list(results.glob("trace-*.jsonl")) and time.monotonic() < deadline:
+    deadline = time.monotonic() + 120  # a bound on a hang only: the wait ends when the fleet has started
+    while not fleet_started(results, 2) and time.monotonic() < deadline:
         time.sleep(0.1)
     time.sleep(1.5)  # the robots are moving (one cell takes 4 s at this speed)
     os.killpg(launcher.pid, signal.SIGINT)  # what the terminal does on Ctrl-C

@@ -12,7 +12,7 @@ import time
 import types
 
 import pytest
-from polling import drain, receive_within
+from polling import PATIENCE, drain, receive_within
 
 from mrmp.live.transport import (
     FaultyTransport,
@@ -104,9 +104,8 @@ def test_faulty_delay_holds_a_datagram_at_least_delay_min(udp_fleet):
     faulty = FaultyTransport(a, LiveFaults(delay_min=0.2, delay_max=0.3), seed=3)
     started = time.monotonic()
     faulty.send(b"late", recipient=1)
-    assert receive_within(b, timeout=2.0, poll=0.01) == b"late"
-    took = time.monotonic() - started
-    assert 0.2 <= took < 1.0
+    assert receive_within(b, poll=0.01) == b"late"
+    assert time.monotonic() - started >= 0.2  # never sooner (later only as the machine's load makes it)
     assert (faulty.counts.sent, faulty.counts.delayed) == (1, 1)
     faulty.close()
 
@@ -116,7 +115,7 @@ def test_faulty_delayed_datagrams_all_arrive_and_close_closes_the_inner_transpor
     faulty = FaultyTransport(inner, LiveFaults(delay_min=0.01, delay_max=0.05, reorder=0.5), seed=4)
     for number in range(30):
         faulty.send(b"%d" % number, recipient=number % 3)
-    deadline = time.monotonic() + 2.0
+    deadline = time.monotonic() + PATIENCE
     while len(inner.sent) < 30 and time.monotonic() < deadline:
         time.sleep(0.01)
     assert sorted(data for _, data, _ in inner.sent) == sorted(b"%d" % number for number in range(30))

@@ -265,6 +265,9 @@ class LiveDriver:
         started = clock()
         report.started_at = started
         report.believed_path.append((started, self._present()))
+        if on_progress is not None:  # the launcher learns at once when this robot's run began
+            self._fill_report(started)
+            on_progress(report)
         self._send(self._state_messages(started))
         last_state = started
         self._begin(started)

@@ -44,8 +44,9 @@ from mrmp.live.transport_table import FAULTS, TRANSPORTS
 class LiveOptions:
     """How to run a scenario live.
 
-    ``kill`` maps robot ids to seconds after the start at which their process is
-    killed (SIGKILL), to study failures. With a ``plan`` (a solved central plan),
+    ``kill`` maps robot ids to the wall-clock seconds after the fleet's start (when
+    the last robot began its run) at which their process is killed (SIGKILL), to
+    study failures. With a ``plan`` (a solved central plan),
     every robot follows its share of it through the plan's action dependencies.
     """
 
@@ -86,6 +87,8 @@ class _Fleet:
     timeout: float
     done: Path
     """The file whose appearance tells the referee to finish."""
+    results: Path
+    """The folder the robots write their reports to."""
 
 
 _PYTHON = [sys.executable, "-m", "mrmp"]
@@ -167,7 +170,7 @@ def _start_fleet(options: LiveOptions, files: _RunFiles, layout: FleetLayout, se
         plan = [f"--plan={files.shares[index]}"] if files.shares else []
         command = [*_PYTHON, "agent", f"--robot={robot_id}", *common, *plan, *transport.arguments(layout.ids)]
         agents.append(subprocess.Popen(command, start_new_session=True))
-    return _Fleet(list(layout.ids), agents, referee, started, timeout, files.done)
+    return _Fleet(list(layout.ids), agents, referee, started, timeout, files.done, files.results)
 
 
 def _agent_arguments(options: LiveOptions, files: _RunFiles, session: int, timeout: float) -> list[str]:
@@ -189,17 +192,25 @@ def _agent_arguments(options: LiveOptions, files: _RunFiles, session: int, timeo
 
 
 def _watch(fleet: _Fleet, kill: Mapping[str, float], say: Callable[[str], None]) -> str:
-    """Wait for the robots to stop, killing those of ``kill`` on time; then stop every process. Why the run stopped."""
+    """Wait for the robots to stop, killing those of ``kill`` on time; then stop every process. Why the run stopped.
+
+    Kill times count from the fleet's start (the last robot to begin its run, as its
+    report says), not from the launch, so that a slow start on a busy machine does not
+    move a kill to before the robots have moved.
+    """
     stop_reason = "all arrived"
-    kills = {fleet.ids.index(robot_id): fleet.started + seconds for robot_id, seconds in kill.items()}
+    pending_kills = {fleet.ids.index(robot_id): seconds for robot_id, seconds in kill.items()}
+    fleet_start: float | None = None
     try:
         while any(agent.poll() is None for agent in fleet.agents):
             now = time.monotonic()
-            for index, when in list(kills.items()):
-                if now >= when and fleet.agents[index].poll() is None:
+            if pending_kills and fleet_start is None:
+                fleet_start = _fleet_start(fleet)
+            for index, seconds in list(pending_kills.items()):
+                if fleet_start is not None and now >= fleet_start + seconds and fleet.agents[index].poll() is None:
                     fleet.agents[index].kill()
-                    say(f"live: killed robot {fleet.ids[index]} at {now - fleet.started:.1f} s")
-                    del kills[index]
+                    say(f"live: killed robot {fleet.ids[index]} at {now - fleet_start:.1f} s after the fleet's start")
+                    del pending_kills[index]
             if now - fleet.started > fleet.timeout + 10.0:
                 stop_reason = "timeout"
                 break
@@ -210,6 +221,18 @@ def _watch(fleet: _Fleet, kill: Mapping[str, float], say: Callable[[str], None])
     finally:
         _shut_down(fleet)
     return stop_reason
+
+
+def _fleet_start(fleet: _Fleet) -> float | None:
+    """When the last robot began its run (its report's ``started_at``), or None while one still waits to begin."""
+    starts = []
+    for index, agent in enumerate(fleet.agents):
+        report = _read_if_there(fleet.results / f"agent-{index}.json")
+        if report is not None and report.get("started_at"):
+            starts.append(float(report["started_at"]))
+        elif agent.poll() is None:
+            return None
+    return max(starts, default=time.monotonic())
 
 
 def _shut_down(fleet: _Fleet) -> None:

@@ -131,7 +131,7 @@ def test_a_run_over_its_time_limit_is_killed_and_recorded_as_timeout():
     started = time.monotonic()
     record = run_isolated(run)
     assert record["status"] == "timeout" and record["error"].startswith("killed after")
-    assert time.monotonic() - started < 10
+    assert time.monotonic() - started < 60  # killed, not run to its end
     assert record["success"] is None and record["collisions"] is None and record["run_id"] == run.run_id
 
 
