@@ -19,6 +19,8 @@ Bodies follow the 10-byte header; cells are two signed 32-bit integers::
    11 lock release   session (u32), operations (1 byte), count (1 byte),
                      count visited cells                                          16 + 8 * count bytes
    12 lock ack       locker (u32), session (u32)                                        18 bytes in all
+   13 release        claim (u32), cell                                                  22 bytes in all
+   14 release ack    owner (u32), claim (u32), cell                                     26 bytes in all
 
 A cell a message does not have (a state's target or claim cell, a grant's
 head) is :data:`~mrmp.protocol.messages.NO_CELL` on the wire, and a flag says
@@ -26,8 +28,8 @@ whether it is there, so that every accepted datagram is exactly one encoding.
 
 Examples
 --------
->>> STATE.size, CLAIM.size, LOCK_GRANT.size
-(52, 22, 45)
+>>> STATE.size, CLAIM.size, LOCK_GRANT.size, RELEASE.size, RELEASE_ACK.size
+(52, 22, 45, 22, 26)
 """
 
 from __future__ import annotations
@@ -48,6 +50,8 @@ from mrmp.protocol.messages import (
     LockReleaseMessage,
     LockRequestMessage,
     PullMessage,
+    ReleaseAckMessage,
+    ReleaseMessage,
     ReplyMessage,
     ReserveMessage,
     StateMessage,
@@ -128,6 +132,16 @@ def _unpack_reply(sender: int, seq: int, fields: Fields, _: tuple[Cell, ...]) ->
     if granted > 1 or claim == 0:
         raise DecodeError("malformed", f"reply with granted={granted}, claim={claim}")
     return ReplyMessage(sender, seq, claimant, claim, (cx, cy), bool(granted))
+
+
+def _unpack_release_cell(sender: int, seq: int, fields: Fields, _: tuple[Cell, ...]) -> ReleaseMessage:
+    claim, cx, cy = fields
+    return ReleaseMessage(sender, seq, claim, (cx, cy))
+
+
+def _unpack_release_ack(sender: int, seq: int, fields: Fields, _: tuple[Cell, ...]) -> ReleaseAckMessage:
+    owner, claim, cx, cy = fields
+    return ReleaseAckMessage(sender, seq, owner, claim, (cx, cy))
 
 
 STATE = register(WireFormat(1, StateMessage, "!iiiiiiiiBBII", _pack_state, _unpack_state))
@@ -220,4 +234,8 @@ LOCK_RELEASE = register(
 )
 LOCK_ACK = register(
     WireFormat(12, LockAckMessage, "!II", lambda m: (m.locker, m.session), lambda s, q, f, _: LockAckMessage(s, q, *f))
+)
+RELEASE = register(WireFormat(13, ReleaseMessage, "!Iii", lambda m: (m.claim, *m.cell), _unpack_release_cell))
+RELEASE_ACK = register(
+    WireFormat(14, ReleaseAckMessage, "!IIii", lambda m: (m.owner, m.claim, *m.cell), _unpack_release_ack)
 )

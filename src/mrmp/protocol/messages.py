@@ -10,7 +10,8 @@ the state of its safety protocol (the cell its body is entering, and its
 current claim; see ``docs/protocol.md``).
 
 :class:`ClaimMessage` and :class:`ReplyMessage` are the safety protocol's
-request for a cell and its answer. :class:`BeaconMessage`,
+request for a cell and its answer, :class:`ReleaseMessage` and
+:class:`ReleaseAckMessage` its release of a cell and the acknowledgement. :class:`BeaconMessage`,
 :class:`InheritMessage`, :class:`AnswerMessage`, :class:`ReserveMessage` and
 :class:`PullMessage` carry decentralized PIBT (:mod:`mrmp.robot.pibt_robot`).
 :class:`LockRequestMessage`, :class:`LockGrantMessage`,
@@ -136,6 +137,30 @@ class ReplyMessage(Message):
     claim: int
     cell: Cell
     granted: bool
+
+
+@dataclass(frozen=True, slots=True)
+class ReleaseMessage(Message):
+    """To the replicas of ``cell``: the sender no longer covers nor claims ``cell`` under claim ``claim`` or older.
+
+    Claim 0 is the registration every robot holds on its start cell.
+    """
+
+    sender: int
+    seq: int
+    claim: int
+    cell: Cell
+
+
+@dataclass(frozen=True, slots=True)
+class ReleaseAckMessage(Message):
+    """A replica's answer to a release: it holds no registration of ``cell`` for ``owner`` up to claim ``claim``."""
+
+    sender: int
+    seq: int
+    owner: int
+    claim: int
+    cell: Cell
 
 
 @dataclass(frozen=True, slots=True)

@@ -1,31 +1,36 @@
-"""The safety layer: a robot enters a cell only when a majority of the fleet has registered it to that robot.
+"""The safety layer: a robot enters a cell only when a majority of the cell's replicas registered it to that robot.
 
-Every robot keeps a *registry*: for each cell, at most one owner. It owns its
-own Present, the cell its body is entering, and the cell of its pending claim;
-it records a peer as the owner of a cell when it grants that peer's claim (and,
-at the start, every peer owns its start cell). A robot that wants to enter a
-cell sends a :class:`~mrmp.protocol.messages.ClaimMessage` to every peer; each
-peer grants the claim only if the cell has no other owner in its registry, and
+Each cell has a *replica set* of at most three robots, the same for every
+robot (:mod:`mrmp.protocol.replicas`). Each robot keeps a *registry* for the
+cells it is a replica of: for each, at most one owner. A robot owns its own
+Present, the cell its body is entering and the cell of its pending claim; it
+records a peer as the owner of a cell when it grants that peer's claim (and, at
+the start, every robot owns its start cell in the registries of that cell's
+replicas). A robot that wants to enter a cell sends a
+:class:`~mrmp.protocol.messages.ClaimMessage` to the cell's replicas; each
+grants the claim only if the cell has no other owner in its registry, and
 refuses otherwise. The claimant starts moving only once a majority of the
-fleet, itself included, has registered the cell to it.
+cell's replicas (itself among them if it is one) has registered the cell to it.
 
-Safety (no two robots ever cover one cell, whatever is lost, delayed, duplicated
-or reordered): two majorities of one fleet share at least one robot, and that
-robot registers a cell to at most one owner at a time, so two robots can never
-both hold a majority for one cell at once. A registration is only dropped on
-evidence from its owner itself: a state message sent *after* the claim (a larger
-sequence number) that shows the owner neither covering the cell nor still
-claiming it. A registration only ever moves forward (to a newer claim of the
-same owner, never back to an older one), and a claim older than one already
-seen from its sender is ignored. Until then the granting robot keeps the cell for its owner, even if
-the owner is silent for ever (a crashed robot is an obstacle at its last cells),
-so lost, late, duplicated or reordered messages can only delay a robot, never
-let two robots into one cell. The full argument, and what it costs in messages,
-is in ``docs/protocol.md``.
+A registration is dropped only on a :class:`~mrmp.protocol.messages.ReleaseMessage`
+from its owner naming the cell and a claim at least as new as the registered
+one. A robot sends one to the cell's replicas when it has left a cell, or given
+up a claim, and repeats it until each replica acknowledges it
+(:class:`~mrmp.protocol.messages.ReleaseAckMessage`) or a bounded number of
+tries passes.
+
+Safety (no two robots ever cover one cell, whatever is lost, delayed,
+duplicated or reordered): two majorities of one replica set share at least one
+robot, and that robot registers a cell to at most one owner at a time; a
+registration lasts at least as long as its owner covers the cell, because its
+owner sends the release only after it stopped covering the cell. So two robots
+can never both hold a majority for one cell at once. A crashed robot never
+releases: it is an obstacle at its last cells. The full argument, and what it
+costs in messages, is in ``docs/protocol.md``.
 
 This module is sans-IO: it consumes messages and the driver's time, and returns
-messages to send. Liveness needs a majority of the fleet alive and in touch; a
-robot that cannot hear a majority cannot move.
+messages to send with their recipients. Liveness needs, for each cell to enter,
+a majority of its replicas alive and in touch.
 
 Examples
 --------
@@ -35,11 +40,14 @@ Examples
 >>> layer.owner_of((0, 2)), layer.owner_of((1, 1))
 (1, None)
 >>> claim = layer.start_claim((0, 1), now=0.0)
->>> claim.cell, layer.may_enter((0, 1))
-((0, 1), False)
+>>> claim.cell, layer.replicas_of((0, 1)), layer.may_enter((0, 1))
+((0, 1), (0, 1, 2), False)
 >>> layer.handle_reply(ReplyMessage(sender=2, seq=1, claimant=0, claim=claim.claim, cell=(0, 1), granted=True), now=0.1)
 >>> layer.may_enter((0, 1))
 True
+>>> layer.begin_move((0, 1)); layer.end_move((0, 1))
+>>> [(type(message).__name__, message.cell, recipients) for message, recipients in layer.expire(now=1.0)]
+[('ReleaseMessage', (0, 0), (1, 2))]
 """
 
 from __future__ import annotations
@@ -48,22 +56,31 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 from mrmp.core.cell import Cell
-from mrmp.protocol.messages import ClaimMessage, ReplyMessage, StateMessage
+from mrmp.protocol.messages import ClaimMessage, Message, ReleaseAckMessage, ReleaseMessage, ReplyMessage
+from mrmp.protocol.replicas import REPLICAS, majority, replica_set
+
+RELEASE_TRIES = 32
+"""How often a release is sent to a replica that does not acknowledge it before it is given up.
+
+A replica that missed every try keeps a stale registration: the cell then
+needs the other replicas' grants (still a majority of three when only one
+replica is stale)."""
+
+Send = tuple[Message, tuple[int, ...]]
+"""A message for the robot to stamp and send, and its recipients."""
 
 
 @dataclass
-class _Grant:
-    """A cell this robot has registered to a peer, and the claim that asked for it."""
+class _Registration:
+    """A cell this robot has registered to a peer, and the claim that asked for it (0: the peer's start)."""
 
     owner: int
     claim: int
-    claim_seq: int
-    cell: Cell
 
 
 @dataclass
 class PendingClaim:
-    """This robot's own claim in progress."""
+    """This robot's own claim in progress; ``votes`` are the replicas that granted it (itself included)."""
 
     number: int
     cell: Cell
@@ -74,8 +91,19 @@ class PendingClaim:
 
 
 @dataclass
+class _Release:
+    """A release this robot still sends: the replicas of ``cell`` that have not acknowledged it."""
+
+    claim: int
+    cell: Cell
+    waiting: set[int]
+    sent_at: float = -float("inf")
+    tries: int = 0
+
+
+@dataclass
 class SafetyStats:
-    """What the layer did: claims made, granted, refused, timed out; replies given."""
+    """What the layer did: claims made, granted, refused, timed out; replies given; releases sent and given up."""
 
     claims: int = 0
     granted: int = 0
@@ -83,6 +111,8 @@ class SafetyStats:
     timed_out: int = 0
     grants_given: int = 0
     refusals_given: int = 0
+    releases: int = 0
+    releases_given_up: int = 0
 
 
 class SafetyLayer:
@@ -98,7 +128,12 @@ class SafetyLayer:
         A claim without a majority after this long (driver's time units) is
         abandoned.
     retry_interval:
-        A pending claim is sent again after this long without a majority.
+        A pending claim, or an unacknowledged release, is sent again after this long.
+    replicas:
+        Replicas per cell (:data:`~mrmp.protocol.replicas.REPLICAS`).
+    keep_releases:
+        Whether releases are sent (False for a robot that moves unguarded, which
+        claims nothing and so has nothing to release).
     """
 
     def __init__(
@@ -107,66 +142,79 @@ class SafetyLayer:
         starts: Sequence[Cell],
         claim_timeout: float = 4.0,
         retry_interval: float = 1.0,
+        replicas: int = REPLICAS,
+        keep_releases: bool = True,
     ) -> None:
         self.index = index
         self.fleet_size = len(starts)
-        self.quorum = self.fleet_size // 2 + 1
+        self.replica_count = min(self.fleet_size, replicas)
+        self.quorum = majority(self.replica_count)
         self.claim_timeout = claim_timeout
         self.retry_interval = retry_interval
+        self.keep_releases = keep_releases
         self.present: Cell = starts[index]
+        self.present_claim = 0
         self.target: Cell | None = None
         self.pending: PendingClaim | None = None
         self.granted_claim: PendingClaim | None = None
         self.stats = SafetyStats()
+        self._replicas = replicas
         self._claim_numbers = 0
-        self._grants: dict[Cell, _Grant] = {}
-        self._newest_state: dict[int, tuple[int, int]] = {}
+        self._registry: dict[Cell, _Registration] = {}
         self._highest_claim: dict[int, int] = {}
+        self._highest_release: dict[int, int] = {}
+        self._releases: dict[tuple[Cell, int], _Release] = {}
         for owner, cell in enumerate(starts):
-            if owner != index:
-                self._grants[cell] = _Grant(owner, 0, 0, cell)
+            if owner != index and index in self.replicas_of(cell):
+                self._registry[cell] = _Registration(owner, 0)
+
+    def replicas_of(self, cell: Cell) -> tuple[int, ...]:
+        """The robots that keep ``cell``'s registry (the same for every robot of the fleet)."""
+        return replica_set(cell, self.fleet_size, self._replicas)
 
     # -- the registry -----------------------------------------------------------------
 
     def owner_of(self, cell: Cell) -> int | None:
-        """The robot this robot has registered ``cell`` to, or None."""
+        """The robot this robot's registry names for ``cell`` (itself for its own cells), or None."""
         if cell == self.present or cell == self.target:
             return self.index
         if self.pending is not None and cell == self.pending.cell:
             return self.index
         if self.granted_claim is not None and cell == self.granted_claim.cell:
             return self.index
-        grant = self._grants.get(cell)
-        return grant.owner if grant is not None else None
-
-    # -- this robot's claims ----------------------------------------------------------
+        registration = self._registry.get(cell)
+        return registration.owner if registration is not None else None
 
     def can_claim(self, cell: Cell) -> bool:
-        """Whether ``cell`` is free in this robot's own registry (no peer owns it)."""
+        """Whether no peer owns ``cell`` in this robot's own registry."""
         owner = self.owner_of(cell)
         return owner is None or owner == self.index
 
-    def start_claim(self, cell: Cell, now: float) -> ClaimMessage | None:
-        """Begin claiming ``cell`` (abandoning any other pending claim); None if a peer owns it here.
+    # -- this robot's claims ----------------------------------------------------------
 
-        The returned message carries sequence number 0; the robot stamps it.
+    def start_claim(self, cell: Cell, now: float) -> ClaimMessage | None:
+        """Begin claiming ``cell`` (giving up any other pending claim); None if a peer owns it here.
+
+        The claim goes to :meth:`replicas_of` ``cell`` (but this robot); the
+        returned message carries sequence number 0, the robot stamps it.
         """
-        if not self.can_claim(cell):
+        if cell == self.present or cell == self.target or not self.can_claim(cell):
             return None
+        self.cancel_claim()
         self._claim_numbers += 1
-        self.pending = PendingClaim(self._claim_numbers, cell, now, now)
+        votes = {self.index} if self.index in self.replicas_of(cell) else set()
+        self.pending = PendingClaim(self._claim_numbers, cell, now, now, votes)
         self.stats.claims += 1
         return ClaimMessage(self.index, 0, self.pending.number, cell)
 
+    def claim_recipients(self, cell: Cell) -> tuple[int, ...]:
+        """Where a claim for ``cell`` goes: its replicas but this robot."""
+        return tuple(replica for replica in self.replicas_of(cell) if replica != self.index)
+
     def may_enter(self, cell: Cell) -> bool:
-        """Whether a majority has registered ``cell`` to this robot for its pending claim."""
+        """Whether a majority of ``cell``'s replicas registered it to this robot for its pending claim."""
         pending = self.pending
-        return (
-            pending is not None
-            and pending.cell == cell
-            and not pending.refused
-            and 1 + len(pending.votes) >= self.quorum
-        )
+        return pending is not None and pending.cell == cell and not pending.refused and len(pending.votes) >= self.quorum
 
     def begin_move(self, cell: Cell) -> None:
         """The body starts entering ``cell`` (which :meth:`may_enter` allowed, or any cell when unguarded)."""
@@ -177,32 +225,40 @@ class SafetyLayer:
         self.target = cell
 
     def end_move(self, cell: Cell) -> None:
-        """The body stands on ``cell``: it is the new Present, and the move's claim is over."""
+        """The body stands on ``cell``: it is the new Present; the cells left are released."""
+        granted = self.granted_claim
+        if cell != self.present:
+            self._release(self.present, self.present_claim)
+            self.present_claim = granted.number if granted is not None and granted.cell == cell else 0
+        if granted is not None and granted.cell != cell:
+            self._release(granted.cell, granted.number)  # the body stopped short of the cell it was allowed
         self.present = cell
         self.target = None
         self.granted_claim = None
 
     def cancel_claim(self) -> None:
-        """Abandon the pending claim (peers release it when they hear the next state)."""
-        self.pending = None
-
-    def expire(self, now: float) -> ClaimMessage | None:
-        """Time out or resend the pending claim; returns a claim to send again, if any."""
+        """Give up the pending claim, releasing it at the replicas that may have granted it."""
         pending = self.pending
-        if pending is None:
-            return None
-        if pending.refused:
-            self.stats.refused += 1
-            self.cancel_claim()
-            return None
-        if now - pending.started_at >= self.claim_timeout:
-            self.stats.timed_out += 1
-            self.cancel_claim()
-            return None
-        if now - pending.sent_at >= self.retry_interval and 1 + len(pending.votes) < self.quorum:
-            pending.sent_at = now
-            return ClaimMessage(self.index, 0, pending.number, pending.cell)
-        return None
+        if pending is not None:
+            self.pending = None
+            self._release(pending.cell, pending.number)
+
+    def expire(self, now: float) -> list[Send]:
+        """Time out or resend the pending claim, and send the releases due: the messages to send."""
+        sends: list[Send] = []
+        pending = self.pending
+        if pending is not None:
+            if pending.refused:
+                self.stats.refused += 1
+                self.cancel_claim()
+            elif now - pending.started_at >= self.claim_timeout:
+                self.stats.timed_out += 1
+                self.cancel_claim()
+            elif now - pending.sent_at >= self.retry_interval and len(pending.votes) < self.quorum:
+                pending.sent_at = now
+                sends.append((ClaimMessage(self.index, 0, pending.number, pending.cell), self.claim_recipients(pending.cell)))
+        sends.extend(self._releases_due(now))
+        return sends
 
     def state_fields(self) -> dict[str, object]:
         """The safety part of this robot's state message: ``target``, ``claim``, ``claim_cell``."""
@@ -213,59 +269,95 @@ class SafetyLayer:
             "claim_cell": claim.cell if claim is not None else None,
         }
 
+    @property
+    def unacknowledged_releases(self) -> int:
+        """Releases still being sent."""
+        return len(self._releases)
+
+    # -- releases ------------------------------------------------------------------------
+
+    def _release(self, cell: Cell, claim: int) -> None:
+        """Start sending the release of ``cell`` (registered for ``claim``) to its replicas."""
+        if not self.keep_releases:
+            return
+        waiting = set(self.claim_recipients(cell))
+        if waiting:
+            self._releases[(cell, claim)] = _Release(claim, cell, waiting)
+            self.stats.releases += 1
+
+    def _releases_due(self, now: float) -> list[Send]:
+        sends: list[Send] = []
+        for key, release in list(self._releases.items()):
+            if now - release.sent_at < self.retry_interval:
+                continue
+            if release.tries >= RELEASE_TRIES:
+                del self._releases[key]
+                self.stats.releases_given_up += 1
+                continue
+            release.tries += 1
+            release.sent_at = now
+            sends.append((ReleaseMessage(self.index, 0, release.claim, release.cell), tuple(sorted(release.waiting))))
+        return sends
+
     # -- peers' messages ---------------------------------------------------------------
 
-    def handle_state(self, message: StateMessage) -> None:
-        """Drop registrations the sender's newer state shows it is done with."""
-        sender = message.sender
-        if message.seq <= self._newest_state.get(sender, (-1, 0))[0]:
-            return
-        self._newest_state[sender] = (message.seq, message.claim)
-        self._highest_claim[sender] = max(self._highest_claim.get(sender, 0), message.claim)
-        occupied = message.occupied
-        for cell in [cell for cell, grant in self._grants.items() if grant.owner == sender]:
-            grant = self._grants[cell]
-            if message.seq <= grant.claim_seq or cell in occupied:
-                continue
-            if grant.claim and message.claim == grant.claim:
-                continue
-            del self._grants[cell]
-
     def handle_claim(self, message: ClaimMessage, claimant_outranks: bool) -> ReplyMessage | None:
-        """Grant or refuse a peer's claim; None for a claim its sender has already given up.
+        """Grant or refuse a peer's claim; None for a claim that is over, or not for this robot to answer.
 
         ``claimant_outranks`` says whether the claimant wins a contest with this
-        robot's own pending claim on the same cell (this robot then abandons its
-        claim and grants).
-        The reply carries sequence number 0; the robot stamps it.
+        robot's own pending claim on the same cell (this robot then gives up its
+        claim and grants). The reply carries sequence number 0; the robot stamps it.
         """
         sender, cell = message.sender, message.cell
-        newest_seq, newest_claim = self._newest_state.get(sender, (-1, 0))
-        if message.seq < newest_seq and newest_claim != message.claim:
-            return None  # a newer state of its sender shows it gave this claim up
-        if message.claim < self._highest_claim.get(sender, 0):
-            return None  # its sender has made a newer claim since: this one is over
+        if self.index not in self.replicas_of(cell):
+            return None  # not a replica of the cell: its registry does not count
+        if message.claim < self._highest_claim.get(sender, 0) or message.claim <= self._highest_release.get(sender, -1):
+            return None  # its sender has made a newer claim, or released this one: it is over
         self._highest_claim[sender] = message.claim
         owner = self.owner_of(cell)
-        pending_here = self.pending is not None and self.pending.cell == cell and cell != self.present
-        if owner == self.index and pending_here and self.target != cell and claimant_outranks and self.granted_claim is None:
-            self.pending = None
+        pending = self.pending
+        contested = pending is not None and pending.cell == cell and self.granted_claim is None
+        if owner == self.index and contested and claimant_outranks and cell not in (self.present, self.target):
+            self.cancel_claim()
             owner = self.owner_of(cell)
         if owner is None or owner == sender:
-            previous = self._grants.get(cell)
-            claim_seq = message.seq if previous is None else max(previous.claim_seq, message.seq)
-            self._grants[cell] = _Grant(sender, message.claim, claim_seq, cell)  # records only move forward
+            self._registry[cell] = _Registration(sender, message.claim)  # only newer claims get here
             self.stats.grants_given += 1
             return ReplyMessage(self.index, 0, sender, message.claim, cell, True)
         self.stats.refusals_given += 1
         return ReplyMessage(self.index, 0, sender, message.claim, cell, False)
 
     def handle_reply(self, message: ReplyMessage, now: float) -> None:
-        """Count a peer's answer to this robot's pending claim (others are ignored)."""
+        """Count a replica's answer to this robot's pending claim (others are ignored)."""
         pending = self.pending
         if pending is None or message.claimant != self.index or message.claim != pending.number:
+            return
+        if message.cell != pending.cell or message.sender not in self.replicas_of(pending.cell):
             return
         if message.granted:
             pending.votes.add(message.sender)
         else:
             pending.refused = True
+
+    def handle_release(self, message: ReleaseMessage) -> ReleaseAckMessage:
+        """Drop the sender's registration of the cell if it is not newer than the release; acknowledge it.
+
+        The acknowledgement carries sequence number 0; the robot stamps it.
+        """
+        sender, cell = message.sender, message.cell
+        self._highest_release[sender] = max(self._highest_release.get(sender, -1), message.claim)
+        registration = self._registry.get(cell)
+        if registration is not None and registration.owner == sender and registration.claim <= message.claim:
+            del self._registry[cell]
+        return ReleaseAckMessage(self.index, 0, sender, message.claim, cell)
+
+    def handle_release_ack(self, message: ReleaseAckMessage) -> None:
+        """A replica has taken in one of this robot's releases: stop sending it there."""
+        if message.owner != self.index:
+            return
+        release = self._releases.get((message.cell, message.claim))
+        if release is None:
+            return
+        release.waiting.discard(message.sender)
+        if not release.waiting:
+            del self._releases[(message.cell, message.claim)]

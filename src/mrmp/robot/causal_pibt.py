@@ -93,6 +93,8 @@ from mrmp.protocol.messages import (
     LockReleaseMessage,
     LockRequestMessage,
     Message,
+    ReleaseAckMessage,
+    ReleaseMessage,
     ReplyMessage,
     StateMessage,
 )
@@ -500,7 +502,7 @@ class CausalRobot(MessageEndpoint):
             self.claim_failures += 1
             return []
         self.stats["claims"] += 1
-        return [Outgoing(self._stamp(claim))]
+        return [Outgoing(self._stamp(claim), self.safety.claim_recipients(claim.cell))]
 
     def motion(self, now: float) -> Cell | None:
         """The cell the body may start entering now (a majority registered it to this robot), if any."""
@@ -539,7 +541,11 @@ class CausalRobot(MessageEndpoint):
             self.reached += 1
         self.away = int(self.tail != self.goal)
         self._reset()
-        return [Outgoing(self.state_message())]
+        return [Outgoing(self.state_message()), *self._safety_sends(now)]
+
+    def _safety_sends(self, now: float) -> list[Outgoing]:
+        """The safety layer's messages due now (releases of the cells left, claims to resend), stamped."""
+        return [Outgoing(self._stamp(message), recipients) for message, recipients in self.safety.expire(now)]
 
     def _give_up_head(self) -> list[Outgoing]:
         """Extended into a cell the registries keep refusing: contract again on the tail."""
@@ -565,10 +571,11 @@ class CausalRobot(MessageEndpoint):
             elif session.position < len(session.order):
                 sent.extend(self._advance(now))
                 self.stats["resent"] += 1
+        safety_sends = self._safety_sends(now)
+        sent.extend(safety_sends)
         if self.mode == EXTENDED and not self.moving and not self.body_arrived:
-            resend = self.safety.expire(now)
-            if resend is not None:
-                sent.append(Outgoing(self._stamp(resend)))
+            if any(isinstance(item.message, ClaimMessage) for item in safety_sends):
+                pass  # the claim is still on its way
             elif self.safety.pending is None:
                 if self._failed_at is None:
                     self._failed_at = now
@@ -576,13 +583,13 @@ class CausalRobot(MessageEndpoint):
                 if self.claim_failures >= MAX_CLAIM_FAILURES and self.locked_by is None and self.session is None:
                     sent.extend(self._give_up_head())
                 elif now - self._failed_at >= 2 * self.retry_interval:
-                    sent.extend(self._claim_head(now))  # registries release a cell only on its last owner's state
+                    sent.extend(self._claim_head(now))  # a cell is free again once its owner's release arrives
         else:
             sent.extend(self._finish_move_when_free(now))
         return sent
 
     def heartbeat(self) -> list[Outgoing]:
-        """The state message every peer gets regularly (it releases registrations, tells where this robot is)."""
+        """The state message every peer gets regularly (it tells where this robot is)."""
         return [Outgoing(self.state_message())]
 
     # -- messages in ------------------------------------------------------------------------
@@ -617,6 +624,15 @@ class CausalRobot(MessageEndpoint):
         self.safety.handle_reply(message, now)
         return []
 
+    @handlers.on(ReleaseMessage)
+    def _on_cell_release(self, message: ReleaseMessage, now: float) -> list[Outgoing]:
+        return self._answer_release(message)
+
+    @handlers.on(ReleaseAckMessage)
+    def _on_cell_release_ack(self, message: ReleaseAckMessage, now: float) -> list[Outgoing]:
+        self.safety.handle_release_ack(message)
+        return []
+
     @handlers.on(LockRequestMessage)
     def _on_lock_request(self, message: LockRequestMessage, now: float) -> list[Outgoing]:
         return self._take_request(message)
@@ -646,7 +662,6 @@ class CausalRobot(MessageEndpoint):
                 self.known_heads[sender] = message.next
             else:
                 self.known_heads.pop(sender, None)
-        self.safety.handle_state(message)
 
     def _grant(self, locker: int, session: int) -> Outgoing:
         grant = LockGrantMessage(

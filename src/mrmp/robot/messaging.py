@@ -35,7 +35,7 @@ from mrmp.core.cell import Cell
 from mrmp.core.heading import Heading
 from mrmp.policies.priority import outranks
 from mrmp.protocol.codec import DecodeError, decode
-from mrmp.protocol.messages import ClaimMessage, Message, StateMessage
+from mrmp.protocol.messages import ClaimMessage, Message, ReleaseMessage, StateMessage
 from mrmp.protocol.safety import SafetyLayer
 
 M = TypeVar("M", bound=Message)
@@ -131,6 +131,10 @@ class MessageEndpoint:
             self.dropped["stale_claim"] += 1
             return []
         return [Outgoing(self._stamp(reply), (message.sender,))]
+
+    def _answer_release(self, message: ReleaseMessage) -> list[Outgoing]:
+        """The safety layer's acknowledgement of a peer's release, for that peer alone."""
+        return [Outgoing(self._stamp(self.safety.handle_release(message)), (message.sender,))]
 
     def receive(self, message: Message, now: float) -> list[Outgoing]:
         """Take in one decoded message; return the answers to send."""

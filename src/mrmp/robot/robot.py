@@ -22,7 +22,8 @@ One step, as in the thesis (sections 3.5-3.6), with the safety layer:
    (guarded: only once a majority has registered it to this robot);
 5. :meth:`Robot.arrived`: the body stands on a new cell (the Khepera counts grid
    lines); the robot then announces again;
-6. :meth:`Robot.expire`: timers (resend or abandon a claim).
+6. :meth:`Robot.expire`: timers (resend or abandon a claim, send the releases
+   of the cells left).
 
 With ``guarded=False`` step 4 allows whatever step 3 decided, reproducing the
 thesis as written.
@@ -51,7 +52,7 @@ from mrmp.core.grid import Grid
 from mrmp.core.heading import Heading
 from mrmp.core.scenario import RobotSpec
 from mrmp.policies.base import Decision, Policy, Situation
-from mrmp.protocol.messages import ClaimMessage, Message, ReplyMessage, StateMessage
+from mrmp.protocol.messages import ClaimMessage, Message, ReleaseAckMessage, ReleaseMessage, ReplyMessage, StateMessage
 from mrmp.protocol.safety import SafetyLayer
 from mrmp.robot.belief import Belief
 from mrmp.robot.messaging import Handlers, MessageEndpoint, Outgoing
@@ -109,7 +110,9 @@ class Robot(MessageEndpoint):
         self.wanted: Cell | None = None
         self.moving = False
         self.belief = Belief()
-        self.safety = SafetyLayer(index, starts, claim_timeout=claim_timeout, retry_interval=retry_interval)
+        self.safety = SafetyLayer(
+            index, starts, claim_timeout=claim_timeout, retry_interval=retry_interval, keep_releases=guarded
+        )
         self.seq = 0
         self.progress = 0
         self.dropped: Counter[str] = Counter()
@@ -163,7 +166,7 @@ class Robot(MessageEndpoint):
         if claim is None:
             self.wanted = None  # a peer owns the cell in this robot's registry: stay this step
             return []
-        return [Outgoing(self._stamp(claim))]
+        return [Outgoing(self._stamp(claim), self.safety.claim_recipients(claim.cell))]
 
     def motion(self, now: float) -> Cell | None:
         """The cell the body may start entering now, if any; the robot then counts as moving."""
@@ -187,13 +190,13 @@ class Robot(MessageEndpoint):
         self.safety.end_move(cell)
 
     def expire(self, now: float) -> list[Outgoing]:
-        """Run the safety layer's timers: resend a claim still short of a majority, or abandon it."""
+        """Run the safety layer's timers: resend a claim still short of a majority, or abandon it; send releases due."""
         if not self.guarded:
             return []
-        resend = self.safety.expire(now)
+        sends = self.safety.expire(now)
         if self.safety.pending is None and not self.moving:
             self.wanted = None
-        return [Outgoing(self._stamp(resend))] if resend is not None else []
+        return [Outgoing(self._stamp(message), recipients) for message, recipients in sends]
 
     # -- messages in ----------------------------------------------------------------------
 
@@ -211,7 +214,6 @@ class Robot(MessageEndpoint):
     @handlers.on(StateMessage)
     def _take_state(self, message: StateMessage, now: float) -> list[Outgoing]:
         self.belief.update(message, now)
-        self.safety.handle_state(message)
         return []
 
     @handlers.on(ClaimMessage)
@@ -222,4 +224,13 @@ class Robot(MessageEndpoint):
     @handlers.on(ReplyMessage)
     def _take_reply(self, message: ReplyMessage, now: float) -> list[Outgoing]:
         self.safety.handle_reply(message, now)
+        return []
+
+    @handlers.on(ReleaseMessage)
+    def _take_release(self, message: ReleaseMessage, now: float) -> list[Outgoing]:
+        return self._answer_release(message)
+
+    @handlers.on(ReleaseAckMessage)
+    def _take_release_ack(self, message: ReleaseAckMessage, now: float) -> list[Outgoing]:
+        self.safety.handle_release_ack(message)
         return []

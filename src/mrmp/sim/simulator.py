@@ -268,6 +268,8 @@ class LockstepSimulator:
             network[f"claims_{name}" if name != "claims" else "claims"] = sum(
                 getattr(robot.safety.stats, name) for robot in self.robots
             )
+        network["releases"] = sum(robot.safety.stats.releases for robot in self.robots)
+        network["releases_given_up"] = sum(robot.safety.stats.releases_given_up for robot in self.robots)
         policy = self.robots[0].policy.name if self.robots else self.scenario.policy.name
         return run_result(self, self._results, policy, stop_reason, wall_time, network, message_log=self._message_log)
 

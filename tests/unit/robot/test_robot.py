@@ -3,7 +3,7 @@
 from mrmp.core import Grid, Heading, RobotSpec
 from mrmp.policies.thesis import ThesisPolicy
 from mrmp.protocol.codec import encode
-from mrmp.protocol.messages import ClaimMessage, ReplyMessage, StateMessage
+from mrmp.protocol.messages import ClaimMessage, ReleaseMessage, ReplyMessage, StateMessage
 from mrmp.robot.robot import Robot
 
 STARTS = [(0, 2), (4, 2)]
@@ -40,7 +40,9 @@ def test_refusal_abandons_the_claim_and_the_robot_decides_again():
     [claim] = a.decide(now=1)
     a.receive(ReplyMessage(1, 1, 0, claim.message.claim, (1, 2), False), now=1)
     assert a.motion(now=1) is None
-    assert a.expire(now=1) == [] and a.safety.pending is None and a.wanted is None
+    [release] = a.expire(now=1)  # the replicas that granted it are told the claim is over
+    assert isinstance(release.message, ReleaseMessage) and release.message.cell == (1, 2) and release.recipients == (1,)
+    assert a.safety.pending is None and a.wanted is None
     assert a.decide(now=2) != []  # a new claim
 
 
