@@ -147,7 +147,7 @@ def test_an_activation_without_answers_is_abandoned_and_released_everywhere():
 def test_a_head_the_registries_keep_refusing_is_given_up_and_never_entered():
     """Robot 0 has not heard where robot 1 is: its plan extends into robot 1's cell, the safety layer refuses it."""
     robot = CausalRobot(0, Grid(1, 3), [(0, 0), (0, 1)], goal=(0, 2), retry_interval=1)
-    robot.known = {}  # stale knowledge: no robot known nearby, so no lock either
+    robot.known.clear()  # stale knowledge: no robot known nearby, so no lock either
     robot.activate(0)
     robot.activate(0)
     assert (robot.mode, robot.head) == (EXTENDED, (0, 1))
