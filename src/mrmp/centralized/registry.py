@@ -19,6 +19,7 @@ from mrmp.centralized.lacam import lacam
 from mrmp.centralized.plan import PlanningResult
 from mrmp.centralized.prioritized import prioritized
 from mrmp.core.scenario import Scenario
+from mrmp.core.seeds import Stream, derive_seed
 
 PLANNERS: dict[str, Callable[..., PlanningResult]] = {"cbs": cbs, "pp": prioritized, "lacam": lacam}
 """Central planners by name: Conflict-Based Search, prioritized planning, LaCAM. Each is called as
@@ -39,4 +40,4 @@ def plan_with(name: str, scenario: Scenario, time_limit_s: float) -> PlanningRes
     planner = PLANNERS[name]
     if name in _HEADING_AWARE:
         return planner(scenario, time_limit_s=time_limit_s, heading_aware=scenario.policy.heading_aware)
-    return planner(scenario, time_limit_s=time_limit_s, seed=scenario.seed)
+    return planner(scenario, time_limit_s=time_limit_s, seed=derive_seed(scenario.seed, Stream.PLANNER))

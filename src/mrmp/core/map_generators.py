@@ -38,7 +38,6 @@ Examples
 
 from __future__ import annotations
 
-import random
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -46,6 +45,7 @@ from typing import Any
 from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid, connected_regions
 from mrmp.core.scenario import RobotSpec, Scenario
+from mrmp.core.seeds import Stream, stream_random
 
 
 def largest_region(grid: Grid) -> list[Cell]:
@@ -99,7 +99,7 @@ def random_map(width: int, height: int, density: float, seed: int) -> Grid:
     _check_size(width, height)
     if not 0.0 <= density < 1.0:
         raise ValueError(f"density must be in [0, 1), got {density}")
-    rng = random.Random(seed)
+    rng = stream_random(seed, Stream.MAP)
     free = {(x, y) for x in range(height) for y in range(width) if rng.random() >= density}
     if not free:
         free = {(0, 0)}
@@ -138,7 +138,7 @@ def maze_map(width: int, height: int, corridor: int, seed: int) -> Grid:
     def carve(x0: int, y0: int, x_extent: int, y_extent: int) -> None:
         free.update((x, y) for x in range(x0, x0 + x_extent) for y in range(y0, y0 + y_extent))
 
-    rng = random.Random(seed)
+    rng = stream_random(seed, Stream.MAP)
     visited = {(0, 0)}
     stack = [(0, 0)]
     carve(1, 1, corridor, corridor)
@@ -225,7 +225,7 @@ def room_map(width: int, height: int, room_size: int, doors: int, seed: int) -> 
         raise ValueError(f"room_size and doors must be at least 1, got {room_size} and {doors}")
     _check_size(width, height, room_size)
     pitch = room_size + 1
-    rng = random.Random(seed)
+    rng = stream_random(seed, Stream.MAP)
 
     def walls(extent: int) -> list[int]:
         return [index for index in range(room_size, extent - 1, pitch)]
@@ -371,7 +371,7 @@ def random_instance(grid: Grid, agents: int, seed: int, name: str | None = None)
     region = largest_region(grid)
     if agents > len(region):
         raise ValueError(f"{agents} robots do not fit in a connected region of {len(region)} free cells")
-    rng = random.Random(seed)
+    rng = stream_random(seed, Stream.INSTANCE)
     starts, goals = rng.sample(region, agents), rng.sample(region, agents)
     robots = tuple(RobotSpec(str(index), start, goal) for index, (start, goal) in enumerate(zip(starts, goals)))
     return Scenario(grid, robots, name=name if name is not None else f"{grid.name}-seed-{seed}", seed=seed)

@@ -1,17 +1,16 @@
-"""Seeds for independent random streams, derived from one run's seed.
+"""Seeds for independent random streams, derived from one seed by one rule.
 
-A live robot has three consumers of randomness besides its policy: its fault
-injector, its simulated body (jitter, missed grid lines) and its driver's own
-timing draws. :func:`derive_seed` names the stream and the robot's index and
-hashes them with the run's seed (BLAKE2b), so no two consumers share a stream:
-no arithmetic coincidence such as ``7919 * s + i == 104729 * s + 17`` can make
-one robot's fault injector replay another consumer's draws.
-
-The simulators' own streams (tie-breaking ``seed * 7919 + index``, the
-asynchronous simulator's speeds, lifelong goals, the simulated network) keep
-their historic derivations, on which the published benchmark figures rest; a
-live robot's tie-breaking uses the simulator's formula so that a live fleet and
-a simulated one break ties alike.
+Every consumer of randomness in mrmp draws from a stream of its own: a robot's
+tie-breaking, the asynchronous simulator's paces, lifelong goals, the
+simulated network, a central planner's tie-breaks, a live robot's fault
+injector, body and driver, a generated map and a random instance's starts and
+goals. :func:`derive_seed` names the consumer (a :class:`Stream`) and, where a
+stream is per robot, the robot's index, and hashes them with the given seed
+(BLAKE2b, RFC 7693), so no two consumers share a stream: no arithmetic
+coincidence (such as a formula ``a * seed + index`` giving robot 0 of seed 0
+the seed 0 of another consumer) can make one consumer replay another's draws.
+A live robot and a simulated one derive their tie-breaking seeds alike, so a
+live fleet and a simulated one break ties alike.
 
 Examples
 --------
@@ -19,9 +18,9 @@ Examples
 True
 >>> len({derive_seed(4, stream, 0) for stream in Stream}) == len(Stream)
 True
->>> derive_seed(4, Stream.BODY, 1) != derive_seed(4, Stream.BODY, 0)
+>>> derive_seed(4, Stream.TIES, 1) != derive_seed(4, Stream.TIES, 0)
 True
->>> stream_random(4, Stream.SCHEDULE).random() == stream_random(4, Stream.SCHEDULE).random()
+>>> stream_random(4, Stream.NETWORK).random() == stream_random(4, Stream.NETWORK).random()
 True
 """
 
@@ -33,22 +32,38 @@ import random
 
 
 class Stream(enum.Enum):
-    """The consumers of a live robot's randomness that draw from streams of their own."""
+    """The consumers of randomness, each drawing from a stream of its own."""
 
+    TIES = "ties"
+    """A robot's tie-breaks between equally near cells, in every simulator and live (per robot)."""
+    PACES = "paces"
+    """The asynchronous simulator's robot paces, activation times and move durations."""
+    GOALS = "goals"
+    """The new goals of a lifelong run."""
+    NETWORK = "network"
+    """The simulated network's losses, delays, duplicates and reorderings."""
+    PLANNER = "planner"
+    """A central planner's random tie-breaks (LaCAM's PIBT)."""
     LIVE_FAULTS = "live-faults"
     """A live robot's fault injector (per robot)."""
     BODY = "body"
     """A live robot's simulated body: jitter and missed grid lines (per robot)."""
     SCHEDULE = "schedule"
     """A live robot driver's own timing draws (per robot)."""
+    MAP = "map"
+    """A generated map's obstacles, maze walls or doors, from the map's seed."""
+    INSTANCE = "instance"
+    """A random instance's starts and goals, from the instance's seed."""
 
 
 def derive_seed(seed: int, stream: Stream, index: int = 0) -> int:
-    """The seed of ``stream`` (for robot ``index`` where the stream is per robot) in a run seeded ``seed``.
+    """The seed of ``stream`` (for robot ``index`` where the stream is per robot) derived from ``seed``.
 
     A 64-bit integer, the same on every machine and Python version.
 
-    >>> derive_seed(0, Stream.LIVE_FAULTS) == derive_seed(0, Stream.LIVE_FAULTS) != derive_seed(1, Stream.LIVE_FAULTS)
+    >>> derive_seed(0, Stream.NETWORK) == derive_seed(0, Stream.NETWORK) != derive_seed(1, Stream.NETWORK)
+    True
+    >>> derive_seed(0, Stream.NETWORK) != derive_seed(0, Stream.TIES, 0)
     True
     """
     key = f"mrmp/{stream.value}/{seed}/{index}".encode()
@@ -56,5 +71,5 @@ def derive_seed(seed: int, stream: Stream, index: int = 0) -> int:
 
 
 def stream_random(seed: int, stream: Stream, index: int = 0) -> random.Random:
-    """A generator for ``stream`` of a run seeded ``seed`` (see :func:`derive_seed`)."""
+    """A generator for ``stream`` derived from ``seed`` (see :func:`derive_seed`)."""
     return random.Random(derive_seed(seed, stream, index))

@@ -29,12 +29,12 @@ caller, through ``on_progress`` while running and at the end.
 
 from __future__ import annotations
 
-import random
 import time
 from collections.abc import Callable
 
 from mrmp.core.cell import Cell
 from mrmp.core.scenario import Scenario
+from mrmp.core.seeds import Stream, stream_random
 from mrmp.live.body import Body
 from mrmp.live.driver import AgentTiming, LiveDriver
 from mrmp.live.transport import Transport
@@ -79,7 +79,7 @@ class CausalAgent(LiveDriver):
             scenario.grid,
             [robot.start for robot in scenario.robots],
             spec.goal,
-            rng=random.Random(seed * 7919 + index),
+            rng=stream_random(seed, Stream.TIES, index),
             retry_interval=retry,
             lock_timeout=max(1.0, 20 * retry),
             claim_timeout=timing.claim_timeout,

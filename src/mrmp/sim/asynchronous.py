@@ -35,7 +35,6 @@ Examples
 from __future__ import annotations
 
 import math
-import random
 import time
 from collections import Counter
 
@@ -43,6 +42,7 @@ from mrmp.core.cell import Cell
 from mrmp.core.heading import Heading, right_turns
 from mrmp.core.result import RobotResult, RunResult
 from mrmp.core.scenario import Scenario
+from mrmp.core.seeds import Stream, stream_random
 from mrmp.robot.causal_pibt import CausalRobot
 from mrmp.robot.robot import Outgoing
 from mrmp.search.flat_map import FlatMap
@@ -87,7 +87,7 @@ class AsynchronousSimulator:
         starts = [spec.start for spec in scenario.robots]
         worst = scenario.worst_faults()
         retry, lock_timeout, claim_timeout, self.heartbeat_period = causal_timers(worst.delay_max)
-        self._random = random.Random(scenario.seed * 104_729 + 17)
+        self._random = stream_random(scenario.seed, Stream.PACES)
         self.paces = [self._random.randint(1, SLOWEST_PACE) for _ in scenario.robots]
         self.robots = [
             CausalRobot(
@@ -95,7 +95,7 @@ class AsynchronousSimulator:
                 grid,
                 starts,
                 spec.goal,
-                rng=random.Random(scenario.seed * 7919 + index),
+                rng=stream_random(scenario.seed, Stream.TIES, index),
                 retry_interval=retry,
                 lock_timeout=lock_timeout,
                 claim_timeout=claim_timeout,

@@ -19,11 +19,12 @@ import random
 from collections.abc import Container, Iterable, Sequence
 
 from mrmp.core.cell import Cell
+from mrmp.core.seeds import Stream, stream_random
 
 
 def goal_random(seed: int) -> random.Random:
     """The random generator of a run's new goals (independent of the network's)."""
-    return random.Random(seed * 1_000_003 + 7)
+    return stream_random(seed, Stream.GOALS)
 
 
 def new_goal(rng: random.Random, free_cells: Sequence[Cell], taken: Container[Cell], here: Cell) -> Cell | None:

@@ -37,13 +37,12 @@ Examples
 ...                 policy=PolicyOptions(name="pibt"))
 >>> result = RoundsSimulator(swap).run()
 >>> result.success, result.makespan, result.sum_of_costs, result.lower_bound
-(True, 9, 13, 8)
+(True, 7, 11, 8)
 """
 
 from __future__ import annotations
 
 import gc
-import random
 import time
 from collections import Counter
 from collections.abc import Sequence
@@ -53,6 +52,7 @@ from mrmp.core.faults import message_fates
 from mrmp.core.heading import right_turns
 from mrmp.core.result import RobotResult, RunResult
 from mrmp.core.scenario import NetworkFaults, Scenario
+from mrmp.core.seeds import Stream, stream_random
 from mrmp.protocol.codec import fixed_sizes
 from mrmp.protocol.messages import BeaconMessage, Message, ReserveMessage  # noqa: F401  (ReserveMessage: doctest)
 from mrmp.robot.messaging import Outgoing
@@ -134,7 +134,7 @@ class RoundsSimulator:
                     swap=options.swap,
                     heading_aware=options.heading_aware,
                     turn_cost=scenario.timing.turn_time / scenario.timing.cell_time,
-                    rng=random.Random(scenario.seed * 7919 + index) if random_ties else None,
+                    rng=stream_random(scenario.seed, Stream.TIES, index) if random_ties else None,
                     tie_penalties=tie_penalties,
                 )
             )
@@ -148,7 +148,7 @@ class RoundsSimulator:
             for spec in scenario.robots
         ]
         self._durations: list[list[float]] = [[] for _ in scenario.robots]
-        self._random = random.Random(scenario.seed)
+        self._random = stream_random(scenario.seed, Stream.NETWORK)
         self._links = link_faults(scenario)
         self._perfect = scenario.network.is_perfect and not self._links
         self._near: dict[int, list[tuple[int, ...] | None]] = {}

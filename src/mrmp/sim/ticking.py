@@ -28,6 +28,7 @@ from typing import Any, Protocol
 from mrmp.core.cell import Cell
 from mrmp.core.result import RobotResult, RunResult
 from mrmp.core.scenario import NetworkFaults, Scenario
+from mrmp.core.seeds import Stream, derive_seed
 from mrmp.protocol.codec import encode
 from mrmp.robot.robot import Outgoing
 from mrmp.sim.network import SimulatedNetwork
@@ -59,7 +60,9 @@ def link_faults(scenario: Scenario) -> dict[tuple[int, int], NetworkFaults]:
 
 def scenario_network(scenario: Scenario) -> SimulatedNetwork:
     """The simulated network of ``scenario``: its faults, seed and per-link faults (by robot index)."""
-    return SimulatedNetwork(scenario.network, seed=scenario.seed, links=link_faults(scenario))
+    return SimulatedNetwork(
+        scenario.network, seed=derive_seed(scenario.seed, Stream.NETWORK), links=link_faults(scenario)
+    )
 
 
 def run_ticks(
