@@ -134,16 +134,38 @@ def write_svg(
     ValueError
         If ``seconds_per_tick`` is not positive or ``hold_s`` is negative.
     """
+    root = _svg_root(grid, result, seconds_per_tick, hold_s, show_messages)
+    target = Path(path)
+    with replacing(target) as temporary:
+        ET.ElementTree(root).write(temporary, encoding="utf-8", xml_declaration=True)
+    return target
+
+
+def svg_text(
+    grid: Grid, result: RunResult, *, seconds_per_tick: float = 0.4, hold_s: float = 1.5, show_messages: bool = False
+) -> str:
+    """The animated SVG of :func:`write_svg` as text, to embed in HTML (no XML declaration).
+
+    >>> from mrmp.core import Grid, RobotSpec, Scenario
+    >>> from mrmp.sim.simulator import simulate
+    >>> grid = Grid(1, 3)
+    >>> text = svg_text(grid, simulate(Scenario(grid, (RobotSpec("A", (0, 0), (0, 2)),))))
+    >>> text.startswith("<svg") and text.endswith("</svg>")
+    True
+    """
+    root = _svg_root(grid, result, seconds_per_tick, hold_s, show_messages)
+    return ET.tostring(root, encoding="unicode")
+
+
+def _svg_root(grid: Grid, result: RunResult, seconds_per_tick: float, hold_s: float, show_messages: bool) -> ET.Element:
+    """The animation's ``<svg>`` element, indented; checks the timing arguments."""
     if not seconds_per_tick > 0:
         raise ValueError(f"seconds_per_tick must be positive, got {seconds_per_tick}")
     if not hold_s >= 0:
         raise ValueError(f"hold_s must not be negative, got {hold_s}")
     root = _SvgRun(grid, result, seconds_per_tick, hold_s, show_messages).build()
     ET.indent(root, space=" ")
-    target = Path(path)
-    with replacing(target) as temporary:
-        ET.ElementTree(root).write(temporary, encoding="utf-8", xml_declaration=True)
-    return target
+    return root
 
 
 def _n(value: float) -> str:
