@@ -14,11 +14,11 @@ robot's share: its moves and the dependencies it waits for).
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 
 from mrmp.centralized.registry import PLANNER_NAMES, plan_with
 from mrmp.core.result import RunResult
-from mrmp.core.scenario import PolicyOptions, Scenario
+from mrmp.core.scenario import Scenario
 from mrmp.experiments.execution import execute_in_simulator
 from mrmp.sim.policy_table import policy_names
 from mrmp.sim.simulator import simulate
@@ -43,10 +43,14 @@ class ComparisonRow:
 
 
 def compare_methods(scenario: Scenario, time_limit_s: float = 30.0) -> list[ComparisonRow]:
-    """Run every decentralized policy and every central planner (with execution) on ``scenario``."""
+    """Run every decentralized policy and every central planner (with execution) on ``scenario``.
+
+    Every policy runs with the scenario's policy settings (``resolve``,
+    ``heading_aware``, ...), only its name replaced.
+    """
     rows: list[ComparisonRow] = []
     for name in policy_names():
-        result = simulate(scenario.with_changes(policy=PolicyOptions(name=name, resolve=scenario.policy.resolve)))
+        result = simulate(scenario.with_changes(policy=replace(scenario.policy, name=name)))
         rows.append(_row(name, "decentralized", result, result.stop_reason))
     for name in PLANNER_NAMES:
         started = time.perf_counter()
