@@ -257,22 +257,23 @@ def print_result(result: RunResult, console: Console) -> None:
             str(robot.messages_sent),
         )
     if len(result.robots) > TABLE_ROWS:
-        table.caption = f"{len(result.robots) - TABLE_ROWS} more robots in the --json result"
+        table.caption = f"{len(result.robots) - TABLE_ROWS} more robots not shown (--json writes every robot)"
     console.print(table)
     verdict = "[green]success[/green]" if result.success else "[red]failure[/red]"
     if result.mode == "live":
         network = result.network
-        rejected = {key[9:]: value for key, value in network.items() if key.startswith("rejected_") and value}
-        injected = {key[9:]: value for key, value in network.items() if key.startswith("injected_") and value}
+        rejected = _counts(network, "rejected_")
+        injected = _counts(network, "injected_")
         moves = sum(robot.steps for robot in result.robots)
         arrivals = sum(robot.time_s for robot in result.robots if robot.arrived)
         console.print(
             f"{verdict} ({result.stop_reason}): wall-clock makespan {result.time_makespan_s:.2f} s "
-            f"(ideal {result.ideal_makespan_s or 0:.2f} s), sum of arrival times {arrivals:.2f} s, "
+            f"(ideal {result.ideal_makespan_s or 0:.2f} s: the longest single-robot path at this speed), "
+            f"sum of arrival times {arrivals:.2f} s, "
             f"moves {moves} (lower bound {result.lower_bound}), collisions: {len(result.collisions)}, "
             f"messages {result.messages}, wall time {result.wall_time_s:.1f} s"
         )
-        console.print(f"  dropped by robots: {rejected or 'none'}; injected faults: {injected or 'none'}", markup=False)
+        console.print(f"  dropped by robots: {rejected}; injected faults: {injected}", markup=False)
         if network.get("missed_lines"):
             console.print(f"  grid lines missed by bodies: {network['missed_lines']} (positions believed wrong from then on)")
     elif result.lifelong:
@@ -297,6 +298,18 @@ def print_result(result: RunResult, console: Console) -> None:
         console.print(f"  did not arrive: {names}")
 
 
+def _counts(network: dict[str, int], prefix: str) -> str:
+    """The nonzero counts of ``network`` whose key starts with ``prefix``, as ``"lost 24, duplicated 3"``.
+
+    >>> _counts({"injected_sent": 82, "injected_lost": 24, "injected_delayed": 0, "messages": 9}, "injected_")
+    'sent 82, lost 24'
+    >>> _counts({}, "rejected_")
+    'none'
+    """
+    counts = [f"{key[len(prefix):].replace('_', ' ')} {value}" for key, value in network.items() if key.startswith(prefix) and value]
+    return ", ".join(counts) or "none"
+
+
 def _check_show_messages(scenario: Scenario, written: bool, live: bool, planned: bool) -> None:
     """Refuse ``--show-messages`` before the run when its messages would not be recorded or drawn."""
     from mrmp.sim.simulator import records_messages
@@ -309,7 +322,7 @@ def _check_show_messages(scenario: Scenario, written: bool, live: bool, planned:
         raise InputError(
             Problem(
                 "--show-messages",
-                f"{scenario.policy.name} runs in synchronous rounds whose messages are not recorded; "
+                f"{scenario.policy.name} {policy_entry(scenario.policy.name).runs}, which records no messages; "
                 "use a per-robot policy or --planner",
             )
         )

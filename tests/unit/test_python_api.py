@@ -42,7 +42,7 @@ def test_bad_options_are_refused_naming_the_field(options: dict[str, object], me
 
 
 def test_load_names_the_file_of_a_missing_scenario(tmp_path: Path) -> None:
-    with pytest.raises(InputError, match="nothing.yaml"):
+    with pytest.raises(InputError, match=r"nothing\.yaml"):
         mrmp.load(tmp_path / "nothing.yaml")
 
 

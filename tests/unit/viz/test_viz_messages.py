@@ -136,7 +136,9 @@ def test_cli_refuses_show_messages_where_none_are_recorded(tmp_path: Path) -> No
     runner = CliRunner()
     swap = str(EXAMPLES / "thesis-swap.yaml")
     pibt = runner.invoke(app, ["run", swap, "--policy", "pibt", "--show-messages", "--animate", str(tmp_path / "a.svg")])
-    assert pibt.exit_code == 2 and "synchronous rounds whose messages are not recorded" in pibt.output
+    assert pibt.exit_code == 2 and "pibt runs in synchronous rounds (mrmp.sim.rounds), which records no" in pibt.output
+    causal = runner.invoke(app, ["run", swap, "--policy", "causal", "--show-messages", "--animate", str(tmp_path / "a.svg")])
+    assert causal.exit_code == 2 and "causal runs asynchronously (mrmp.sim.asynchronous), which records no" in causal.output
     assert "success" not in pibt.output, "refused before the run"
     alone = runner.invoke(app, ["run", swap, "--show-messages"])
     assert alone.exit_code == 2 and "give --animate" in alone.output
