@@ -331,9 +331,15 @@ def _check_show_messages(scenario: Scenario, written: bool, live: bool, planned:
 def _watched(
     scenario: Scenario, fps: float | None, console: Console, start: Callable[[TickObserver | None], RunResult]
 ) -> RunResult:
-    """``start(on_tick)``, drawing every tick in the terminal when ``fps`` is given (``--watch``)."""
+    """``start(on_tick)``, drawing every tick in the terminal when ``fps`` is given (``--watch``).
+
+    Without ``--watch``, a terminal shows one progress line while the run goes.
+    """
     if fps is None:
-        return start(None)
+        from mrmp.viz.progress import ProgressLine
+
+        with ProgressLine(scenario, console) as progress:
+            return start(progress.on_tick if console.is_terminal else None)
     from mrmp.viz.terminal import TerminalView
 
     with TerminalView(scenario, console, fps) as view:

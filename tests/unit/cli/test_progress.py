@@ -1,0 +1,42 @@
+"""``mrmp run`` reports its progress on a terminal, and nothing of it elsewhere."""
+
+from __future__ import annotations
+
+import os
+import pty
+import subprocess
+import sys
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[3]
+COMMAND = [sys.executable, "-m", "mrmp", "run", str(ROOT / "examples" / "thesis-swap.yaml"), "--max-ticks", "40"]
+
+
+def _read_all(descriptor: int) -> bytes:
+    chunks = []
+    while True:
+        try:
+            chunk = os.read(descriptor, 65536)
+        except OSError:  # the terminal's other end closed
+            break
+        if not chunk:
+            break
+        chunks.append(chunk)
+    return b"".join(chunks)
+
+
+def test_a_terminal_sees_the_progress_line() -> None:
+    parent, child = pty.openpty()
+    process = subprocess.Popen(COMMAND, stdin=child, stdout=child, stderr=child, env={**os.environ, "COLUMNS": "120"})
+    os.close(child)
+    output = _read_all(parent).decode("utf-8", "replace")
+    os.close(parent)
+    assert process.wait() == 0
+    assert "tick 1 of 40: 0 of 2 robots on their goals, 0 collisions so far" in output
+    assert "success" in output
+
+
+def test_a_pipe_sees_no_progress_line() -> None:
+    finished = subprocess.run(COMMAND, capture_output=True, text=True, check=False)
+    assert finished.returncode == 0 and "success" in finished.stdout
+    assert "robots on their goals" not in finished.stdout + finished.stderr
