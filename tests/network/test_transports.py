@@ -168,7 +168,7 @@ def test_zenoh_transport_module_imports_without_zenoh_and_says_what_to_install()
     )
     result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=30, check=False)
     assert result.returncode == 0, result.stderr
-    assert result.stdout.strip() == "the zenoh transport needs the eclipse-zenoh package: pip install eclipse-zenoh"
+    assert result.stdout.strip() == "the zenoh transport needs the eclipse-zenoh package: in a checkout, .venv/bin/pip install -e '.[zenoh]'"
 
 
 def test_without_zenoh_its_table_entry_is_still_there_and_says_how_to_install_it():
@@ -179,7 +179,7 @@ def test_without_zenoh_its_table_entry_is_still_there_and_says_how_to_install_it
     )
     result = subprocess.run([sys.executable, "-c", script], capture_output=True, text=True, timeout=30, check=False)
     assert result.returncode == 0, result.stderr
-    assert result.stdout.strip() == "True zenoh needs the eclipse-zenoh package: pip install 'mrmp[zenoh]'"
+    assert result.stdout.strip() == "True zenoh needs the eclipse-zenoh package: in a checkout, .venv/bin/pip install -e '.[zenoh]'"
 
 
 def test_zenoh_transport_refuses_a_zenoh_without_liveliness(monkeypatch):

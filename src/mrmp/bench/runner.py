@@ -129,7 +129,7 @@ def _dask_records(runs: Sequence[BenchRun], address: Any) -> Generator[dict[str,
     except ImportError:
         from mrmp.core.errors import InputError, Problem
 
-        raise InputError(Problem("--dask", "needs dask.distributed: pip install 'mrmp[dask]'")) from None
+        raise InputError(Problem("--dask", "needs dask.distributed: in a checkout, .venv/bin/pip install -e '.[dask]'")) from None
     client = address if hasattr(address, "submit") else Client(address)
     futures = []
     try:

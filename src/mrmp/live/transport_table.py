@@ -153,7 +153,7 @@ class MulticastEntry(TransportEntry[MulticastOptions]):
 
 # -- Zenoh --------------------------------------------------------------------------------------
 
-MISSING_ZENOH_PACKAGE = "zenoh needs the eclipse-zenoh package: pip install 'mrmp[zenoh]'"
+MISSING_ZENOH_PACKAGE = "zenoh needs the eclipse-zenoh package: in a checkout, .venv/bin/pip install -e '.[zenoh]'"
 """What the Zenoh entry answers when ``eclipse-zenoh`` is not installed."""
 
 

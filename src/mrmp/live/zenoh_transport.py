@@ -94,10 +94,10 @@ from typing import TYPE_CHECKING, Any, Self
 if TYPE_CHECKING:  # pragma: no cover - typing only
     import zenoh
 
-MISSING_ZENOH = "the zenoh transport needs the eclipse-zenoh package: pip install eclipse-zenoh"
+MISSING_ZENOH = "the zenoh transport needs the eclipse-zenoh package: in a checkout, .venv/bin/pip install -e '.[zenoh]'"
 """The message of the :class:`RuntimeError` raised when Zenoh is not installed."""
 
-TOO_OLD_ZENOH = "the zenoh transport needs eclipse-zenoh 1.1 or later: pip install -U eclipse-zenoh"
+TOO_OLD_ZENOH = "the zenoh transport needs eclipse-zenoh 1.1 or later: in a checkout, .venv/bin/pip install -U -e '.[zenoh]'"
 """The message of the :class:`RuntimeError` raised when the installed Zenoh has no liveliness API."""
 
 DEFAULT_QUEUE_LIMIT = 10_000
