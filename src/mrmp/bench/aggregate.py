@@ -310,7 +310,58 @@ def _markdown_cell(text: str) -> str:
 
 def headline_markdown(summaries: Sequence[GroupSummary]) -> str:
     """The headline table as GitHub-flavoured Markdown (numbers right-aligned), ending without a newline."""
-    table = headline_table(summaries)
+    return table_markdown(headline_table(summaries))
+
+
+def compact_table(records: Sequence[BenchRecord]) -> TextTable:
+    """One row per (map, N), one column per method: success over every seed and fault setting, then mean SoC/LB.
+
+    A cell reads ``100%, 1.08`` (success rate, mean SoC/LB of the successful
+    runs), ``0%`` when no run succeeded, ``t/o`` when every run hit its time
+    limit, and is empty when the method did not run there. Maps, N and
+    methods keep the order in which the records first name them (N ascending
+    within a map). Lifelong runs are left out (their figure is throughput).
+
+    >>> from mrmp.io.report_input import BenchRecord, FaultSetting
+    >>> def run(policy, agents, success, soc, status="done"):
+    ...     return BenchRecord("r", status, "empty-8-8", agents, policy, 0, FaultSetting(), False,
+    ...                        success=success, soc_over_lb=soc)
+    >>> table = compact_table([run("pibt", 4, True, 1.5), run("pibt", 4, False, None), run("cbs", 4, None, None, "timeout"),
+    ...                        run("pibt", 8, True, 1.25)])
+    >>> table.columns, table.rows
+    (('map', 'N', 'pibt', 'cbs'), (('empty-8-8', '4', '50%, 1.50', 't/o'), ('empty-8-8', '8', '100%, 1.25', '')))
+    """
+    one_shot = [record for record in records if not record.lifelong]
+    maps = list(dict.fromkeys(record.map for record in one_shot))
+    methods = list(dict.fromkeys(record.policy for record in one_shot))
+    cells: dict[tuple[str, int, str], list[BenchRecord]] = defaultdict(list)
+    for record in one_shot:
+        cells[(record.map, record.agents, record.policy)].append(record)
+    rows = []
+    for map_name in maps:
+        for agents in sorted({record.agents for record in one_shot if record.map == map_name}):
+            row = [map_name, str(agents)]
+            row.extend(_compact_cell(cells.get((map_name, agents, method), [])) for method in methods)
+            rows.append(tuple(row))
+    return TextTable(
+        columns=("map", "N", *methods), numeric=(False, True, *(False for _ in methods)), rows=tuple(rows)
+    )
+
+
+def _compact_cell(runs: Sequence[BenchRecord]) -> str:
+    """A method's runs at one (map, N) as ``success%, SoC/LB``, ``0%``, ``t/o`` or empty."""
+    if not runs:
+        return ""
+    if all(run.status == "timeout" for run in runs):
+        return "t/o"
+    successes = [run for run in runs if run.success]
+    rate = f"{round(100 * len(successes) / len(runs))}%"
+    quality = mean(run.soc_over_lb for run in successes)
+    return rate if quality is None else f"{rate}, {quality:.2f}"
+
+
+def table_markdown(table: TextTable) -> str:
+    """``table`` as GitHub-flavoured Markdown (numeric columns right-aligned), ending without a newline."""
     lines = [
         "| " + " | ".join(_markdown_cell(column) for column in table.columns) + " |",
         "|" + "|".join("---:" if numeric else "---" for numeric in table.numeric) + "|",
