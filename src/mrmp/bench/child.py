@@ -4,8 +4,9 @@ It reads one :class:`~mrmp.experiments.matrix.BenchRun` as JSON on standard inpu
 executes it (:func:`mrmp.experiments.records.execute_run`) and writes its record as
 one JSON line on standard output. Running each run in a process of its own
 lets the runner kill it when it overruns its time limit, and keeps a crash of
-one run from taking the benchmark down. On Linux the process also ends when
-the worker that started it dies (``PR_SET_PDEATHSIG``), so that no run goes on
+one run from taking the benchmark down. The process also ends when the
+worker that started it dies (the parent-death signal, set before it starts,
+and checked again here: :mod:`mrmp.io.lifetime`), so that no run goes on
 unsupervised.
 """
 
@@ -18,23 +19,12 @@ import sys
 
 from mrmp.experiments.matrix import BenchRun
 from mrmp.experiments.records import execute_run
-
-PARENT_VARIABLE = "MRMP_BENCH_PARENT"
-"""The environment variable naming the process id of the worker that started the run."""
+from mrmp.io.lifetime import die_with_parent, parent_pid
 
 
 def _end_with_parent() -> None:
-    """Ask Linux to kill this process when its parent dies; end now if it already has."""
-    if not sys.platform.startswith("linux"):
-        return
-    import ctypes
-
-    parent = int(os.environ.get(PARENT_VARIABLE, os.getppid()))
-    try:
-        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
-    except (OSError, AttributeError):
-        return
-    if os.getppid() != parent:
+    """Ask to be killed when the worker that started this run ends; end now if it already has."""
+    if die_with_parent(signal.SIGKILL) and os.getppid() != parent_pid():
         os._exit(1)
 
 

@@ -13,8 +13,11 @@ arrives (flushed and fsynced). On start, runs whose id already has a record
 there are skipped, so a benchmark stopped by Ctrl-C or a kill resumes where it
 stopped; ``retry_errors`` also runs again those whose last record is an
 ``error``. Ctrl-C (or SIGTERM) stops the workers and their children and
-leaves every finished record on disk. At the end ``results.csv`` is
-regenerated from ``results.jsonl``.
+leaves every finished record on disk. A main process that dies any other way
+(SIGKILL) takes its workers and their runs with it: a worker gets the
+parent-death signal and watches the main process, and a run's process gets
+the parent-death signal before it runs anything (:mod:`mrmp.io.lifetime`). At
+the end ``results.csv`` is regenerated from ``results.jsonl``.
 """
 
 from __future__ import annotations
@@ -34,6 +37,7 @@ from typing import Any
 
 from mrmp.experiments.matrix import BenchRun
 from mrmp.experiments.records import base_record
+from mrmp.io.lifetime import child_environment, die_with_parent, preexec_dying_with, watch_parent
 
 KILL_GRACE_S = 2.0
 """Seconds a run's process may exceed its time limit before it is killed (start-up, writing the record)."""
@@ -63,7 +67,8 @@ def run_isolated(run: BenchRun) -> dict[str, Any]:
         stderr=subprocess.PIPE,
         text=True,
         start_new_session=True,
-        env={**os.environ, "MRMP_BENCH_PARENT": str(os.getpid())},
+        preexec_fn=preexec_dying_with(signum=signal.SIGKILL),
+        env=child_environment(),
     )
     _CHILD = child
     try:
@@ -97,15 +102,22 @@ def _stop_worker(signum: int, frame: FrameType | None) -> None:
     os._exit(128 + signum)
 
 
-def _init_worker() -> None:
-    """A pool worker ignores Ctrl-C (the main process decides) and stops its child on SIGTERM."""
+def _init_worker(main: int) -> None:
+    """A pool worker ignores Ctrl-C (the main process decides), stops its child on SIGTERM, and ends with ``main``.
+
+    The worker asks for SIGTERM when its parent ends and watches the main
+    process: either way, once the main process is gone the worker kills its
+    run and exits, instead of waiting for work for ever.
+    """
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, _stop_worker)
+    die_with_parent(signal.SIGTERM)
+    watch_parent(main, lambda: _stop_worker(signal.SIGTERM, None))
 
 
 def _pool_records(runs: Sequence[BenchRun], workers: int) -> Generator[dict[str, Any], None, None]:
     """Records of ``runs`` from a local process pool, in the order they finish."""
-    executor = ProcessPoolExecutor(max_workers=workers, initializer=_init_worker)
+    executor = ProcessPoolExecutor(max_workers=workers, initializer=_init_worker, initargs=(os.getpid(),))
     finished = False
     try:
         pending: set[Future[dict[str, Any]]] = {executor.submit(run_isolated, run) for run in runs}
