@@ -32,6 +32,7 @@ Examples
 
 from __future__ import annotations
 
+import math
 from collections import deque
 from collections.abc import Iterable, Mapping, Sequence
 
@@ -77,7 +78,8 @@ def grid_size_problem(x_size: int, y_size: int) -> str | None:
     cells = x_size * y_size
     if cells <= MAX_GRID_CELLS:
         return None
-    return f"a map of {x_size}x{y_size} = {cells} cells is larger than the bound of {MAX_GRID_CELLS} cells (2048 x 2048)"
+    side = math.isqrt(MAX_GRID_CELLS)
+    return f"a map of {x_size}x{y_size} = {cells} cells is larger than the bound of {MAX_GRID_CELLS} cells ({side} x {side})"
 
 
 def connected_regions(grid: Grid, origins: Iterable[Cell]) -> tuple[dict[Cell, int], list[list[Cell]]]:

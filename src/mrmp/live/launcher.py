@@ -33,7 +33,7 @@ from mrmp.core.errors import InputError, Problem
 from mrmp.core.limits import MAX_RUN_SECONDS
 from mrmp.core.result import RunResult
 from mrmp.core.scenario import Scenario
-from mrmp.io.lifetime import child_environment, preexec_dying_with
+from mrmp.io.lifetime import preexec_dying_with
 from mrmp.io.live_files import prepare_folder, read_json, write_key_file
 from mrmp.io.plans import write_plan, write_share
 from mrmp.io.scenario_file import save_scenario
@@ -159,7 +159,7 @@ def _write_run_files(scenario: Scenario, options: LiveOptions, ids: list[str]) -
 
 def _start(command: list[str]) -> subprocess.Popen[bytes]:
     """Start ``command`` in its own session, bound to this process's life (:mod:`mrmp.io.lifetime`)."""
-    return subprocess.Popen(command, start_new_session=True, preexec_fn=preexec_dying_with(), env=child_environment())
+    return subprocess.Popen(command, start_new_session=True, preexec_fn=preexec_dying_with())
 
 
 def _start_fleet(options: LiveOptions, files: _RunFiles, layout: FleetLayout, session: int, timeout: float) -> _Fleet:

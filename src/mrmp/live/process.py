@@ -20,7 +20,7 @@ from pathlib import Path
 from mrmp.core.errors import InputError, Problem
 from mrmp.core.scenario import Scenario
 from mrmp.core.seeds import Stream, derive_seed, stream_random
-from mrmp.io.lifetime import parent_pid, watch_parent
+from mrmp.io.lifetime import watch_parent
 from mrmp.io.live_files import TraceReader, TraceWriter, write_json
 from mrmp.io.plans import read_share
 from mrmp.live.agent import Agent, AgentReport, AgentTiming
@@ -183,7 +183,7 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
             scenario, index, transport, body, sealer, opener, options, policy
         )
         _on_stop_signals(agent.stop_requested.set)
-        watch_parent(parent_pid(), agent.stop_requested.set)
+        watch_parent(agent.stop_requested.set)
         if isinstance(opened, ConnectedTransport):
             _wait_for_peers(opened, len(scenario.robots) - 1, agent.stop_requested)
         report = agent.run(on_progress=lambda report: write_json(report_path, report.as_dict()))
@@ -211,7 +211,7 @@ def run_referee(scenario: Scenario, results: Path, start_time: float, done_file:
     """
     stop = threading.Event()
     _on_stop_signals(stop.set)
-    watch_parent(parent_pid(), stop.set)
+    watch_parent(stop.set)
     ids, starts = [robot.id for robot in scenario.robots], [robot.start for robot in scenario.robots]
     referee = IntervalReferee(scenario.grid, ids, starts, start_time)
     readers = [TraceReader(results / f"trace-{index}.jsonl") for index in range(len(scenario.robots))]

@@ -34,9 +34,9 @@ def parent_with_a_child(child_code, tmp_path):
     """A Python process that starts ``python -c child_code`` bound to it, prints the child's pid, and waits for ever."""
     parent_code = textwrap.dedent(f"""
         import subprocess, sys, time
-        from mrmp.io.lifetime import child_environment, preexec_dying_with
+        from mrmp.io.lifetime import preexec_dying_with
         child = subprocess.Popen([sys.executable, "-c", {child_code!r}], preexec_fn=preexec_dying_with(),
-                                 env=child_environment(), cwd={str(tmp_path)!r})
+                                 cwd={str(tmp_path)!r})
         print(child.pid, flush=True)
         time.sleep(3600)
     """)
@@ -62,10 +62,10 @@ def test_a_child_that_ignores_the_signal_still_notices_that_its_parent_is_gone(t
     watcher = textwrap.dedent("""
         import os, signal, threading, time
         from pathlib import Path
-        from mrmp.io.lifetime import parent_pid, watch_parent
+        from mrmp.io.lifetime import watch_parent
         signal.signal(signal.SIGTERM, signal.SIG_IGN)  # only the watch can end this process
         gone = threading.Event()
-        watch_parent(parent_pid(), gone.set)
+        watch_parent(gone.set)
         Path("watching").touch()
         gone.wait()
         Path("noticed").touch()
