@@ -207,6 +207,13 @@ def time_scale_checked(value: float, option: str = "--time-scale") -> float:
 
 
 def _not_negative(value: float, option: str, largest: float) -> float:
+    """``value`` if it is between 0 and ``largest``.
+
+    >>> _not_negative(float("nan"), "--listen-time", MAX_STEP_SECONDS)
+    Traceback (most recent call last):
+    ...
+    mrmp.core.errors.InputError: --listen-time: must be between 0 and 3600, got nan
+    """
     if not 0.0 <= value <= largest:
         raise InputError(Problem(option, f"must be between 0 and {shown(largest)}, got {value}"))
     return value
