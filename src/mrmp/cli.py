@@ -20,6 +20,15 @@ from rich.console import Console
 from rich.table import Table
 
 from mrmp.core.errors import InputError, MrmpError, Problem
+from mrmp.core.limits import (
+    MAX_LIVE_DELAY_SECONDS,
+    MAX_LIVE_ROBOTS,
+    MAX_RUN_SECONDS,
+    MAX_STEP_SECONDS,
+    MAX_TIME_SCALE,
+    MIN_TIME_SCALE,
+    shown,
+)
 from mrmp.core.options import setting_types, settings
 from mrmp.core.result import RunResult
 from mrmp.core.scenario import NetworkFaults, PolicyOptions, Scenario, scenario_problems
@@ -74,6 +83,10 @@ def _load(
     if scenario_path is not None:
         if map_path or scen_path:
             raise InputError(Problem("--map/--scen", "give either a scenario file or --map and --scen, not both"))
+        if agents is not None:
+            raise InputError(
+                Problem("--agents", "goes with --map and --scen; a YAML scenario lists its robots (or sets agents: next to scen:)")
+            )
         return load_scenario(scenario_path, known_policies=policy_names())
     if map_path is None or scen_path is None:
         raise InputError(Problem("SCENARIO", "give a scenario file, or --map and --scen (with --agents)"))
@@ -160,9 +173,49 @@ def with_policy_flags(command: Callable[..., None]) -> Callable[..., None]:
     return with_flags
 
 
-def _positive(value: float, option: str) -> float:
+def _positive(value: float, option: str, largest: float | None = None, unit: str = "") -> float:
+    """``value`` if it is positive (and at most ``largest`` when given).
+
+    >>> _positive(2.5, "--time-limit", MAX_RUN_SECONDS)
+    2.5
+    >>> _positive(float("inf"), "--time-limit", MAX_RUN_SECONDS, "seconds")
+    Traceback (most recent call last):
+    ...
+    mrmp.core.errors.InputError: --time-limit: must be at most 86400 seconds, got inf
+    """
     if not value > 0:
         raise InputError(Problem(option, f"must be positive, got {value}"))
+    if largest is not None and not value <= largest:
+        raise InputError(Problem(option, f"must be at most {shown(largest)}{' ' + unit if unit else ''}, got {value}"))
+    return value
+
+
+def time_scale_checked(value: float, option: str = "--time-scale") -> float:
+    """A ``--time-scale`` between :data:`~mrmp.core.limits.MIN_TIME_SCALE` and :data:`~mrmp.core.limits.MAX_TIME_SCALE`.
+
+    >>> time_scale_checked(10.0)
+    10.0
+    >>> time_scale_checked(float("inf"))
+    Traceback (most recent call last):
+    ...
+    mrmp.core.errors.InputError: --time-scale: must be between 0.001 and 1000 (times the robots' real speed), got inf
+    """
+    if not MIN_TIME_SCALE <= value <= MAX_TIME_SCALE:
+        bounds = f"between {shown(MIN_TIME_SCALE)} and {shown(MAX_TIME_SCALE)}"
+        raise InputError(Problem(option, f"must be {bounds} (times the robots' real speed), got {value}"))
+    return value
+
+
+def _not_negative(value: float, option: str, largest: float) -> float:
+    """``value`` if it is between 0 and ``largest``.
+
+    >>> _not_negative(float("nan"), "--listen-time", MAX_STEP_SECONDS)
+    Traceback (most recent call last):
+    ...
+    mrmp.core.errors.InputError: --listen-time: must be between 0 and 3600, got nan
+    """
+    if not 0.0 <= value <= largest:
+        raise InputError(Problem(option, f"must be between 0 and {shown(largest)}, got {value}"))
     return value
 
 
@@ -179,6 +232,8 @@ def parse_range_ms(text: str, option: str) -> tuple[float, float]:
     (0.02, 0.08)
     """
     low, high = parse_range(text, option, "milliseconds", whole=False)
+    if not high <= MAX_LIVE_DELAY_SECONDS * 1000:
+        raise InputError(Problem(option, f"must be at most {shown(MAX_LIVE_DELAY_SECONDS * 1000)} milliseconds, got {text!r}"))
     return low / 1000.0, high / 1000.0
 
 
@@ -197,8 +252,8 @@ def parse_kills(items: list[str]) -> dict[str, float]:
             robot = ""
         if not separator or not robot:
             raise InputError(Problem("--kill", f"expected ROBOT@SECONDS, got {item!r}"))
-        if not 0.0 <= kills[robot] <= 86_400.0:
-            raise InputError(Problem("--kill", f"the seconds of {item!r} must be between 0 and 86400"))
+        if not 0.0 <= kills[robot] <= MAX_RUN_SECONDS:
+            raise InputError(Problem("--kill", f"the seconds of {item!r} must be between 0 and {shown(MAX_RUN_SECONDS)}"))
     return kills
 
 
@@ -215,6 +270,12 @@ def live_faults(scenario: Scenario, time_scale: float, delay_ms: str | None) -> 
     low, high = network.delay_min * tick, network.delay_max * tick
     if delay_ms is not None:
         low, high = parse_range_ms(delay_ms, "--delay-ms")
+    elif high > MAX_LIVE_DELAY_SECONDS:
+        reason = (
+            f"a delay of {network.delay_max} ticks is {high:g} s at this speed, more than the bound of "
+            f"{shown(MAX_LIVE_DELAY_SECONDS)} s; give --delay-ms"
+        )
+        raise InputError(Problem("network.delay", reason))
     return LiveFaults(network.loss, low, high, network.duplicate, network.reorder)
 
 
@@ -224,7 +285,7 @@ def _plan(name: str, scenario: Scenario, time_limit: float, console: Console) ->
 
     if name not in PLANNER_NAMES:
         raise InputError(Problem("--planner", f"unknown planner {name!r}; known: {', '.join(PLANNER_NAMES)}"))
-    plan = plan_with(name, scenario, time_limit_s=_positive(time_limit, "--time-limit"))
+    plan = plan_with(name, scenario, time_limit_s=_positive(time_limit, "--time-limit", MAX_RUN_SECONDS, "seconds"))
     if not plan.solved:
         console.print(f"[red]{name}: no plan[/red] ({plan.status}: {plan.message}) after {plan.planning_time_s:.2f} s")
         raise typer.Exit(1)
@@ -437,12 +498,18 @@ class RunRequest:
 def _validate_run(scenario: Scenario, request: RunRequest) -> None:
     """Refuse, before anything runs, the combinations of options that cannot be honoured."""
     entry = policy_entry(scenario.policy.name)
-    if scenario.lifelong and (request.live or request.planner is not None):
+    planned = request.planner is not None  # the plan replaces the policy: its limits do not apply
+    if scenario.lifelong and (request.live or planned):
         raise InputError(Problem("--lifelong", "lifelong runs are simulated with a decentralized policy (not --live, not --planner)"))
-    if request.unsafe and entry.always_guarded:
+    if request.unsafe and entry.always_guarded and not planned:
         raise InputError(Problem("--unsafe", f"{entry.name} always enters cells through the safety layer; it has no unsafe form"))
-    if request.live and entry.live_driver is None:
+    if request.live and entry.live_driver is None and not planned:
         raise InputError(Problem("--policy", f"{entry.name} {entry.not_live}"))
+    if planned:
+        _positive(request.time_limit, "--time-limit", MAX_RUN_SECONDS, "seconds")
+    time_scale_checked(request.time_scale)
+    if request.live:
+        _validate_live(scenario, request)
     if request.animate is not None:
         from mrmp.viz.animate import animation_problem
 
@@ -456,6 +523,24 @@ def _validate_run(scenario: Scenario, request: RunRequest) -> None:
         raise InputError(Problem("--watch", "live runs are not drawn in the terminal (--watch is for simulated runs)"))
     if request.watch:
         _positive(request.watch_fps, "--watch-fps")
+
+
+def _validate_live(scenario: Scenario, request: RunRequest) -> None:
+    """Refuse, before any process starts, what a live run cannot do: too many robots, a results folder that is a file."""
+    from mrmp.io.live_files import prepare_folder
+
+    if len(scenario.robots) > MAX_LIVE_ROBOTS:
+        reason = f"a live run starts one process per robot, at most {MAX_LIVE_ROBOTS}; this scenario has {len(scenario.robots)}"
+        raise InputError(Problem("--live", reason))
+    live_faults(scenario, request.time_scale, request.delay_ms)
+    parse_kills(request.kill)
+    _fraction(request.jitter, "--jitter")
+    _fraction(request.miss_line, "--miss-line")
+    if request.results is not None:
+        try:
+            prepare_folder(request.results)
+        except InputError as error:
+            raise InputError(Problem("--results", str(error))) from None
 
 
 def _simulated_run(scenario: Scenario, request: RunRequest, plan: PlanningResult | None, console: Console) -> RunResult:
@@ -482,7 +567,7 @@ def _live_run(scenario: Scenario, request: RunRequest, plan: PlanningResult | No
 
     options = LiveOptions(
         transport=request.transport,
-        time_scale=_positive(request.time_scale, "--time-scale"),
+        time_scale=time_scale_checked(request.time_scale),
         faults=live_faults(scenario, request.time_scale, request.delay_ms),
         jitter=_fraction(request.jitter, "--jitter"),
         miss_line=_fraction(request.miss_line, "--miss-line"),
@@ -527,7 +612,7 @@ def compare(
     console = Console(stderr=json_path == "-", highlight=False)
     try:
         scenario = _load(scenario_path, map_path, scen_path, agents)
-        rows = compare_methods(scenario, time_limit_s=_positive(time_limit, "--time-limit"))
+        rows = compare_methods(scenario, time_limit_s=_positive(time_limit, "--time-limit", MAX_RUN_SECONDS, "seconds"))
     except InputError as error:
         raise _fail(error.problems) from None
     table = Table(title=f"{scenario.name}: {len(scenario.robots)} robots, lower bound {rows[0].lower_bound if rows else 0}")
@@ -654,7 +739,7 @@ def bench(
         if workers is not None and workers < 1:
             raise InputError(Problem("--workers", f"must be at least 1, got {workers}"))
         if time_limit is not None:
-            _positive(time_limit, "--time-limit")
+            _positive(time_limit, "--time-limit", MAX_RUN_SECONDS, "seconds")
         config = load_bench_config(config_path, time_limit=time_limit)
         for note in config.notes:
             err.print(f"note: {note}", markup=False)
@@ -735,9 +820,10 @@ def agent(
     """Run one robot of a fleet as this process (one command per robot, on its own computer)."""
     import os
 
-    from mrmp.io.live_files import read_key_file
+    from mrmp.io.lifetime import die_with_parent
+    from mrmp.io.live_files import key_from_environment, read_key_file
     from mrmp.live.agent import AgentTiming
-    from mrmp.live.process import AgentOptions, check_key_policy, die_with_parent, run_agent, warn
+    from mrmp.live.process import AgentOptions, check_key_policy, run_agent, warn
     from mrmp.live.transport import LiveFaults
 
     die_with_parent()
@@ -751,8 +837,10 @@ def agent(
             "bind": bind, "peer": peer, "group": group, "interface": interface, "listen": listen, "connect": connect, "fleet": fleet,
         }
         spec = TRANSPORTS.parse(transport, transport_values, ids, index)
-        environment_key = os.environ.get("MRMP_FLEET_KEY", "").encode()
-        key = read_key_file(key_file) if key_file is not None else environment_key
+        missing = spec.entry.unavailable()
+        if missing is not None:
+            raise InputError(Problem("--transport", missing))
+        key = read_key_file(key_file) if key_file is not None else key_from_environment(os.environ.get("MRMP_FLEET_KEY"))
         key = check_key_policy(key, spec, warn)
         low, high = parse_range_ms(delay_ms, "--delay-ms")
         options = AgentOptions(
@@ -761,22 +849,25 @@ def agent(
             key=key,
             session=session,
             results=results,
-            time_scale=_positive(time_scale, "--time-scale"),
+            time_scale=time_scale_checked(time_scale),
             faults=LiveFaults(_fraction(loss, "--loss"), low, high, _fraction(duplicate, "--duplicate"), _fraction(reorder, "--reorder")),
             jitter=_fraction(jitter, "--jitter"),
             miss_line=_fraction(miss_line, "--miss-line"),
             guarded=not unsafe and scenario.safety,
             seed=seed,
-            timing=AgentTiming(listen_time=listen_time, timeout=timeout),
+            timing=AgentTiming(
+                listen_time=_not_negative(listen_time, "--listen-time", MAX_STEP_SECONDS),
+                timeout=_positive(timeout, "--timeout", MAX_RUN_SECONDS, "seconds"),
+            ),
             plan=plan,
         )
         if plan is not None:
             from mrmp.io.plans import read_share
 
             read_share(plan, robot)  # a bad share is bad input: report it before any socket opens
+        report = run_agent(scenario, options)  # an address that cannot be used is bad input too
     except InputError as error:
         raise _fail(error.problems) from None
-    report = run_agent(scenario, options)
     raise typer.Exit(0 if report.arrived else 1)
 
 
@@ -788,7 +879,8 @@ def referee(
     done_file: Annotated[Path, typer.Option(help="Stop when this file appears.")],
 ) -> None:
     """Judge a live run from the robots' ground-truth traces, until told to stop."""
-    from mrmp.live.process import die_with_parent, run_referee, warn
+    from mrmp.io.lifetime import die_with_parent
+    from mrmp.live.process import run_referee, warn
 
     die_with_parent()
     try:

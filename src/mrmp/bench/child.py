@@ -1,48 +1,32 @@
 """The process one benchmark run executes in: ``python -m mrmp.bench.child``.
 
-It reads one :class:`~mrmp.experiments.matrix.BenchRun` as JSON on standard input,
-executes it (:func:`mrmp.experiments.records.execute_run`) and writes its record as
-one JSON line on standard output. Running each run in a process of its own
-lets the runner kill it when it overruns its time limit, and keeps a crash of
-one run from taking the benchmark down. On Linux the process also ends when
-the worker that started it dies (``PR_SET_PDEATHSIG``), so that no run goes on
+It reads one :class:`~mrmp.experiments.matrix.BenchRun` as one line of JSON on
+standard input, builds its scenario, writes :data:`READY` on standard output,
+executes the run (:func:`mrmp.experiments.records.execute_run`) and writes its
+record as one JSON line on standard output. Running each run in a process of
+its own lets the runner kill it when it overruns its time limit, counted from
+its readiness, and keeps a crash of one run from taking the benchmark down.
+The runner starts it bound to the worker's life (the parent-death signal, set
+before it runs anything: :mod:`mrmp.io.lifetime`), so that no run goes on
 unsupervised.
 """
 
 from __future__ import annotations
 
 import json
-import os
-import signal
 import sys
 
 from mrmp.experiments.matrix import BenchRun
 from mrmp.experiments.records import execute_run
 
-PARENT_VARIABLE = "MRMP_BENCH_PARENT"
-"""The environment variable naming the process id of the worker that started the run."""
-
-
-def _end_with_parent() -> None:
-    """Ask Linux to kill this process when its parent dies; end now if it already has."""
-    if not sys.platform.startswith("linux"):
-        return
-    import ctypes
-
-    parent = int(os.environ.get(PARENT_VARIABLE, os.getppid()))
-    try:
-        ctypes.CDLL(None, use_errno=True).prctl(1, signal.SIGKILL)  # PR_SET_PDEATHSIG
-    except (OSError, AttributeError):
-        return
-    if os.getppid() != parent:
-        os._exit(1)
+READY = "ready"
+"""The line the process writes once its imports are done and the run's scenario is built (its timed work begins)."""
 
 
 def main() -> int:
-    """Read a run on stdin, execute it, write its record on stdout."""
-    _end_with_parent()
-    run = BenchRun.from_dict(json.loads(sys.stdin.read()))
-    record = execute_run(run)
+    """Read a run on stdin, execute it (saying when it is ready), write its record on stdout."""
+    run = BenchRun.from_dict(json.loads(sys.stdin.readline()))
+    record = execute_run(run, on_ready=lambda: print(READY, flush=True))
     sys.stdout.write("\n" + json.dumps(record, separators=(",", ":")) + "\n")
     sys.stdout.flush()
     return 0

@@ -4,23 +4,29 @@ Each run executes in a fresh child process (``python -m mrmp.bench.child``)
 started by a worker of a :class:`concurrent.futures.ProcessPoolExecutor`, or
 by a worker of an existing dask.distributed cluster (``dask_address``). The
 worker kills the child when it overruns the run's time limit (plus
-:data:`KILL_GRACE_S` for process start-up and the record's transfer), which
-gives a record with status ``timeout``; a child that dies gives status
-``error`` with the last line it wrote.
+:data:`KILL_GRACE_S` for the record's transfer), counted from the moment the
+child says it is ready (its imports done and the run's scenario built, which a
+loaded machine makes slow), which gives a record with status ``timeout``; a
+child that dies, or does not get ready within :data:`STARTUP_LIMIT_S`, gives
+status ``error`` with the last line it wrote.
 
 The main process appends each record to ``results.jsonl`` as soon as it
 arrives (flushed and fsynced). On start, runs whose id already has a record
 there are skipped, so a benchmark stopped by Ctrl-C or a kill resumes where it
 stopped; ``retry_errors`` also runs again those whose last record is an
 ``error``. Ctrl-C (or SIGTERM) stops the workers and their children and
-leaves every finished record on disk. At the end ``results.csv`` is
-regenerated from ``results.jsonl``.
+leaves every finished record on disk. A main process that dies any other way
+(SIGKILL) takes its workers and their runs with it: a worker gets the
+parent-death signal and watches the main process, and a run's process gets
+the parent-death signal before it runs anything (:mod:`mrmp.io.lifetime`). At
+the end ``results.csv`` is regenerated from ``results.jsonl``.
 """
 
 from __future__ import annotations
 
 import json
 import os
+import select
 import signal
 import subprocess
 import sys
@@ -32,11 +38,16 @@ from pathlib import Path
 from types import FrameType
 from typing import Any
 
+from mrmp.bench.child import READY
 from mrmp.experiments.matrix import BenchRun
 from mrmp.experiments.records import base_record
+from mrmp.io.lifetime import die_with_parent, preexec_dying_with, watch_parent
 
 KILL_GRACE_S = 2.0
-"""Seconds a run's process may exceed its time limit before it is killed (start-up, writing the record)."""
+"""Seconds a run's process may exceed its time limit, counted from its readiness, before it is killed."""
+
+STARTUP_LIMIT_S = 600.0
+"""Seconds a run's process may take to get ready (start, import mrmp, build the run's scenario) before it is killed."""
 
 Say = Callable[[str], None]
 """Where the runner's notes go (one line each)."""
@@ -44,6 +55,10 @@ Say = Callable[[str], None]
 
 def run_isolated(run: BenchRun) -> dict[str, Any]:
     """Execute ``run`` in a child process, killed when over its time limit; return its record.
+
+    The time limit counts from the child's readiness (:data:`mrmp.bench.child.READY`:
+    its imports done and the run's scenario built), so that neither the start-up
+    of its interpreter on a loaded machine nor reading the map eats the run's time.
 
     Examples
     --------
@@ -54,8 +69,6 @@ def run_isolated(run: BenchRun) -> dict[str, Any]:
     ('done', 'centralized', 0)
     """
     global _CHILD
-    limit = run.time_limit_s + KILL_GRACE_S
-    started = time.perf_counter()
     child = subprocess.Popen(
         [sys.executable, "-m", "mrmp.bench.child"],
         stdin=subprocess.PIPE,
@@ -63,11 +76,16 @@ def run_isolated(run: BenchRun) -> dict[str, Any]:
         stderr=subprocess.PIPE,
         text=True,
         start_new_session=True,
-        env={**os.environ, "MRMP_BENCH_PARENT": str(os.getpid())},
+        preexec_fn=preexec_dying_with(signal.SIGKILL),
     )
     _CHILD = child
     try:
-        output, errors = child.communicate(json.dumps(run.to_dict()), timeout=limit)
+        if not _ready(child, run):
+            child.kill()
+            errors = child.communicate()[1]
+            return base_record(run, "error", _failure(child, errors, f"not ready after {STARTUP_LIMIT_S:g} s"))
+        started = time.perf_counter()
+        output, errors = child.communicate(timeout=run.time_limit_s + KILL_GRACE_S)
     except subprocess.TimeoutExpired:
         child.kill()
         child.communicate()
@@ -82,8 +100,33 @@ def run_isolated(run: BenchRun) -> dict[str, Any]:
                 return record
         except json.JSONDecodeError:
             pass
-    last = next((line.strip() for line in reversed(errors.splitlines()) if line.strip()), "no message")
-    return base_record(run, "error", f"the run's process ended with status {child.returncode}: {last}"[:300])
+    return base_record(run, "error", _failure(child, errors, "no message"))
+
+
+def _failure(child: subprocess.Popen[str], errors: str, otherwise: str) -> str:
+    """One line on a run's process that gave no record: its status and the last line it wrote (else ``otherwise``)."""
+    last = next((line.strip() for line in reversed(errors.splitlines()) if line.strip()), otherwise)
+    return f"the run's process ended with status {child.returncode}: {last}"[:300]
+
+
+def _ready(child: subprocess.Popen[str], run: BenchRun) -> bool:
+    """Give ``child`` its run; whether it wrote :data:`~mrmp.bench.child.READY` within :data:`STARTUP_LIMIT_S`."""
+    assert child.stdin is not None and child.stdout is not None
+    try:
+        child.stdin.write(json.dumps(run.to_dict()) + "\n")
+        child.stdin.flush()
+    except BrokenPipeError:  # the child is gone already
+        return False
+    expected, line = (READY + "\n").encode(), b""
+    deadline = time.monotonic() + STARTUP_LIMIT_S
+    while expected.startswith(line) and line != expected:
+        readable, _, _ = select.select([child.stdout], [], [], max(0.0, deadline - time.monotonic()))
+        # byte by byte, past any buffer: what follows the line is left for communicate()
+        byte = os.read(child.stdout.fileno(), 1) if readable else b""
+        if not byte:
+            return False
+        line += byte
+    return line == expected
 
 
 _CHILD: subprocess.Popen[str] | None = None
@@ -97,15 +140,22 @@ def _stop_worker(signum: int, frame: FrameType | None) -> None:
     os._exit(128 + signum)
 
 
-def _init_worker() -> None:
-    """A pool worker ignores Ctrl-C (the main process decides) and stops its child on SIGTERM."""
+def _init_worker(main: int) -> None:
+    """A pool worker ignores Ctrl-C (the main process decides), stops its child on SIGTERM, and ends with ``main``.
+
+    The worker asks for SIGTERM when its parent ends and watches the main
+    process: either way, once the main process is gone the worker kills its
+    run and exits, instead of waiting for work for ever.
+    """
     signal.signal(signal.SIGINT, signal.SIG_IGN)
     signal.signal(signal.SIGTERM, _stop_worker)
+    die_with_parent(signal.SIGTERM)
+    watch_parent(lambda: _stop_worker(signal.SIGTERM, None), main)
 
 
 def _pool_records(runs: Sequence[BenchRun], workers: int) -> Generator[dict[str, Any], None, None]:
     """Records of ``runs`` from a local process pool, in the order they finish."""
-    executor = ProcessPoolExecutor(max_workers=workers, initializer=_init_worker)
+    executor = ProcessPoolExecutor(max_workers=workers, initializer=_init_worker, initargs=(os.getpid(),))
     finished = False
     try:
         pending: set[Future[dict[str, Any]]] = {executor.submit(run_isolated, run) for run in runs}

@@ -396,6 +396,11 @@ def space_time_astar(
     >>> space_time_astar(grid, (0, 0), (0, 4), max_time=3).status
     'horizon'
 
+    A deadline already passed:
+
+    >>> space_time_astar(grid, (0, 0), (0, 4), deadline=0.0).status
+    'deadline'
+
     Heading-aware: facing NORTH, going EAST costs one right turn first:
 
     >>> result = space_time_astar(grid, (0, 0), (0, 2), heading_aware=True)
@@ -408,6 +413,8 @@ def space_time_astar(
         raise ValueError(f"start {start} is not a free cell")
     if not grid.is_free(goal):
         raise ValueError(f"goal {goal} is not a free cell")
+    if deadline is not None and time.perf_counter() > deadline:  # before the distance table, as long as a search
+        return SpaceTimeResult("deadline", None, None, 0)
     search = _SpaceTimeSearch(grid, goal, reservations or Reservations(), avoid, heading_aware)
     start_facing = int(heading) if heading_aware else 0
     if search.hopeless(start, start_facing):

@@ -32,10 +32,12 @@ Examples
 
 from __future__ import annotations
 
+import math
 from collections import deque
 from collections.abc import Iterable, Mapping, Sequence
 
 from mrmp.core.cell import Cell
+from mrmp.core.limits import MAX_GRID_CELLS
 
 FREE_SYMBOLS = frozenset(".GS")
 """MovingAI symbols of passable terrain."""
@@ -63,6 +65,21 @@ def movingai_from_cell(cell: Cell, height: int) -> tuple[int, int]:
     (0, 0)
     """
     return (cell[1], height - 1 - cell[0])
+
+
+def grid_size_problem(x_size: int, y_size: int) -> str | None:
+    """Why a grid of ``x_size`` by ``y_size`` cells is too large (:data:`~mrmp.core.limits.MAX_GRID_CELLS`), or None.
+
+    >>> grid_size_problem(32, 32) is None
+    True
+    >>> grid_size_problem(100_000, 100_000)
+    'a map of 100000x100000 = 10000000000 cells is larger than the bound of 4194304 cells (2048 x 2048)'
+    """
+    cells = x_size * y_size
+    if cells <= MAX_GRID_CELLS:
+        return None
+    side = math.isqrt(MAX_GRID_CELLS)
+    return f"a map of {x_size}x{y_size} = {cells} cells is larger than the bound of {MAX_GRID_CELLS} cells ({side} x {side})"
 
 
 def connected_regions(grid: Grid, origins: Iterable[Cell]) -> tuple[dict[Cell, int], list[list[Cell]]]:
@@ -113,8 +130,9 @@ class Grid:
     Raises
     ------
     ValueError
-        If a size is not positive, a blocked cell is outside the grid, or a cost
-        is not positive.
+        If a size is not positive, the grid has more than
+        :data:`~mrmp.core.limits.MAX_GRID_CELLS` cells, a blocked cell is
+        outside the grid, or a cost is not positive.
 
     Examples
     --------
@@ -137,6 +155,9 @@ class Grid:
     ) -> None:
         if x_size <= 0 or y_size <= 0:
             raise ValueError(f"grid size must be positive, got {x_size}x{y_size}")
+        problem = grid_size_problem(x_size, y_size)
+        if problem is not None:
+            raise ValueError(problem)
         self.x_size = x_size
         self.y_size = y_size
         self.name = name

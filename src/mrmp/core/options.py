@@ -34,6 +34,7 @@ from dataclasses import dataclass
 from typing import Any
 
 from mrmp.core.errors import InputError, Problem
+from mrmp.core.limits import MAX_RADIUS
 
 RESOLUTIONS = ("divert", "wait")
 """How a lower-priority robot resolves a conflict: divert (prioritized technique,
@@ -123,8 +124,10 @@ def _one_of_resolutions(value: object) -> str | None:
     return None if value in RESOLUTIONS else f"must be one of {', '.join(RESOLUTIONS)}, got {value!r}"
 
 
-def _at_least_two(value: int) -> str | None:
-    return None if value >= 2 else f"must be at least 2 (cells), got {value}"
+def _radius_in_bounds(value: int) -> str | None:
+    if value < 2:
+        return f"must be at least 2 (cells), got {value}"
+    return None if value <= MAX_RADIUS else f"must be at most {MAX_RADIUS} (cells), got {value}"
 
 
 def resolve_setting() -> Any:
@@ -143,10 +146,10 @@ def heading_aware_setting() -> Any:
 
 
 def radius_setting() -> Any:
-    """``radius``: how far a ``pibt`` robot's beacon reaches (cells, Manhattan, at least 2)."""
+    """``radius``: how far a ``pibt`` robot's beacon reaches (cells, Manhattan, 2 to :data:`~mrmp.core.limits.MAX_RADIUS`)."""
     return setting(
-        2, help="pibt: how far a robot's beacon reaches, in cells (at least 2).", yaml_key="radius", flag="--radius",
-        check=_at_least_two,
+        2, help=f"pibt: how far a robot's beacon reaches, in cells (2 to {MAX_RADIUS}).", yaml_key="radius",
+        flag="--radius", check=_radius_in_bounds,
     )
 
 

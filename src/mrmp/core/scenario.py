@@ -26,6 +26,7 @@ from mrmp.core.cell import Cell
 from mrmp.core.errors import Problem
 from mrmp.core.grid import Grid, connected_regions
 from mrmp.core.heading import Heading
+from mrmp.core.limits import MAX_DELAY_TICKS, MAX_ROBOTS, MAX_STEP_SECONDS, MAX_TICKS, at_most
 from mrmp.core.options import (
     RESOLUTIONS,
     check_settings,
@@ -197,21 +198,46 @@ def _fault_problems(faults: NetworkFaults, where: str) -> list[Problem]:
         problems.append(
             Problem(f"{where}.delay", f"must be a range 0 <= min <= max ticks, got {faults.delay_min}..{faults.delay_max}")
         )
+    elif faults.delay_max > MAX_DELAY_TICKS:
+        problems.append(Problem(f"{where}.delay", f"must be at most {MAX_DELAY_TICKS} ticks, got {faults.delay_max}"))
+    return problems
+
+
+def _timing_problems(timing: Timing) -> list[Problem]:
+    """``cell_time`` positive, ``turn_time`` not negative, both finite and at most :data:`MAX_STEP_SECONDS`.
+
+    >>> [str(problem) for problem in _timing_problems(Timing(cell_time=float("inf")))]
+    ['timing.cell_time: must be at most 3600 seconds, got inf']
+    """
+    problems = []
+    if not timing.cell_time > 0:
+        problems.append(Problem("timing.cell_time", f"must be positive, got {timing.cell_time}"))
+    if not timing.turn_time >= 0:
+        problems.append(Problem("timing.turn_time", f"must not be negative, got {timing.turn_time}"))
+    for name in ("cell_time", "turn_time"):
+        value = getattr(timing, name)
+        reason = at_most(value, MAX_STEP_SECONDS, "seconds") if value >= 0 else None
+        if reason is not None:
+            problems.append(Problem(f"timing.{name}", reason))
     return problems
 
 
 def scenario_problems(scenario: Scenario) -> list[Problem]:
     """Every problem with the meaning of ``scenario``, each named by its field path.
 
-    Checks: robots present, unique ids, starts and goals on the grid and free,
-    no two robots sharing a start or a goal, each goal reachable from its start,
-    timing and fault values in range, links between existing robots.
+    Checks: robots present (at most :data:`~mrmp.core.limits.MAX_ROBOTS`), unique
+    ids, starts and goals on the grid and free, no two robots sharing a start or
+    a goal, each goal reachable from its start, timing, fault values and tick
+    limit in range (:mod:`mrmp.core.limits`), links between existing robots.
     """
     problems: list[Problem] = []
     grid = scenario.grid
     size = f"{grid.x_size}x{grid.y_size}"
     if not scenario.robots:
         problems.append(Problem("robots", "a scenario needs at least one robot"))
+    if len(scenario.robots) > MAX_ROBOTS:
+        problems.append(Problem("robots", f"a scenario has at most {MAX_ROBOTS} robots, this one has {len(scenario.robots)}"))
+        return problems
     seen_ids: dict[str, int] = {}
     seen_starts: dict[Cell, int] = {}
     seen_goals: dict[Cell, int] = {}
@@ -239,11 +265,7 @@ def scenario_problems(scenario: Scenario) -> list[Problem]:
                 labels = connected_regions(grid, grid.free_cells())[0]
             if labels[robot.start] != labels[robot.goal]:
                 problems.append(Problem(f"{where}.goal", f"cell {robot.goal} cannot be reached from start {robot.start}"))
-    timing = scenario.timing
-    if not timing.cell_time > 0:
-        problems.append(Problem("timing.cell_time", f"must be positive, got {timing.cell_time}"))
-    if not timing.turn_time >= 0:
-        problems.append(Problem("timing.turn_time", f"must not be negative, got {timing.turn_time}"))
+    problems.extend(_timing_problems(scenario.timing))
     problems.extend(_fault_problems(scenario.network, "network"))
     for index, link in enumerate(scenario.links):
         where = f"network.links[{index}]"
@@ -255,4 +277,6 @@ def scenario_problems(scenario: Scenario) -> list[Problem]:
         problems.extend(_fault_problems(link.faults, where))
     if scenario.max_ticks is not None and scenario.max_ticks <= 0:
         problems.append(Problem("max_ticks", f"must be positive, got {scenario.max_ticks}"))
+    elif scenario.max_ticks is not None and scenario.max_ticks > MAX_TICKS:
+        problems.append(Problem("max_ticks", f"must be at most {MAX_TICKS}, got {scenario.max_ticks}"))
     return problems

@@ -60,11 +60,12 @@ from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
 from mrmp.centralized.registry import PLANNER_NAMES
 from mrmp.core.errors import InputError
-from mrmp.core.grid import Grid
+from mrmp.core.grid import Grid, grid_size_problem
+from mrmp.core.limits import MAX_BENCH_MAPS, MAX_BENCH_RUNS, MAX_ROBOTS, MAX_RUN_SECONDS, MAX_TICKS, shown
 from mrmp.core.map_generators import GENERATORS, complete_spec, generate, largest_region
 from mrmp.core.scenario import NetworkFaults, _fault_problems
 from mrmp.experiments.matrix import BenchRun
-from mrmp.io._files import PathLike, read_text
+from mrmp.io._files import PathLike, file_problem, read_text
 from mrmp.io.movingai import read_map, read_scen_entries, scen_map_problems
 from mrmp.io.scenario_file import (
     _BAD,
@@ -74,6 +75,7 @@ from mrmp.io.scenario_file import (
     _in_order,
     _line,
     _Reader,
+    _unusable,
 )
 from mrmp.sim.policy_table import policy_names
 
@@ -148,8 +150,10 @@ class _BenchReader(_Reader):
             return None
         return list(node.value)
 
-    def positive_list(self, entries: dict[str, Any], key: str, path: str, smallest: int = 1) -> list[int] | None:
-        """A list of distinct integers, each at least ``smallest``."""
+    def positive_list(
+        self, entries: dict[str, Any], key: str, path: str, smallest: int = 1, largest: int | None = None
+    ) -> list[int] | None:
+        """A list of distinct integers, each at least ``smallest`` (and at most ``largest`` when given)."""
         nodes = self.items(entries, key, path)
         if nodes is None:
             return None
@@ -160,17 +164,24 @@ class _BenchReader(_Reader):
                 continue
             if value < smallest:
                 self.report(_line(node), f"{path}[{index}]", f"must be at least {smallest}, got {value}")
+            elif largest is not None and value > largest:
+                self.report(_line(node), f"{path}[{index}]", f"must be at most {largest}, got {value}")
             elif value in values:
                 self.report(_line(node), f"{path}[{index}]", f"{value} is listed twice")
             else:
                 values.append(value)
         return values
 
-    def bounded(self, entries: dict[str, Any], key: str, path: str, read: Any, smallest: float) -> Any:
-        """An optional number read with ``read`` that must be at least ``smallest``."""
+    def bounded(
+        self, entries: dict[str, Any], key: str, path: str, read: Any, smallest: float, largest: float | None = None
+    ) -> Any:
+        """An optional number read with ``read`` that must be at least ``smallest`` (and at most ``largest``)."""
         value = self.optional(entries, key, path, read)
-        if value is not None and value is not _BAD and value < smallest:
+        if value is not None and value is not _BAD and not value >= smallest:
             self.report(entries[key].key_line, path, f"must be at least {smallest:g}, got {value}")
+            return _BAD
+        if value is not None and value is not _BAD and largest is not None and not value <= largest:
+            self.report(entries[key].key_line, path, f"must be at most {shown(largest)}, got {value}")
             return _BAD
         return value
 
@@ -180,8 +191,9 @@ class _BenchReader(_Reader):
         if relative is _BAD:
             return None
         file = (self.base_dir / relative).resolve()
-        if not file.is_file():
-            self.report(_line(node), path, f"{what} not found: {self.base_dir / relative}")
+        problem = file_problem(file)
+        if problem is not None:
+            self.report(_line(node), path, _unusable(what, self.base_dir / relative, problem))
             return None
         return file
 
@@ -196,7 +208,7 @@ class _BenchReader(_Reader):
         entries = self.mapping(node, path, FILE_MAP_KEYS, required=("map",))
         if entries is None or "map" not in entries:
             return []
-        agents = self.positive_list(entries, "agents", f"{path}.agents")
+        agents = self.positive_list(entries, "agents", f"{path}.agents", largest=MAX_ROBOTS)
         agents_given = tuple(agents) if agents else None
         map_file = self.file(entries["map"].value, f"{path}.map", "map file")
         if ("scen" in entries) == ("instances" in entries):
@@ -209,7 +221,7 @@ class _BenchReader(_Reader):
             except InputError as error:
                 self.problems.extend(error.problems)
         if "instances" in entries:
-            count = self.bounded(entries, "instances", f"{path}.instances", self.integer, 1)
+            count = self.bounded(entries, "instances", f"{path}.instances", self.integer, 1, MAX_BENCH_RUNS)
             if map_file is None or grid is None or count is _BAD or count is None:
                 return []
             capacity = len(largest_region(grid))
@@ -261,6 +273,11 @@ class _BenchReader(_Reader):
             value = self.bounded(entries, key, f"{path}.{key}", self.integer, 1)
             ok = ok and value is not _BAD and value is not None
             spec[key] = value
+        if ok:
+            too_large = grid_size_problem(spec["height"], spec["width"])
+            if too_large is not None:
+                self.report(_line(node), path, too_large)
+                ok = False
         for parameter in generator.parameters:
             read = self.integer if parameter.kind is int else self.number
             value = self.bounded(entries, parameter.name, f"{path}.{parameter.name}", read, parameter.minimum)
@@ -274,8 +291,11 @@ class _BenchReader(_Reader):
             seeds = list(given) if given else [0]
         elif "seeds" in entries:
             self.report(entries["seeds"].key_line, f"{path}.seeds", f"{kind} maps are not random: leave seeds out")
-        count = self.bounded(entries, "instances", f"{path}.instances", self.integer, 1)
-        agents = self.positive_list(entries, "agents", f"{path}.agents")
+        count = self.bounded(entries, "instances", f"{path}.instances", self.integer, 1, MAX_BENCH_RUNS)
+        agents = self.positive_list(entries, "agents", f"{path}.agents", largest=MAX_ROBOTS)
+        if ok and len(seeds) > MAX_BENCH_MAPS:
+            self.report(entries["seeds"].key_line, f"{path}.seeds", f"at most {MAX_BENCH_MAPS} maps, got {len(seeds)} seeds")
+            ok = False
         if not ok or count is _BAD:
             return []
         instances = []
@@ -305,21 +325,31 @@ class _BenchReader(_Reader):
         name = self.optional(top, "name", "name", self.label)
         name = Path(self.source).stem if name is None or name is _BAD else name
         instances: list[_Instance] = []
-        for index, node in enumerate(self.items(top, "maps", "maps") or []):
+        map_nodes = self.items(top, "maps", "maps") or []
+        if len(map_nodes) > MAX_BENCH_MAPS:
+            self.report(top["maps"].key_line, "maps", f"at most {MAX_BENCH_MAPS} maps, got {len(map_nodes)}")
+            map_nodes = []
+        for index, node in enumerate(map_nodes):
             self.lines[f"maps[{index}]"] = _line(node)
             instances += self.map_entry(node, f"maps[{index}]")
-        agents = self.positive_list(top, "agents", "agents") or []
+            if len({instance.generator or instance.map_path for instance in instances}) > MAX_BENCH_MAPS:
+                self.report(_line(node), f"maps[{index}]", f"the configuration reaches more than {MAX_BENCH_MAPS} maps")
+                break
+        agents = self.positive_list(top, "agents", "agents", largest=MAX_ROBOTS) or []
         policies = self.policies(top)
         seeds = self.positive_list(top, "seeds", "seeds", smallest=0) or [0]
         faults = self.fault_list(top)
-        time_limit = self.bounded(top, "time_limit", "time_limit", self.number, 0.001)
-        max_ticks = self.bounded(top, "max_ticks", "max_ticks", self.integer, 1)
+        time_limit = self.bounded(top, "time_limit", "time_limit", self.number, 0.001, MAX_RUN_SECONDS)
+        max_ticks = self.bounded(top, "max_ticks", "max_ticks", self.integer, 1, MAX_TICKS)
         lifelong = self.optional(top, "lifelong", "lifelong", self.boolean)
         if lifelong is True:
             central = [policy for policy in policies if policy in PLANNER_NAMES]
             if central:
                 self.report(top["lifelong"].key_line, "lifelong",
                             f"lifelong runs use decentralized policies only; remove {', '.join(central)}")  # fmt: skip
+        matrix = sum(len(family.agents or agents) for family in instances) * len(policies) * len(seeds) * len(faults)
+        if matrix > MAX_BENCH_RUNS:
+            self.report(_line(root), "", f"the matrix has {matrix} runs, more than the bound of {MAX_BENCH_RUNS}")
         if self.problems:
             return None
         limit = time_limit_override or (time_limit if time_limit is not None else DEFAULT_TIME_LIMIT_S)

@@ -22,6 +22,7 @@ from dataclasses import replace
 
 from mrmp.centralized.execution import distributed_bytes, plan_policies
 from mrmp.centralized.plan import PlanningResult
+from mrmp.core.limits import MAX_TICKS
 from mrmp.core.result import RunResult
 from mrmp.core.scenario import Scenario
 from mrmp.sim.metrics import default_max_ticks, network_slowdown, shortest_steps
@@ -37,7 +38,8 @@ def execution_max_ticks(scenario: Scenario, plan: PlanningResult) -> int:
     takes longer than its plan (a crowded 34-tick plan took 127 ticks with the
     safety layer on): ``64 + 8 * plan length``, times the network's slowdown of a
     claim's round trip (:func:`~mrmp.sim.metrics.network_slowdown`) when guarded,
-    and never less than the simulator's own default.
+    and never less than the simulator's own default (nor more than
+    :data:`~mrmp.core.limits.MAX_TICKS`).
 
     >>> from mrmp.core import Grid, RobotSpec, Scenario
     >>> from mrmp.centralized.plan import PlanningResult
@@ -49,7 +51,7 @@ def execution_max_ticks(scenario: Scenario, plan: PlanningResult) -> int:
     ticks = 64 + 8 * length
     if scenario.safety:
         ticks = int(ticks * network_slowdown(scenario))
-    return max(ticks, default_max_ticks(scenario, shortest_steps(scenario)))
+    return min(max(ticks, default_max_ticks(scenario, shortest_steps(scenario))), MAX_TICKS)
 
 
 def execute_in_simulator(

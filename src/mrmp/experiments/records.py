@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import time
 import traceback
+from collections.abc import Callable
 from typing import Any
 
 from mrmp.core.errors import MrmpError
@@ -128,16 +129,21 @@ def result_fields(result: RunResult) -> dict[str, Any]:
     return fields
 
 
-def execute_run(run: BenchRun) -> dict[str, Any]:
+def execute_run(run: BenchRun, on_ready: Callable[[], None] = lambda: None) -> dict[str, Any]:
     """Run ``run`` in this process and return its record (never raises for a failing run).
 
     A central planner that stops at its limit gives status ``timeout``; any
     exception gives status ``error`` with a one-line message. Wall-clock
     limits beyond the planner's own are enforced by the caller
-    (:func:`mrmp.bench.runner.run_isolated`).
+    (:func:`mrmp.bench.runner.run_isolated`), counted from ``on_ready``: it is
+    called once the run's scenario is built (or has failed to build), when
+    the planner's or the simulator's own clock is about to start.
     """
     try:
-        scenario = build_scenario(run)
+        try:
+            scenario = build_scenario(run)
+        finally:
+            on_ready()
         if run.kind == "centralized":
             from mrmp.centralized.registry import plan_with
             from mrmp.experiments.execution import execute_in_simulator

@@ -14,27 +14,87 @@ Examples
 Traceback (most recent call last):
 ...
 mrmp.core.errors.InputError: ...missing.txt: file not found
+>>> read_text("/dev/zero")
+Traceback (most recent call last):
+...
+mrmp.core.errors.InputError: /dev/zero: is a device, not a file
 """
 
 from __future__ import annotations
 
 import os
+import stat
 import tempfile
 from pathlib import Path
 
 from mrmp.core.errors import InputError, Problem
+from mrmp.core.limits import MAX_INPUT_FILE_BYTES
 
 PathLike = str | os.PathLike[str]
 """Anything :class:`pathlib.Path` accepts."""
 
 
-def read_text(path: PathLike) -> str:
-    """Read a UTF-8 text file, turning every failure into an :class:`InputError` naming the file.
+def file_problem(path: PathLike) -> str | None:
+    """Why ``path`` cannot be read as an input file (missing, a folder, a device), or None when it can.
+
+    A regular file or a pipe (``<(...)`` in a shell) can be read; a device
+    such as ``/dev/zero`` or ``/dev/urandom`` never ends, so it is refused.
+
+    >>> file_problem("/dev/null"), file_problem("/"), file_problem("/no/such/file")
+    ('is a device, not a file', 'is a folder, not a file', 'file not found')
+    """
+    try:
+        mode = os.stat(path).st_mode
+    except FileNotFoundError:
+        return "file not found"
+    except OSError as error:
+        return f"cannot read the file: {error.strerror or error}"
+    if stat.S_ISDIR(mode):
+        return "is a folder, not a file"
+    if stat.S_ISCHR(mode) or stat.S_ISBLK(mode):
+        return "is a device, not a file"
+    if stat.S_ISSOCK(mode):
+        return "is a socket, not a file"
+    return None
+
+
+def read_bytes(path: PathLike, limit: int = MAX_INPUT_FILE_BYTES) -> bytes:
+    """The bytes of a file of at most ``limit`` bytes, every failure an :class:`InputError` naming the file.
+
+    Raises
+    ------
+    InputError
+        If the file is missing, a folder, a device, unreadable, or longer than
+        ``limit`` bytes (checked before reading a regular file, and by reading
+        at most one byte more from a pipe).
+    """
+    where = str(path)
+    problem = file_problem(path)
+    if problem is not None:
+        raise InputError(Problem(where, problem))
+    too_long = f"longer than the bound of {limit} bytes"
+    try:
+        with open(path, "rb") as handle:
+            status = os.fstat(handle.fileno())
+            if stat.S_ISREG(status.st_mode) and status.st_size > limit:
+                raise InputError(Problem(where, too_long))
+            data = handle.read(limit + 1)
+    except OSError as error:
+        raise InputError(Problem(where, f"cannot read the file: {error.strerror or error}")) from None
+    if len(data) > limit:
+        raise InputError(Problem(where, too_long))
+    return data
+
+
+def read_text(path: PathLike, limit: int = MAX_INPUT_FILE_BYTES) -> str:
+    """Read a UTF-8 text file of at most ``limit`` bytes, turning every failure into an :class:`InputError` naming the file.
 
     Parameters
     ----------
     path:
         The file to read.
+    limit:
+        The longest file accepted, in bytes (:mod:`mrmp.core.limits`).
 
     Returns
     -------
@@ -44,18 +104,11 @@ def read_text(path: PathLike) -> str:
     Raises
     ------
     InputError
-        If the file is missing, a folder, unreadable, or not UTF-8 text; the
-        problem names the file (and the line of the first bad byte).
+        If the file is missing, a folder, a device, unreadable, too long, or not
+        UTF-8 text; the problem names the file (and the line of the first bad byte).
     """
     where = str(path)
-    try:
-        data = Path(path).read_bytes()
-    except FileNotFoundError:
-        raise InputError(Problem(where, "file not found")) from None
-    except IsADirectoryError:
-        raise InputError(Problem(where, "is a folder, not a file")) from None
-    except OSError as error:
-        raise InputError(Problem(where, f"cannot read the file: {error.strerror or error}")) from None
+    data = read_bytes(path, limit)
     try:
         return data.decode("utf-8")
     except UnicodeDecodeError as error:

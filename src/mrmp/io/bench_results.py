@@ -113,6 +113,8 @@ def read_records(path: PathLike, repair: bool = False) -> list[dict[str, Any]]:
             record = json.loads(raw)
         except json.JSONDecodeError as error:
             raise InputError(Problem(f"{path}:{number}", f"not a JSON record: {error.msg}")) from None
+        except RecursionError:
+            raise InputError(Problem(f"{path}:{number}", "not a JSON record: nested too deeply")) from None
         if not isinstance(record, dict) or not isinstance(record.get("run_id"), str):
             raise InputError(Problem(f"{path}:{number}", "expected a JSON object with a run_id"))
         records.append(record)

@@ -19,12 +19,14 @@ Examples
 from __future__ import annotations
 
 import json
+import os
 from pathlib import Path
 from typing import IO, Any
 
 from mrmp.core.cell import Cell
 from mrmp.core.errors import InputError, Problem
-from mrmp.io._files import PathLike, atomic_write_text, read_text
+from mrmp.core.limits import MIN_KEY_BYTES
+from mrmp.io._files import PathLike, atomic_write_text, read_bytes, read_text
 
 TraceEvent = tuple[int, str, Cell, float]
 
@@ -75,9 +77,38 @@ class TraceReader:
                 item = json.loads(line)
                 cell = (int(item["cell"][0]), int(item["cell"][1]))
                 events.append((int(item["robot"]), str(item["event"]), cell, float(item["t"])))
-            except (ValueError, KeyError, TypeError, IndexError):
+            except (ValueError, KeyError, TypeError, IndexError, RecursionError):
                 continue
         return events
+
+
+def prepare_folder(path: PathLike) -> Path:
+    """Make ``path`` a folder to write a run's files in (created with its parents if missing).
+
+    Raises
+    ------
+    InputError
+        If it is a file, or cannot be created or written to (naming the folder).
+
+    >>> import tempfile, pathlib
+    >>> folder = pathlib.Path(tempfile.mkdtemp())
+    >>> prepare_folder(folder / "run") == folder / "run"
+    True
+    >>> (folder / "note").write_text("x") and prepare_folder(folder / "note")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    mrmp.core.errors.InputError: ...note: is a file, not a folder
+    """
+    folder = Path(path)
+    if folder.exists() and not folder.is_dir():
+        raise InputError(Problem(str(path), "is a file, not a folder"))
+    try:
+        folder.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise InputError(Problem(str(path), f"cannot create the folder: {error.strerror or error}")) from None
+    if not os.access(folder, os.W_OK | os.X_OK):
+        raise InputError(Problem(str(path), "cannot write in this folder"))
+    return folder
 
 
 def write_json(path: PathLike, data: Any) -> None:
@@ -98,10 +129,12 @@ def read_json(path: PathLike) -> Any:
         return json.loads(text)
     except json.JSONDecodeError as error:
         raise InputError(Problem(f"{path}:{error.lineno}", f"not valid JSON: {error.msg}")) from None
+    except RecursionError:
+        raise InputError(Problem(str(path), "not valid JSON: nested too deeply")) from None
 
 
 def read_key_file(path: PathLike) -> bytes:
-    """Read a fleet key: the file's bytes, less surrounding white space; at least 16 bytes.
+    """Read a fleet key: the file's bytes, less surrounding white space; at least :data:`MIN_KEY_BYTES` bytes.
 
     Raises
     ------
@@ -109,11 +142,48 @@ def read_key_file(path: PathLike) -> bytes:
         If the file cannot be read or the key is shorter than 16 bytes.
     """
     try:
-        key = Path(path).read_bytes().strip()
-    except OSError as error:
-        raise InputError(Problem(str(path), f"cannot read the fleet key: {error.strerror or error}")) from None
-    if len(key) < 16:
-        raise InputError(Problem(str(path), f"a fleet key needs at least 16 bytes, this one has {len(key)}"))
+        key = read_bytes(path).strip()
+    except InputError as error:
+        reason = error.problems[0].reason
+        raise InputError(Problem(str(path), f"cannot read the fleet key: {reason}")) from None
+    return checked_key(key, str(path))
+
+
+def key_from_environment(value: str | None) -> bytes:
+    """The fleet key given by ``MRMP_FLEET_KEY`` (``value``): empty when unset or empty, else at least 16 bytes.
+
+    The key is the variable's bytes as they are; white space around them does
+    not count towards the 16 bytes.
+
+    Raises
+    ------
+    InputError
+        If the variable holds a key shorter than 16 bytes (naming ``MRMP_FLEET_KEY``).
+
+    >>> key_from_environment(None), key_from_environment(""), key_from_environment("k" * 16)
+    (b'', b'', b'kkkkkkkkkkkkkkkk')
+    >>> key_from_environment(" ")
+    Traceback (most recent call last):
+    ...
+    mrmp.core.errors.InputError: MRMP_FLEET_KEY: a fleet key needs at least 16 bytes, this one has 0
+    """
+    if not value:
+        return b""
+    key = value.encode()
+    checked_key(key.strip(), "MRMP_FLEET_KEY")
+    return key
+
+
+def checked_key(key: bytes, where: str) -> bytes:
+    """``key`` if it has at least :data:`MIN_KEY_BYTES` bytes.
+
+    Raises
+    ------
+    InputError
+        If it is shorter (the problem names ``where``).
+    """
+    if len(key) < MIN_KEY_BYTES:
+        raise InputError(Problem(where, f"a fleet key needs at least {MIN_KEY_BYTES} bytes, this one has {len(key)}"))
     return key
 
 

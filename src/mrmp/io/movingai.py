@@ -44,6 +44,7 @@ from mrmp.core.grid import (
     FREE_SYMBOLS,
     Grid,
     cell_from_movingai,
+    grid_size_problem,
     movingai_from_cell,
 )
 from mrmp.core.scenario import RobotSpec
@@ -182,6 +183,9 @@ def _parse_map_header(lines: Sequence[str], source: str) -> tuple[int, int, int]
     for key in ("height", "width"):
         if key not in sizes:
             raise InputError(Problem(f"{source}:{index + 1}", f"bad header: missing '{key} N' before 'map'"))
+    too_large = grid_size_problem(sizes["height"], sizes["width"])
+    if too_large is not None:
+        raise InputError(Problem(f"{source}:{index + 1}", f"bad header: {too_large}"))
     return sizes["height"], sizes["width"], index
 
 

@@ -98,7 +98,7 @@ def read_plan(path: PathLike, robot_ids: Sequence[str]) -> PlanFile:
         ids = [str(robot["id"]) for robot in robots]
         paths = tuple(tuple((int(cell[0]), int(cell[1])) for cell in robot["path"]) for robot in robots)
         planner, seconds = str(data["planner"]), float(data["planning_time_s"])
-    except (ValueError, KeyError, TypeError, IndexError) as error:
+    except (ValueError, KeyError, TypeError, IndexError, RecursionError) as error:
         raise InputError(Problem(where, f"not a plan file: {error}")) from None
     if ids != list(robot_ids):
         raise InputError(Problem(where, f"the plan is for robots {ids}, the scenario has {list(robot_ids)}"))
@@ -139,7 +139,7 @@ def read_share(path: PathLike, robot_id: str) -> tuple[list[Cell], dict[int, lis
         dependencies: dict[int, list[tuple[int, int]]] = {}
         for move, robot, progress in data["dependencies"]:
             dependencies.setdefault(int(move), []).append((int(robot), int(progress)))
-    except (ValueError, KeyError, TypeError, IndexError) as error:
+    except (ValueError, KeyError, TypeError, IndexError, RecursionError) as error:
         raise InputError(Problem(where, f"not a robot's share of a plan: {error}")) from None
     if owner != robot_id:
         raise InputError(Problem(where, f"this share belongs to robot {owner!r}, not {robot_id!r}"))

@@ -43,6 +43,7 @@ from pathlib import Path
 from typing import Any
 
 from mrmp.core.errors import InputError, Problem
+from mrmp.core.limits import MAX_RECORD_FILE_BYTES
 from mrmp.io._files import PathLike, read_text
 from mrmp.io.bench_results import RECORD_FORMAT, RESULTS_JSONL
 
@@ -256,7 +257,7 @@ def read_bench_results(path: PathLike) -> BenchResults:
     target = results_file(path)
     if Path(path).is_dir() and not target.exists():
         raise InputError(Problem(str(path), f"no {RESULTS_JSONL} in this folder (is it the --out of mrmp bench?)"))
-    text = read_text(target)
+    text = read_text(target, MAX_RECORD_FILE_BYTES)
     lines = text.split("\n")
     if lines and lines[-1] == "":
         lines.pop()
@@ -275,6 +276,9 @@ def read_bench_results(path: PathLike) -> BenchResults:
                 truncated = 1
                 continue
             problems.append(Problem(where, f"not valid JSON ({error.msg} at column {error.colno})"))
+            continue
+        except RecursionError:
+            problems.append(Problem(where, "not valid JSON (nested too deeply)"))
             continue
         try:
             records.append(record_from_dict(data, line=number))

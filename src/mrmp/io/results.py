@@ -25,6 +25,7 @@ from typing import Any
 from mrmp.core.errors import InputError, Problem
 from mrmp.core.grid import Grid
 from mrmp.core.heading import Heading
+from mrmp.core.limits import MAX_RECORD_FILE_BYTES
 from mrmp.core.result import Collision, RobotResult, RunResult
 from mrmp.io._files import PathLike, atomic_write_text, read_text
 
@@ -371,11 +372,13 @@ def read_result_json(path: PathLike) -> tuple[RunResult, Grid | None]:
         does not describe a run.
     """
     source = str(path)
-    text = read_text(path)
+    text = read_text(path, MAX_RECORD_FILE_BYTES)
     try:
         data = json.loads(text)
     except json.JSONDecodeError as error:
         raise InputError(Problem(f"{source}:{error.lineno}", f"invalid JSON: {error.msg}")) from None
+    except RecursionError:
+        raise InputError(Problem(source, "invalid JSON: nested too deeply")) from None
     if not isinstance(data, Mapping):
         raise InputError(Problem(source, f"expected a JSON object describing a run, got {type(data).__name__}"))
     return result_from_dict(data, source), grid_from_result_dict(data)

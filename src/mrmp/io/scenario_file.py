@@ -69,12 +69,14 @@ from typing import Any
 
 import yaml
 from yaml.constructor import SafeConstructor
+from yaml.events import MappingStartEvent, SequenceStartEvent
 from yaml.nodes import MappingNode, Node, ScalarNode, SequenceNode
 
 from mrmp.core.cell import Cell
 from mrmp.core.errors import InputError, Problem
-from mrmp.core.grid import COST_SYMBOLS, Grid
+from mrmp.core.grid import COST_SYMBOLS, Grid, grid_size_problem
 from mrmp.core.heading import Heading
+from mrmp.core.limits import MAX_YAML_DEPTH
 from mrmp.core.options import setting_types, settings
 from mrmp.core.scenario import (
     LinkFaults,
@@ -85,7 +87,7 @@ from mrmp.core.scenario import (
     Timing,
     scenario_problems,
 )
-from mrmp.io._files import PathLike, atomic_write_text, read_text
+from mrmp.io._files import PathLike, atomic_write_text, file_problem, read_text
 from mrmp.io.movingai import (
     MAP_SYMBOLS,
     ScenEntry,
@@ -379,6 +381,10 @@ class _Reader:
                 return None
         if width is _BAD or height is _BAD:
             return None
+        too_large = grid_size_problem(height, width)
+        if too_large is not None:
+            self.report(_line(node), "map", too_large)
+            return None
         return Grid(height, width, name=name)
 
     def read_rows(self, node: Node, name: str) -> Grid | None:
@@ -387,6 +393,12 @@ class _Reader:
             got = "an empty list" if isinstance(node, SequenceNode) else _describe(node, self.scalar(node))
             self.report(_line(node), "map.rows", f"expected a non-empty list of rows of symbols, got {got}")
             return None
+        first = node.value[0]
+        if isinstance(first, ScalarNode):
+            too_large = grid_size_problem(len(node.value), len(str(first.value)))
+            if too_large is not None:
+                self.report(_line(node), "map.rows", too_large)
+                return None
         rows: list[str] = []
         ok = True
         for index, item in enumerate(node.value):
@@ -418,8 +430,9 @@ class _Reader:
         if relative is _BAD:
             return None
         path = self.base_dir / relative
-        if not path.is_file():
-            self.report(_line(node), "map.file", f"map file not found: {path}")
+        problem = file_problem(path)
+        if problem is not None:
+            self.report(_line(node), "map.file", _unusable("map file", path, problem))
             return None
         try:
             return read_map(path)
@@ -472,8 +485,9 @@ class _Reader:
         if relative is None or relative is _BAD or agents is None or agents is _BAD:
             return grid, []
         path = self.base_dir / relative
-        if not path.is_file():
-            self.report(entries["scen"].key_line, "scen", f"scenario file not found: {path}")
+        problem = file_problem(path)
+        if problem is not None:
+            self.report(entries["scen"].key_line, "scen", _unusable("scenario file", path, problem))
             return grid, []
         try:
             scen_entries = parse_scen(read_text(path), str(path))
@@ -499,10 +513,11 @@ class _Reader:
             self.report(line, "scen", f"{scen_path} lists no agents")
             return None
         map_path = scen_path.parent / entries[0].map_name
-        if not map_path.is_file():
-            self.report(
-                line, "scen", f"map file {entries[0].map_name!r} named by {scen_path} not found (looked for {map_path})"
-            )
+        problem = file_problem(map_path)
+        if problem is not None:
+            named = f"map file {entries[0].map_name!r} named by {scen_path}"
+            reason = f"{named} not found (looked for {map_path})" if problem == "file not found" else f"{named} {problem}"
+            self.report(line, "scen", reason)
             return None
         return read_map(map_path)
 
@@ -651,6 +666,15 @@ class _Reader:
             self.problems.append(Problem(self.where(path), f"{path}: {original(problem.reason)}"))
 
 
+def _unusable(what: str, path: Path, problem: str) -> str:
+    """Why the file a field names cannot be read, e.g. ``map file not found: x.map``.
+
+    >>> _unusable("map file", Path("/dev/zero"), "is a device, not a file")
+    'map file /dev/zero is a device, not a file'
+    """
+    return f"{what} not found: {path}" if problem == "file not found" else f"{what} {path} {problem}"
+
+
 def _given(values: dict[str, Any]) -> dict[str, Any]:
     """The values that were given and well formed."""
     return {key: value for key, value in values.items() if value is not None and value is not _BAD}
@@ -673,10 +697,45 @@ def _yaml_error_problem(error: yaml.YAMLError, text: str, source: str) -> Proble
     return Problem(f"{source}:{line}", f"invalid YAML: {reason}")
 
 
+class _TooDeep(yaml.MarkedYAMLError):
+    """Lists and mappings nested deeper than :data:`~mrmp.core.limits.MAX_YAML_DEPTH`."""
+
+
+class _DepthBoundedLoader(yaml.SafeLoader):
+    """PyYAML's safe loader, refusing to compose lists and mappings nested deeper than :data:`MAX_YAML_DEPTH`.
+
+    PyYAML's parser is iterative, but its composer recurses once per level, so
+    without a bound a deep file overflows the stack.
+    """
+
+    _depth = 0
+
+    def compose_node(self, parent: Node | None, index: int) -> Node | None:
+        if not self.check_event(SequenceStartEvent, MappingStartEvent):
+            return super().compose_node(parent, index)
+        self._depth += 1
+        try:
+            if self._depth > MAX_YAML_DEPTH:
+                mark = self.peek_event().start_mark
+                raise _TooDeep(problem=f"lists and mappings nested more than {MAX_YAML_DEPTH} levels deep", problem_mark=mark)
+            return super().compose_node(parent, index)
+        finally:
+            self._depth -= 1
+
+
 def _compose(text: str, source: str, expected: str) -> Node:
-    """The YAML node tree of ``text``; invalid YAML, or an empty file (that should hold ``expected``), is an InputError."""
+    """The YAML node tree of ``text``; invalid YAML, or an empty file (that should hold ``expected``), is an InputError.
+
+    >>> _compose("a: " + "[" * 40 + "]" * 40, "deep.yaml", "a mapping")
+    Traceback (most recent call last):
+    ...
+    mrmp.core.errors.InputError: deep.yaml:1: lists and mappings nested more than 32 levels deep
+    """
     try:
-        root = yaml.compose(text, Loader=yaml.SafeLoader)
+        root = yaml.compose(text, Loader=_DepthBoundedLoader)
+    except _TooDeep as error:
+        line = error.problem_mark.line + 1 if error.problem_mark is not None else 1
+        raise InputError(Problem(f"{source}:{line}", str(error.problem))) from None
     except yaml.YAMLError as error:
         raise InputError(_yaml_error_problem(error, text, source)) from None
     if root is None:

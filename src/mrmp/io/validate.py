@@ -23,7 +23,7 @@ from pathlib import Path
 
 from mrmp.core.errors import InputError, Problem
 from mrmp.core.scenario import Scenario, scenario_problems
-from mrmp.io._files import PathLike
+from mrmp.io._files import PathLike, file_problem
 from mrmp.io.movingai import ScenEntry, read_map, read_scen_entries, scen_map_problems
 from mrmp.io.scenario_file import load_scenario
 
@@ -68,8 +68,11 @@ def _scen_problems(path: Path) -> list[Problem]:
     problems: list[Problem] = []
     for map_name, group in by_map.items():
         map_path = path.parent / map_name
-        if not map_path.is_file():
+        unusable = file_problem(map_path)
+        if unusable is not None:
             reason = f"map file {map_name!r} not found next to the file (looked for {map_path})"
+            if unusable != "file not found":
+                reason = f"map file {map_name!r} next to the file ({map_path}) {unusable}"
             problems.append(Problem(f"{source}:{group[0].line}", reason))
             continue
         try:

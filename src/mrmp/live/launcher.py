@@ -4,8 +4,10 @@ The launcher writes the run's scenario, a fresh random fleet key and session
 number to a results folder, starts the referee and one ``mrmp agent`` process
 per robot (each in its own session, so that Ctrl-C reaches the launcher only,
 which then stops its children in order), waits for them, and turns their files
-into a :class:`~mrmp.core.result.RunResult`. Children also die with the
-launcher (``PR_SET_PDEATHSIG``), so a killed launcher leaves no orphans.
+into a :class:`~mrmp.core.result.RunResult`. Children also end with the
+launcher, however it ends, even killed in its first instant: each gets the
+parent-death signal before it runs anything, and watches the launcher
+(:mod:`mrmp.io.lifetime`), so a killed launcher leaves no orphans.
 
 Each robot's transport arguments come from the transport's entry in
 :data:`~mrmp.live.transport_table.TRANSPORTS`, for a fleet laid out on
@@ -28,9 +30,11 @@ from pathlib import Path
 from mrmp.centralized.execution import distributed_bytes, plan_policies
 from mrmp.centralized.plan import PlanningResult
 from mrmp.core.errors import InputError, Problem
+from mrmp.core.limits import MAX_RUN_SECONDS
 from mrmp.core.result import RunResult
 from mrmp.core.scenario import Scenario
-from mrmp.io.live_files import read_json, write_key_file
+from mrmp.io.lifetime import preexec_dying_with
+from mrmp.io.live_files import prepare_folder, read_json, write_key_file
 from mrmp.io.plans import write_plan, write_share
 from mrmp.io.scenario_file import save_scenario
 from mrmp.live.agent import AgentTiming
@@ -113,6 +117,7 @@ def run_live(scenario: Scenario, options: LiveOptions, say: Callable[[str], None
     session = random.SystemRandom().randrange(1, 2**31)
     layout = FleetLayout.on_loopback(ids, fleet=f"mrmp/{session}")
     timeout = options.timeout or max(30.0, 10.0 * ideal_makespan(scenario, options.time_scale) + 3.0 * len(ids))
+    timeout = min(timeout, MAX_RUN_SECONDS)  # what mrmp agent --timeout accepts
     fleet = _start_fleet(options, files, layout, session, timeout)
     say(f"live: {len(ids)} robot processes and a referee over {options.transport} on loopback; results in {files.results}")
     stop_reason = _watch(fleet, options.kill, say)
@@ -133,8 +138,7 @@ def _check(options: LiveOptions, ids: list[str]) -> None:
 
 def _write_run_files(scenario: Scenario, options: LiveOptions, ids: list[str]) -> _RunFiles:
     """Clear the results folder of an earlier run's files; write the scenario, the plan's shares and a fresh fleet key."""
-    results = options.results or Path(tempfile.mkdtemp(prefix="mrmp-live-"))
-    results.mkdir(parents=True, exist_ok=True)
+    results = prepare_folder(options.results) if options.results else Path(tempfile.mkdtemp(prefix="mrmp-live-"))
     for stale in [
         *results.glob("trace-*.jsonl"), *results.glob("agent-*.json"), *results.glob("plan-*.json"),
         results / "referee.json", results / "done",
@@ -153,15 +157,19 @@ def _write_run_files(scenario: Scenario, options: LiveOptions, ids: list[str]) -
     return _RunFiles(results, scenario_file, key_file, results / "done", shares)
 
 
+def _start(command: list[str]) -> subprocess.Popen[bytes]:
+    """Start ``command`` in its own session, bound to this process's life (:mod:`mrmp.io.lifetime`)."""
+    return subprocess.Popen(command, start_new_session=True, preexec_fn=preexec_dying_with())
+
+
 def _start_fleet(options: LiveOptions, files: _RunFiles, layout: FleetLayout, session: int, timeout: float) -> _Fleet:
     """Start the referee, then one ``mrmp agent`` process per robot, each in its own session."""
     started = time.monotonic()
-    referee = subprocess.Popen(
+    referee = _start(
         [
             *_PYTHON, "referee", f"--scenario={files.scenario}", f"--results={files.results}",
             f"--start-time={started}", f"--done-file={files.done}",
         ],
-        start_new_session=True,
     )
     common = _agent_arguments(options, files, session, timeout)
     agents = []
@@ -169,7 +177,7 @@ def _start_fleet(options: LiveOptions, files: _RunFiles, layout: FleetLayout, se
         transport = TRANSPORTS.fleet_spec(options.transport, layout, index)
         plan = [f"--plan={files.shares[index]}"] if files.shares else []
         command = [*_PYTHON, "agent", f"--robot={robot_id}", *common, *plan, *transport.arguments(layout.ids)]
-        agents.append(subprocess.Popen(command, start_new_session=True))
+        agents.append(_start(command))
     return _Fleet(list(layout.ids), agents, referee, started, timeout, files.done, files.results)
 
 

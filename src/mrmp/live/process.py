@@ -3,12 +3,12 @@
 :func:`run_agent` is what ``mrmp agent`` runs on each robot's computer;
 :func:`run_referee` is what ``mrmp referee`` runs beside the fleet. Both write
 their results to a folder as they go, and both stop cleanly on SIGINT or
-SIGTERM, writing what they have.
+SIGTERM, writing what they have. Both also stop when the process that started
+them ends, however it ends (:mod:`mrmp.io.lifetime`).
 """
 
 from __future__ import annotations
 
-import ctypes
 import signal
 import sys
 import threading
@@ -20,6 +20,7 @@ from pathlib import Path
 from mrmp.core.errors import InputError, Problem
 from mrmp.core.scenario import Scenario
 from mrmp.core.seeds import Stream, derive_seed, stream_random
+from mrmp.io.lifetime import watch_parent
 from mrmp.io.live_files import TraceReader, TraceWriter, write_json
 from mrmp.io.plans import read_share
 from mrmp.live.agent import Agent, AgentReport, AgentTiming
@@ -36,7 +37,10 @@ from mrmp.sim.policy_table import policy_entry
 def check_key_policy(key: bytes | None, spec: TransportSpec, warn: Callable[[str], None]) -> bytes:
     """The key to use; without one, refuse anything but loopback and warn loudly.
 
-    The transport's table entry says which hosts it listens on and sends to.
+    The transport's table entry says which hosts it listens on and sends to;
+    each must provably be loopback (:func:`~mrmp.live.transport.is_loopback`):
+    an empty host (every interface), an address in another form, or a Zenoh
+    endpoint whose reach is not just its host is refused.
 
     Raises
     ------
@@ -54,22 +58,17 @@ def check_key_policy(key: bytes | None, spec: TransportSpec, warn: Callable[[str
     """
     if key:
         return key
-    outside = [host for host in spec.hosts() if host and not is_loopback(host)]
+    outside = [host for host in spec.hosts() if not is_loopback(host)]
     if outside:
-        hosts = ", ".join(sorted(set(outside)))
+        hosts = ", ".join(host or repr(host) for host in sorted(set(outside)))
         only = "only loopback runs may go without a key; set MRMP_FLEET_KEY or --key-file"
         raise InputError(Problem("--key-file", f"no fleet key: refusing to talk to {hosts} ({only})"))
     warn("WARNING: no fleet key: messages are NOT authenticated; allowed on loopback only")
     return b""
 
 
-def die_with_parent() -> None:
-    """Ask Linux to send SIGTERM to this process when its parent dies (no orphans of a killed launcher)."""
-    try:
-        libc = ctypes.CDLL(None, use_errno=True)
-        libc.prctl(1, signal.SIGTERM)  # PR_SET_PDEATHSIG
-    except (OSError, AttributeError):
-        pass
+PEER_WAIT_SECONDS = 10.0
+"""How long a robot whose transport connects first waits for its peers before it starts anyway."""
 
 
 def _on_stop_signals(action: Callable[[], None]) -> None:
@@ -136,6 +135,22 @@ LIVE_DRIVERS: dict[str, LiveDriver] = {"agent": _per_robot_agent, "causal": _cau
 """The live drivers by the kind a policy-table entry names (:attr:`mrmp.sim.policy_table.PolicyEntry.live_driver`)."""
 
 
+def driver_kind(scenario: Scenario, following_plan: bool) -> str:
+    """The kind of :data:`LIVE_DRIVERS` entry that runs a robot of ``scenario``.
+
+    A robot following its share of a central plan runs the per-robot driver
+    whatever the scenario's policy: the plan replaces the policy.
+
+    >>> from mrmp.core import Grid, PolicyOptions, RobotSpec, Scenario
+    >>> causal = Scenario(Grid(2, 2), (RobotSpec("A", (0, 0), (1, 1)),), policy=PolicyOptions(name="causal"))
+    >>> driver_kind(causal, following_plan=False), driver_kind(causal, following_plan=True)
+    ('causal', 'agent')
+    """
+    if following_plan:
+        return "agent"
+    return policy_entry(scenario.policy.name).live_driver or "agent"
+
+
 def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
     """Run one robot until it is done, writing ``agent-<i>.json`` and ``trace-<i>.jsonl`` in ``options.results``."""
     index = options.index
@@ -164,11 +179,13 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
         )
         sealer = Sealer(options.key, options.session)
         opener = Opener(options.key, options.session, fleet_size=len(scenario.robots))
-        driver = LIVE_DRIVERS[policy_entry(scenario.policy.name).live_driver or "agent"]
-        agent = driver(scenario, index, transport, body, sealer, opener, options, policy)
+        agent = LIVE_DRIVERS[driver_kind(scenario, following_plan=policy is not None)](
+            scenario, index, transport, body, sealer, opener, options, policy
+        )
         _on_stop_signals(agent.stop_requested.set)
+        watch_parent(agent.stop_requested.set)
         if isinstance(opened, ConnectedTransport):
-            opened.wait_for_peers(len(scenario.robots) - 1, timeout=10.0)
+            _wait_for_peers(opened, len(scenario.robots) - 1, agent.stop_requested)
         report = agent.run(on_progress=lambda report: write_json(report_path, report.as_dict()))
     finally:
         if transport is not None:
@@ -178,14 +195,23 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
     return report
 
 
+def _wait_for_peers(transport: ConnectedTransport, count: int, stop: threading.Event) -> None:
+    """Wait up to :data:`PEER_WAIT_SECONDS` for ``count`` peers to connect, or until ``stop`` is set."""
+    deadline = time.monotonic() + PEER_WAIT_SECONDS
+    while not stop.is_set() and (remaining := deadline - time.monotonic()) > 0:
+        if transport.wait_for_peers(count, timeout=min(remaining, 0.1)):
+            return
+
+
 def run_referee(scenario: Scenario, results: Path, start_time: float, done_file: Path, report: Callable[[str], None]) -> list:
-    """Follow the fleet's traces until ``done_file`` appears (or a signal), reporting collisions as found.
+    """Follow the fleet's traces until ``done_file`` appears (or a signal, or the end of its parent), reporting collisions.
 
     Writes ``referee.json``: the collisions and every robot's ground-truth
     intervals. Returns the collisions.
     """
     stop = threading.Event()
     _on_stop_signals(stop.set)
+    watch_parent(stop.set)
     ids, starts = [robot.id for robot in scenario.robots], [robot.start for robot in scenario.robots]
     referee = IntervalReferee(scenario.grid, ids, starts, start_time)
     readers = [TraceReader(results / f"trace-{index}.jsonl") for index in range(len(scenario.robots))]

@@ -21,9 +21,11 @@ from __future__ import annotations
 
 import contextlib
 import heapq
+import ipaddress
 import random
 import socket
 import struct
+import sys
 import threading
 import time
 from collections.abc import Mapping
@@ -83,17 +85,70 @@ def parse_address(text: str) -> Address:
 
 
 def is_loopback(host: str) -> bool:
-    """Whether ``host`` names a loopback address.
+    """Whether ``host`` provably names a loopback address: ``localhost``, or an address of 127.0.0.0/8 or ``::1``.
 
-    >>> is_loopback("127.0.0.1"), is_loopback("localhost"), is_loopback("10.0.0.1")
-    (True, True, False)
+    Only the strict forms count (:mod:`ipaddress`): ``127.1``, ``0x7f.1`` or
+    ``"127.0.0.1 x"``, which the C library's ``inet_aton`` would read as
+    127.0.0.1, are not loopback here, nor is an empty host (which means every
+    interface to ``bind``).
+
+    >>> is_loopback("127.0.0.1"), is_loopback("localhost"), is_loopback("::1"), is_loopback("[::1]")
+    (True, True, True, True)
+    >>> is_loopback("10.0.0.1"), is_loopback("0.0.0.0"), is_loopback(""), is_loopback("127.1"), is_loopback("127.0.0.1 x")
+    (False, False, False, False, False)
     """
     if host == "localhost":
         return True
     try:
-        return socket.inet_aton(host)[0] == 127
-    except OSError:
-        return host == "::1"
+        return ipaddress.ip_address(host.removeprefix("[").removesuffix("]")).is_loopback
+    except ValueError:
+        return False
+
+
+def multicast_group(text: str) -> Address:
+    """Read ``GROUP:PORT`` with an IPv4 multicast group (224.0.0.0/4).
+
+    Raises
+    ------
+    ValueError
+        If the text is not ``HOST:PORT``, or the host is not an IPv4 multicast address.
+
+    >>> multicast_group("239.255.77.1:47000")
+    ('239.255.77.1', 47000)
+    >>> multicast_group("127.0.0.2:47000")
+    Traceback (most recent call last):
+    ...
+    ValueError: 127.0.0.2 is not an IPv4 multicast group (224.0.0.0 to 239.255.255.255)
+    """
+    host, port = parse_address(text)
+    try:
+        multicast = ipaddress.IPv4Address(host).is_multicast
+    except ValueError:
+        multicast = False
+    if not multicast:
+        raise ValueError(f"{host} is not an IPv4 multicast group (224.0.0.0 to 239.255.255.255)")
+    return host, port
+
+
+def ipv4_interface(text: str) -> str:
+    """Read the IPv4 address of an interface, e.g. ``127.0.0.1``.
+
+    Raises
+    ------
+    ValueError
+        If it is not an IPv4 address in dotted form.
+
+    >>> ipv4_interface("127.0.0.1")
+    '127.0.0.1'
+    >>> ipv4_interface("lo")
+    Traceback (most recent call last):
+    ...
+    ValueError: expected the IPv4 address of an interface, e.g. 127.0.0.1, got 'lo'
+    """
+    try:
+        return str(ipaddress.IPv4Address(text))
+    except ValueError:
+        raise ValueError(f"expected the IPv4 address of an interface, e.g. 127.0.0.1, got {text!r}") from None
 
 
 class _UdpSocket:
@@ -135,7 +190,11 @@ class UdpTransport(_UdpSocket):
     def __init__(self, bind: Address, peers: Mapping[int, Address]) -> None:
         self.peers = dict(peers)
         self._socket = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
-        self._socket.bind(bind)
+        try:
+            self._socket.bind(bind)
+        except BaseException:
+            self._socket.close()
+            raise
         self.address: Address = self._socket.getsockname()
         self._closed = False
 
@@ -150,6 +209,10 @@ class UdpTransport(_UdpSocket):
                 self._socket.sendto(data, address)
 
 
+IP_MULTICAST_ALL = getattr(socket, "IP_MULTICAST_ALL", 49)
+"""Linux's socket option (``<linux/in.h>``) that, set to 0, limits a socket to the groups it joined itself."""
+
+
 class UdpMulticastTransport(_UdpSocket):
     """UDP multicast: every robot joins one group; every datagram goes to all of them.
 
@@ -158,6 +221,13 @@ class UdpMulticastTransport(_UdpSocket):
     routing table. Datagrams addressed to one robot are sent to the group too;
     receivers ignore what is not for them (a robot also hears its own datagrams
     and drops them).
+
+    The socket is bound to the group's address, not to every address: on Linux
+    it then receives only datagrams sent to the group, never one sent to any
+    address of the host (ip(7), "bind"); and with ``IP_MULTICAST_ALL`` off it
+    receives only the group it joined, on the interface it joined it on
+    (ip(7), ``IP_MULTICAST_ALL``). A robot on the loopback interface is
+    therefore unreachable from any other host.
 
     Parameters
     ----------
@@ -171,16 +241,22 @@ class UdpMulticastTransport(_UdpSocket):
         self.group = group
         self.interface = interface
         sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
-        sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
-        if hasattr(socket, "SO_REUSEPORT"):
-            sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEPORT, 1)
-        sock.bind(("", group[1]))
-        interface_bytes = socket.inet_aton(interface)
-        sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_IF, interface_bytes)
-        sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, 1)
-        sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_LOOP, 1)
-        membership = struct.pack("4s4s", socket.inet_aton(group[0]), interface_bytes)
-        sock.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP, membership)
+        try:
+            sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
+            if hasattr(socket, "SO_REUSEPORT"):
+                sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEPORT, 1)
+            sock.bind(group)
+            if sys.platform.startswith("linux"):
+                sock.setsockopt(socket.IPPROTO_IP, IP_MULTICAST_ALL, 0)
+            interface_bytes = socket.inet_aton(interface)
+            sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_IF, interface_bytes)
+            sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_TTL, 1)
+            sock.setsockopt(socket.IPPROTO_IP, socket.IP_MULTICAST_LOOP, 1)
+            membership = struct.pack("4s4s", socket.inet_aton(group[0]), interface_bytes)
+            sock.setsockopt(socket.IPPROTO_IP, socket.IP_ADD_MEMBERSHIP, membership)
+        except BaseException:
+            sock.close()
+            raise
         self._socket = sock
         self._closed = False
 

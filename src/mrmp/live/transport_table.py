@@ -37,9 +37,12 @@ from mrmp.live.transport import (
     Transport,
     UdpMulticastTransport,
     UdpTransport,
+    ipv4_interface,
+    multicast_group,
     parse_address,
 )
 from mrmp.live.transport_entry import Delivery, FleetLayout, TransportEntry, TransportLayer
+from mrmp.live.zenoh_transport import ZenohEndpoint, fleet_keys
 from mrmp.protocol.auth import MAX_DATAGRAM_BYTES
 
 
@@ -136,7 +139,15 @@ class MulticastEntry(TransportEntry[MulticastOptions]):
     delivery = Delivery(echoes=True, addressed_to_all=True, longest=MAX_DATAGRAM_BYTES + 1)
 
     def parse(self, values: Mapping[str, Any], ids: Sequence[str], index: int) -> MulticastOptions:
-        return MulticastOptions(_address(values, "group"), str(values["interface"]))
+        try:
+            group = multicast_group(str(values["group"]))
+        except ValueError as error:
+            raise InputError(Problem("--group", str(error))) from None
+        try:
+            interface = ipv4_interface(str(values["interface"]))
+        except ValueError as error:
+            raise InputError(Problem("--interface", str(error))) from None
+        return MulticastOptions(group, interface)
 
     def hosts(self, options: MulticastOptions) -> list[str]:
         return [options.interface]
@@ -175,21 +186,58 @@ class ZenohEntry(TransportEntry[ZenohOptions]):
     ['--listen=tcp/127.0.0.1:7447', '--connect=tcp/127.0.0.1:7448', '--fleet=mrmp/7']
     >>> entry.hosts(options)
     ['127.0.0.1', '127.0.0.1']
+
+    Endpoints are read with Zenoh's own grammar (:class:`ZenohEndpoint`); one
+    whose reach is not just its host (metadata, ``#config``, a protocol other
+    than TCP or UDP) is named whole by :meth:`hosts`, so that the no-key check
+    refuses it:
+
+    >>> entry.hosts(ZenohOptions("tcp/0.0.0.0:17450?x=/", ("tcp/127.0.0.1:7448#iface=eth0",)))
+    ['tcp/0.0.0.0:17450?x=/', 'tcp/127.0.0.1:7448#iface=eth0']
+    >>> entry.parse({"listen": "", "connect": [], "fleet": "mrmp"}, ["A", "B"], 0)
+    Traceback (most recent call last):
+    ...
+    mrmp.core.errors.InputError: --listen: the zenoh transport needs this robot's endpoint, e.g. tcp/127.0.0.1:7447
     """
 
     name = "zenoh"
     summary = "Zenoh peer sessions over explicit endpoints (needs eclipse-zenoh)"
 
     def parse(self, values: Mapping[str, Any], ids: Sequence[str], index: int) -> ZenohOptions:
-        return ZenohOptions(str(values["listen"]), tuple(values.get("connect") or ()), str(values["fleet"]))
+        listen, connect, fleet = str(values.get("listen") or ""), tuple(values.get("connect") or ()), str(values["fleet"])
+        if not listen:
+            raise InputError(Problem("--listen", "the zenoh transport needs this robot's endpoint, e.g. tcp/127.0.0.1:7447"))
+        for option, endpoint in (("--listen", listen), *(("--connect", endpoint) for endpoint in connect)):
+            try:
+                ZenohEndpoint.parse(endpoint)
+            except ValueError as error:
+                raise InputError(Problem(option, str(error))) from None
+        try:
+            fleet_keys(fleet, index)
+        except ValueError as error:
+            raise InputError(Problem("--fleet", str(error))) from None
+        return ZenohOptions(listen, connect, fleet)
 
     def hosts(self, options: ZenohOptions) -> list[str]:
-        return [endpoint.split("/")[-1].rpartition(":")[0] for endpoint in (options.listen, *options.connect)]
+        hosts = []
+        for text in (options.listen, *options.connect):
+            try:
+                host = ZenohEndpoint.parse(text).sole_host()
+            except ValueError:
+                host = None
+            hosts.append(text if host is None else host)
+        return hosts
 
     def open(self, options: ZenohOptions, index: int, fleet_size: int) -> Transport:
+        import zenoh
+
         from mrmp.live.zenoh_transport import ZenohTransport
 
-        return ZenohTransport(index, options.fleet, options.listen, list(options.connect), fleet_size)
+        try:
+            return ZenohTransport(index, options.fleet, options.listen, list(options.connect), fleet_size)
+        except zenoh.ZError as error:  # e.g. the endpoint is taken, or Zenoh cannot use it
+            first_line = str(error).splitlines()[0] if str(error) else type(error).__name__
+            raise OSError(first_line.split(" at /", 1)[0]) from None  # without the source location of Zenoh's Rust code
 
     def fleet_options(self, layout: FleetLayout, index: int) -> ZenohOptions:
         connect = tuple(f"tcp/{layout.host}:{port}" for _, port in layout.others(index))
@@ -228,8 +276,20 @@ class TransportSpec:
         return self.entry.hosts(self.options)
 
     def open(self, index: int, fleet_size: int) -> Transport:
-        """Open the transport, for robot ``index`` of a fleet of ``fleet_size``."""
-        return self.entry.open(self.options, index, fleet_size)
+        """Open the transport, for robot ``index`` of a fleet of ``fleet_size``.
+
+        Raises
+        ------
+        InputError
+            If the transport cannot be opened with these options (an address
+            taken or not on this host, a group that cannot be joined), naming
+            ``--transport`` and the reason.
+        """
+        try:
+            return self.entry.open(self.options, index, fleet_size)
+        except (OSError, ValueError) as error:
+            reason = error.strerror if isinstance(error, OSError) and error.strerror else str(error)
+            raise InputError(Problem(f"--transport={self.kind}", f"cannot open the transport: {reason}")) from None
 
     def arguments(self, ids: Sequence[str]) -> list[str]:
         """The ``mrmp agent`` arguments that select this transport with these options."""

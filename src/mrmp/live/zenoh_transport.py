@@ -89,6 +89,7 @@ import threading
 import time
 from collections import deque
 from collections.abc import Sequence
+from dataclasses import dataclass
 from typing import TYPE_CHECKING, Any, Self
 
 if TYPE_CHECKING:  # pragma: no cover - typing only
@@ -110,6 +111,94 @@ SCOUTING_DELAY_MS = 100
 """How long opening a session waits for the connections to peers, at most (see the module docstring)."""
 
 _FORBIDDEN_IN_KEYS = set("*$?#")
+
+
+ENDPOINT_FORM = "<protocol>/<address>[?<metadata>][#<config>]"
+"""Zenoh's form of an endpoint (the message of its own parser)."""
+
+IP_PROTOCOLS = ("tcp", "udp")
+"""The Zenoh protocols whose address is ``HOST:PORT`` on an IP network, which the no-key check can read."""
+
+
+@dataclass(frozen=True)
+class ZenohEndpoint:
+    """A Zenoh endpoint split as Zenoh itself splits it: ``<protocol>/<address>[?<metadata>][#<config>]``.
+
+    The grammar is Zenoh's (``commons/zenoh-protocol/src/core/endpoint.rs``,
+    functions ``protocol``, ``address``, ``metadata``, ``config`` and
+    ``EndPoint::try_from``): the protocol ends at the first ``/``; the address
+    runs from there to the first ``?`` or ``#``; the metadata from ``?`` to
+    ``#``; the configuration after ``#``. So ``tcp/0.0.0.0:7447?x=/`` has the
+    address ``0.0.0.0:7447``, whatever its metadata holds.
+
+    >>> ZenohEndpoint.parse("tcp/0.0.0.0:17450?x=/")
+    ZenohEndpoint(protocol='tcp', address='0.0.0.0:17450', metadata='x=/', config='')
+    >>> ZenohEndpoint.parse("tcp/0.0.0.0:17450#a/b").address, ZenohEndpoint.parse("tcp/[::1]:7447").host
+    ('0.0.0.0:17450', '::1')
+    >>> ZenohEndpoint.parse("tcp127.0.0.1:7447")
+    Traceback (most recent call last):
+    ...
+    ValueError: expected a Zenoh endpoint <protocol>/<address>[?<metadata>][#<config>], got 'tcp127.0.0.1:7447'
+    """
+
+    protocol: str
+    address: str
+    metadata: str = ""
+    config: str = ""
+
+    @classmethod
+    def parse(cls, text: str) -> ZenohEndpoint:
+        """Split ``text`` by Zenoh's grammar.
+
+        Raises
+        ------
+        ValueError
+            Where Zenoh's own parser refuses the text: no ``/`` with a protocol
+            before it and something after it; an empty ``?`` metadata or ``#``
+            configuration, or one before the ``/`` (or ``#`` before ``?``).
+        """
+        wrong = ValueError(f"expected a Zenoh endpoint {ENDPOINT_FORM}, got {text!r}")
+        slash = text.find("/")
+        if slash <= 0 or slash == len(text) - 1:
+            raise wrong
+        question, hash_sign = text.find("?"), text.find("#")
+        end_of_address = min(index for index in (question, hash_sign, len(text)) if index >= 0)
+        metadata = config = ""
+        if question >= 0:
+            metadata = text[question + 1 : hash_sign if hash_sign >= 0 else len(text)]
+            if question < slash or not metadata or 0 <= hash_sign < question:
+                raise wrong
+        if hash_sign >= 0:
+            config = text[hash_sign + 1 :]
+            if hash_sign < slash or not config:
+                raise wrong
+        return cls(text[:slash], text[slash + 1 : end_of_address], metadata, config)
+
+    @property
+    def host(self) -> str | None:
+        """The host of an IP endpoint (:data:`IP_PROTOCOLS`, address ``HOST:PORT``), brackets removed; else None.
+
+        >>> ZenohEndpoint("tcp", "127.0.0.1:7447").host, ZenohEndpoint("unixsock-stream", "/tmp/s").host
+        ('127.0.0.1', None)
+        """
+        host, separator, port = self.address.rpartition(":")
+        if self.protocol not in IP_PROTOCOLS or not separator or not port.isdigit():
+            return None
+        return host.removeprefix("[").removesuffix("]")
+
+    def sole_host(self) -> str | None:
+        """The host, when it is all this endpoint reaches: an IP endpoint with no metadata and no configuration.
+
+        Zenoh's ``#config`` can choose the interface or the source address of a
+        link, so an endpoint with one (or with metadata) is not known to stay
+        on its host; None then.
+
+        >>> ZenohEndpoint.parse("tcp/127.0.0.1:7447").sole_host()
+        '127.0.0.1'
+        >>> ZenohEndpoint.parse("tcp/127.0.0.1:7447#iface=eth0").sole_host() is None
+        True
+        """
+        return self.host if not self.metadata and not self.config else None
 
 
 def fleet_keys(fleet: str, index: int) -> dict[str, str]:

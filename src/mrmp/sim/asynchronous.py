@@ -40,6 +40,7 @@ from collections import Counter
 
 from mrmp.core.cell import Cell
 from mrmp.core.heading import Heading, right_turns
+from mrmp.core.limits import MAX_TICKS
 from mrmp.core.result import RobotResult, RunResult
 from mrmp.core.scenario import Scenario
 from mrmp.core.seeds import Stream, stream_random
@@ -121,11 +122,12 @@ class AsynchronousSimulator:
         self._goals = GoalBook(scenario.seed, grid.free_cells() if scenario.lifelong else [])
 
     def default_max_ticks(self) -> int:
-        """Room for the slowest robot's moves and the lock conversations of a crowd over the scenario's network."""
+        """Room for the slowest robot's moves and the lock conversations of a crowd over the scenario's network
+        (never more than :data:`~mrmp.core.limits.MAX_TICKS`)."""
         worst = self.scenario.worst_faults()
         longest = max(self.lengths, default=0)
         slowdown = (1 + worst.delay_max) / max(0.05, 1 - worst.loss)
-        return int(200 + 20 * SLOWEST_PACE * (longest + 2 * len(self.robots)) * slowdown)
+        return min(int(200 + 20 * SLOWEST_PACE * (longest + 2 * len(self.robots)) * slowdown), MAX_TICKS)
 
     @property
     def all_arrived(self) -> bool:

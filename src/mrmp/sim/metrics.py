@@ -19,6 +19,7 @@ import math
 from collections.abc import Sequence
 
 from mrmp.core.grid import Grid
+from mrmp.core.limits import MAX_TICKS
 from mrmp.core.scenario import Scenario
 from mrmp.search.distance import distance_table
 
@@ -43,13 +44,14 @@ def default_max_ticks(scenario: Scenario, lengths: Sequence[int]) -> int:
     Four times the longest shortest path, plus two ticks per robot, and never
     fewer than 64; when the safety layer guards moves over a faulty network,
     times the ticks a claim's round trip can take (``2 * delay_max + 1``) and
-    the expected number of tries of a claim and its answer (``1 / (1 - loss)^2``).
+    the expected number of tries of a claim and its answer (``1 / (1 - loss)^2``);
+    never more than :data:`~mrmp.core.limits.MAX_TICKS`.
     """
     longest = max(lengths, default=0)
     ticks = max(64, 4 * longest + 2 * len(scenario.robots))
     if scenario.safety:
         ticks = int(ticks * network_slowdown(scenario))
-    return ticks
+    return min(ticks, MAX_TICKS)
 
 
 def network_slowdown(scenario: Scenario) -> float:

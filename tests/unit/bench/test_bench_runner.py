@@ -10,7 +10,7 @@ from pathlib import Path
 import pytest
 from typer.testing import CliRunner
 
-from mrmp.bench.runner import run_bench, run_isolated
+from mrmp.bench.runner import KILL_GRACE_S, run_bench, run_isolated
 from mrmp.cli import app
 from mrmp.experiments.bench_config import load_bench_config
 from mrmp.experiments.matrix import BenchRun
@@ -30,7 +30,7 @@ SCHEMA_KEYS = (
 
 def generated_run(policy="pibt", agents=4, **changes):
     spec = (("density", 0.1), ("height", 12), ("kind", "random"), ("seed", 0), ("width", 12))
-    return BenchRun("gen:random-12x12-p0.10-s0", agents, policy, generator=spec, instance=0, time_limit_s=20, **changes)
+    return BenchRun("gen:random-12x12-p0.10-s0", agents, policy, generator=spec, instance=0, **{"time_limit_s": 20, **changes})
 
 
 def den520d_run(policy, agents, time_limit_s):
@@ -139,6 +139,21 @@ def test_a_planner_that_stops_at_its_limit_is_a_timeout():
     record = run_isolated(den520d_run("cbs", 60, time_limit_s=0.2))
     assert record["status"] == "timeout" and "cbs" in record["error"]
     assert record["sum_of_costs"] is None
+
+
+def test_the_time_limit_counts_from_the_runs_readiness_not_its_start_up(tmp_path, monkeypatch):
+    # every Python started from here first sleeps longer than the run's limit and grace: a slow start-up
+    (tmp_path / "sitecustomize.py").write_text(f"import time\ntime.sleep({0.5 + KILL_GRACE_S + 1.0})\n")
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")]))
+    record = run_isolated(generated_run("pp", 3, time_limit_s=0.5))
+    assert record["status"] == "done", record["error"]
+
+
+def test_a_run_whose_process_dies_before_it_is_ready_is_an_error(tmp_path, monkeypatch):
+    (tmp_path / "sitecustomize.py").write_text("raise SystemExit('no interpreter today')\n")
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join([str(tmp_path), os.environ.get("PYTHONPATH", "")]))
+    record = run_isolated(generated_run("pp", 3))
+    assert record["status"] == "error" and record["error"].endswith(": no interpreter today")
 
 
 def test_a_run_that_fails_is_an_error_with_one_line():

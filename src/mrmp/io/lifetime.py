@@ -1,0 +1,104 @@
+"""Processes that end with their parent, whatever kills it.
+
+mrmp starts processes of its own: ``mrmp run --live`` a referee and one
+process per robot, ``mrmp bench`` worker processes, which start one process
+per run. None of them may go on once the process that started it is gone,
+even when that one is killed with SIGKILL and can clean nothing up. Two
+mechanisms make sure of it on Linux:
+
+* the **parent-death signal** (``prctl(PR_SET_PDEATHSIG)``, prctl(2)): the
+  kernel sends it to the child when its parent ends. :func:`preexec_dying_with`
+  sets it in the forked child *before* the child executes anything, then checks
+  that the parent is still the process that forked it: a parent that died in
+  between sends no signal, so the child exits at once;
+* a **watch on the parent** (:func:`watch_parent`): a daemon thread waits on a
+  pidfd of the parent (pidfd_open(2): readable once the process has ended) and
+  then calls back, so that a process that handles the signal, or started before
+  it could be set (a pool's worker), still notices that its parent is gone.
+
+Examples
+--------
+>>> import subprocess, sys
+>>> subprocess.run([sys.executable, "-c", "print('bound')"], preexec_fn=preexec_dying_with(),
+...                capture_output=True, text=True).stdout
+'bound\\n'
+"""
+
+from __future__ import annotations
+
+import ctypes
+import os
+import select
+import signal
+import sys
+import threading
+import time
+from collections.abc import Callable
+
+_PR_SET_PDEATHSIG = 1
+"""prctl(2)'s option number for the parent-death signal (``<linux/prctl.h>``)."""
+
+_PRCTL = ctypes.CDLL(None, use_errno=True).prctl if sys.platform.startswith("linux") else None
+"""The C library's ``prctl``, looked up before any fork, so that a forked child calls it without loading anything."""
+
+
+def die_with_parent(signum: int = signal.SIGTERM) -> bool:
+    """Ask the kernel to send ``signum`` to this process when its parent ends; whether it could (Linux only).
+
+    >>> die_with_parent() == sys.platform.startswith("linux")
+    True
+    """
+    if _PRCTL is None:
+        return False
+    return int(_PRCTL(_PR_SET_PDEATHSIG, int(signum), 0, 0, 0)) == 0
+
+
+def preexec_dying_with(signum: int = signal.SIGTERM, parent: int | None = None) -> Callable[[], None]:
+    """A ``preexec_fn`` for :class:`subprocess.Popen`: the child gets ``signum`` when ``parent`` (default: this process) ends.
+
+    The function runs in the forked child before the new program: it sets the
+    parent-death signal, then exits the child at once (status 1) if the parent
+    is already gone, since no signal would ever come then.
+    """
+    expected = os.getpid() if parent is None else parent
+
+    def bind_to_parent() -> None:
+        die_with_parent(signum)
+        if os.getppid() != expected:
+            os._exit(1)
+
+    return bind_to_parent
+
+
+def watch_parent(on_gone: Callable[[], None], parent: int | None = None, period: float = 0.1) -> threading.Thread:
+    """Call ``on_gone`` once, from a daemon thread, as soon as the process ``parent`` (default: this one's parent) ends.
+
+    It waits on a pidfd of ``parent`` where Linux has one (no polling; a parent
+    that ended but was not reaped yet counts as ended); otherwise it checks
+    every ``period`` seconds whether this process still has ``parent`` as its
+    parent. A parent already gone calls back at once.
+    """
+    watched = os.getppid() if parent is None else parent
+
+    def watch() -> None:
+        try:
+            descriptor = os.pidfd_open(watched)
+        except ProcessLookupError:
+            on_gone()
+            return
+        except (AttributeError, OSError):
+            while os.getppid() == watched:
+                time.sleep(period)
+            on_gone()
+            return
+        try:
+            waiting = select.poll()
+            waiting.register(descriptor, select.POLLIN)
+            waiting.poll()
+        finally:
+            os.close(descriptor)
+        on_gone()
+
+    thread = threading.Thread(target=watch, name="watch-parent", daemon=True)
+    thread.start()
+    return thread

@@ -1,0 +1,81 @@
+"""Processes that end with their parent: the parent-death signal and the watch, each with a real ``kill -9``."""
+
+import os
+import signal
+import subprocess
+import sys
+import textwrap
+import time
+from pathlib import Path
+
+from mrmp.io.lifetime import preexec_dying_with
+
+PATIENCE = 60.0
+"""Seconds a test waits at most for a process to end (a bound on a hang only; it goes on as soon as it has)."""
+
+
+def ended(pid):
+    """Whether process ``pid`` is gone (or a zombie nobody reaped: it runs nothing any more)."""
+    try:
+        state = Path(f"/proc/{pid}/stat").read_text().rsplit(")", 1)[1].split()[0]
+    except (FileNotFoundError, ProcessLookupError):
+        return True
+    return state in ("Z", "X")
+
+
+def wait_until_ended(pids):
+    deadline = time.monotonic() + PATIENCE
+    while not all(ended(pid) for pid in pids) and time.monotonic() < deadline:
+        time.sleep(0.02)
+    return [pid for pid in pids if not ended(pid)]
+
+
+def parent_with_a_child(child_code, tmp_path):
+    """A Python process that starts ``python -c child_code`` bound to it, prints the child's pid, and waits for ever."""
+    parent_code = textwrap.dedent(f"""
+        import subprocess, sys, time
+        from mrmp.io.lifetime import preexec_dying_with
+        child = subprocess.Popen([sys.executable, "-c", {child_code!r}], preexec_fn=preexec_dying_with(),
+                                 cwd={str(tmp_path)!r})
+        print(child.pid, flush=True)
+        time.sleep(3600)
+    """)
+    parent = subprocess.Popen([sys.executable, "-c", parent_code], stdout=subprocess.PIPE, text=True)
+    return parent, int(parent.stdout.readline())
+
+
+def test_a_child_gets_the_parent_death_signal_when_its_parent_is_killed(tmp_path):
+    parent, child = parent_with_a_child("import time; time.sleep(3600)", tmp_path)
+    assert not ended(child)
+    os.kill(parent.pid, signal.SIGKILL)
+    parent.wait()
+    assert wait_until_ended([child]) == []
+
+
+def test_a_child_whose_parent_died_before_it_started_exits_at_once():
+    someone_else = os.getppid()  # not this process: as if the parent had died and the child been adopted
+    completed = subprocess.run(["sleep", "3600"], preexec_fn=preexec_dying_with(parent=someone_else), timeout=PATIENCE)
+    assert completed.returncode == 1
+
+
+def test_a_child_that_ignores_the_signal_still_notices_that_its_parent_is_gone(tmp_path):
+    watcher = textwrap.dedent("""
+        import os, signal, threading, time
+        from pathlib import Path
+        from mrmp.io.lifetime import watch_parent
+        signal.signal(signal.SIGTERM, signal.SIG_IGN)  # only the watch can end this process
+        gone = threading.Event()
+        watch_parent(gone.set)
+        Path("watching").touch()
+        gone.wait()
+        Path("noticed").touch()
+    """)
+    parent, child = parent_with_a_child(watcher, tmp_path)
+    deadline = time.monotonic() + PATIENCE
+    while not (tmp_path / "watching").exists() and time.monotonic() < deadline:
+        time.sleep(0.02)
+    assert not (tmp_path / "noticed").exists()
+    os.kill(parent.pid, signal.SIGKILL)
+    parent.wait()
+    assert wait_until_ended([child]) == []
+    assert (tmp_path / "noticed").exists()
