@@ -33,7 +33,7 @@ from dataclasses import dataclass
 
 from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
-from mrmp.core.options import RESOLUTIONS
+from mrmp.core.options import POLICY_DEFAULT_SEARCH, RESOLUTIONS
 from mrmp.core.scenario import PolicyOptions, RobotSpec, Scenario
 from mrmp.sim.simulator import simulate
 
@@ -75,14 +75,19 @@ def trade_places_pairs(grid: Grid) -> list[tuple[Cell, Cell]]:
     return list(itertools.combinations(cells, 2))
 
 
-def trade_places_scenario(grid: Grid, first: Cell, second: Cell, resolve: str, guarded: bool) -> Scenario:
-    """Robot A from ``first`` to ``second``, robot B back, both facing NORTH, under the thesis's rule."""
+def trade_places_scenario(
+    grid: Grid, first: Cell, second: Cell, resolve: str, guarded: bool, search: str = POLICY_DEFAULT_SEARCH
+) -> Scenario:
+    """Robot A from ``first`` to ``second``, robot B back, both facing NORTH, under the thesis's rule.
+
+    ``search`` gives Next (``policy.search``; by default the update coordinate method).
+    """
     robots = (RobotSpec("A", first, second), RobotSpec("B", second, first))
     return Scenario(
         grid,
         robots,
         name=f"trade {first} {second}",
-        policy=PolicyOptions(name="thesis", resolve=resolve),
+        policy=PolicyOptions(name="thesis", resolve=resolve, search=search),
         max_ticks=TICK_LIMIT,
         safety=guarded,
     )
@@ -96,19 +101,22 @@ def outcome(scenario: Scenario) -> str:
     return "success" if result.success else result.stop_reason
 
 
-def outcome_table(grid: Grid | None = None) -> dict[Column, Counter[str]]:
+def outcome_table(grid: Grid | None = None, search: str = POLICY_DEFAULT_SEARCH) -> dict[Column, Counter[str]]:
     """The outcomes of every trade-places pair of ``grid`` (5x5 when omitted), per column of :data:`COLUMNS`."""
     grid = grid or Grid(5, 5)
     pairs = trade_places_pairs(grid)
     table: dict[Column, Counter[str]] = {}
     for column in COLUMNS:
         table[column] = Counter(
-            outcome(trade_places_scenario(grid, first, second, column.resolve, column.guarded)) for first, second in pairs
+            outcome(trade_places_scenario(grid, first, second, column.resolve, column.guarded, search))
+            for first, second in pairs
         )
     return table
 
 
-def failing_pairs(grid: Grid, column: Column) -> dict[str, list[tuple[Cell, Cell]]]:
+def failing_pairs(
+    grid: Grid, column: Column, search: str = POLICY_DEFAULT_SEARCH
+) -> dict[str, list[tuple[Cell, Cell]]]:
     """The pairs of ``grid`` that do not succeed in ``column``, by outcome.
 
     >>> failing_pairs(Grid(1, 2), Column("divert", guarded=False))
@@ -116,7 +124,7 @@ def failing_pairs(grid: Grid, column: Column) -> dict[str, list[tuple[Cell, Cell
     """
     failures: dict[str, list[tuple[Cell, Cell]]] = {}
     for first, second in trade_places_pairs(grid):
-        result = outcome(trade_places_scenario(grid, first, second, column.resolve, column.guarded))
+        result = outcome(trade_places_scenario(grid, first, second, column.resolve, column.guarded, search))
         if result != "success":
             failures.setdefault(result, []).append((first, second))
     return failures
