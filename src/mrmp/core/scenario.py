@@ -122,10 +122,10 @@ class PolicyOptions:
 
     name: str = "thesis"
     resolve: str = resolve_setting()
-    search: str = search_setting()
     heading_aware: bool = heading_aware_setting()
     radius: int = radius_setting()
     swap: bool = swap_setting()
+    search: str = search_setting()
 
     def __post_init__(self) -> None:
         check_settings(self)

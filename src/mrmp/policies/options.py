@@ -9,7 +9,7 @@ Examples
 --------
 >>> from mrmp.core.scenario import PolicyOptions
 >>> options_from(AstarOptions, PolicyOptions(name="astar", resolve="wait", radius=3))
-AstarOptions(resolve='wait', search='default', heading_aware=False)
+AstarOptions(resolve='wait', heading_aware=False, search='default')
 >>> ThesisOptions(resolve="wiat")
 Traceback (most recent call last):
 ...
@@ -51,8 +51,8 @@ class AstarOptions:
     """Reactive A* (:class:`~mrmp.policies.astar.AstarPolicy`): conflict resolution, the search, whether turns cost time."""
 
     resolve: str = resolve_setting()
-    search: str = search_setting()
     heading_aware: bool = heading_aware_setting()
+    search: str = search_setting()
 
     def __post_init__(self) -> None:
         check_settings(self)
