@@ -144,9 +144,9 @@ def with_policy_flags(command: Callable[..., None]) -> Callable[..., None]:
     >>> def show(policy_settings: dict[str, Any]) -> None:
     ...     print(policy_settings)
     >>> list(inspect.signature(with_policy_flags(show)).parameters)
-    ['resolve', 'heading_aware', 'radius', 'swap']
+    ['resolve', 'heading_aware', 'radius', 'swap', 'search']
     >>> with_policy_flags(show)(radius=3)
-    {'resolve': None, 'heading_aware': None, 'radius': 3, 'swap': None}
+    {'resolve': None, 'heading_aware': None, 'radius': 3, 'swap': None, 'search': None}
     """
     types = setting_types(PolicyOptions)
     flags = [
@@ -442,7 +442,7 @@ def run(
 
 ) -> None:
     """Run a scenario (lockstep simulator, or --live processes) and report what happened."""
-    # --resolve, --heading-aware, --radius and --swap come from PolicyOptions' fields (with_policy_flags)
+    # --resolve, --heading-aware, --radius, --swap and --search come from PolicyOptions' fields (with_policy_flags)
     request = RunRequest(
         json_path, animate, show_messages, watch, watch_fps, planner, time_limit, live, transport, time_scale,
         delay_ms, jitter, miss_line, results, kill or [], unsafe,

@@ -40,6 +40,14 @@ RESOLUTIONS = ("divert", "wait")
 """How a lower-priority robot resolves a conflict: divert (prioritized technique,
 "change of route") or wait (velocity tuning), thesis section 2.1."""
 
+SEARCH_NAMES = ("update-coordinate", "dijkstra", "best-first", "astar")
+"""The single-robot searches a per-robot policy may plan with (the table of them:
+:data:`mrmp.search.choices.SEARCH_TABLE`): the thesis's update coordinate method
+(sections 3.1-3.2) and the three searches of its chapter 1 and future work 1."""
+
+POLICY_DEFAULT_SEARCH = "default"
+"""The ``search`` value that leaves each policy its own search (``thesis``: update-coordinate, ``astar``: A*)."""
+
 SETTING = "mrmp.setting"
 """The key of a field's :class:`Setting` in its dataclass metadata."""
 
@@ -96,8 +104,8 @@ def setting_types(options_type: type) -> dict[str, type]:
     """The Python type of each setting field of ``options_type``, by field name (annotations resolved).
 
     >>> from mrmp.core.scenario import PolicyOptions
-    >>> setting_types(PolicyOptions)
-    {'resolve': <class 'str'>, 'heading_aware': <class 'bool'>, 'radius': <class 'int'>, 'swap': <class 'bool'>}
+    >>> {name: kind.__name__ for name, kind in setting_types(PolicyOptions).items()}
+    {'resolve': 'str', 'heading_aware': 'bool', 'radius': 'int', 'swap': 'bool', 'search': 'str'}
     """
     hints = typing.get_type_hints(options_type)
     return {field.name: hints[field.name] for field, _ in settings(options_type)}
@@ -130,6 +138,11 @@ def _radius_in_bounds(value: int) -> str | None:
     return None if value <= MAX_RADIUS else f"must be at most {MAX_RADIUS} (cells), got {value}"
 
 
+def _one_of_searches(value: object) -> str | None:
+    choices = (POLICY_DEFAULT_SEARCH, *SEARCH_NAMES)
+    return None if value in choices else f"must be one of {', '.join(choices)}, got {value!r}"
+
+
 def resolve_setting() -> Any:
     """``resolve``: the thesis's two collision-avoidance techniques (section 2.1), ``divert`` or ``wait``."""
     return setting(
@@ -150,6 +163,28 @@ def radius_setting() -> Any:
     return setting(
         2, help=f"pibt: how far a robot's beacon reaches, in cells (2 to {MAX_RADIUS}).", yaml_key="radius",
         flag="--radius", check=_radius_in_bounds,
+    )
+
+
+def search_setting() -> Any:
+    """``search``: the single-robot search a per-robot policy plans with (``default``: the policy's own).
+
+    >>> from dataclasses import dataclass
+    >>> @dataclass(frozen=True)
+    ... class Example:
+    ...     search: str = search_setting()
+    ...     def __post_init__(self) -> None:
+    ...         check_settings(self)
+    >>> Example(search="bfs")
+    Traceback (most recent call last):
+    ...
+    mrmp.core.errors.InputError: policy.search: must be one of default, update-coordinate, dijkstra, best-first, astar, got 'bfs'
+    """
+    return setting(
+        POLICY_DEFAULT_SEARCH,
+        help=f"thesis, astar: the single-robot search, {'|'.join(SEARCH_NAMES)} "
+        f"({POLICY_DEFAULT_SEARCH}: update-coordinate for thesis, astar for astar).",
+        yaml_key="search", flag="--search", check=_one_of_searches,
     )
 
 

@@ -33,6 +33,7 @@ from mrmp.core.options import (
     heading_aware_setting,
     radius_setting,
     resolve_setting,
+    search_setting,
     swap_setting,
 )
 
@@ -104,7 +105,8 @@ class PolicyOptions:
     """A scenario's ``policy`` section: which decision rule robots run, and every policy setting.
 
     ``resolve`` chooses the thesis's two collision-avoidance techniques
-    (section 2.1); ``heading_aware`` makes planners charge turns (``pibt``:
+    (section 2.1); ``search`` the single-robot search of the per-robot
+    policies (``default``: each policy's own); ``heading_aware`` makes planners charge turns (``pibt``:
     prefer fewer turns among equally near cells). ``radius`` (cells,
     Manhattan, at least 2) is how far a ``pibt`` robot's beacon reaches;
     ``swap`` turns on ``pibt``'s swap technique. Each setting is declared by
@@ -124,6 +126,7 @@ class PolicyOptions:
     heading_aware: bool = heading_aware_setting()
     radius: int = radius_setting()
     swap: bool = swap_setting()
+    search: str = search_setting()
 
     def __post_init__(self) -> None:
         check_settings(self)

@@ -941,7 +941,7 @@ def _policy_text(policy: PolicyOptions) -> str:
     """The ``policy`` section's items: its name, then every setting by its YAML key.
 
     >>> _policy_text(PolicyOptions())
-    'name: "thesis", resolve: "divert", heading_aware: false, radius: 2, swap: true'
+    'name: "thesis", resolve: "divert", heading_aware: false, radius: 2, swap: true, search: "default"'
     """
     items = [f"name: {_quote(policy.name)}"]
     items += [f"{setting.yaml_key}: {_setting_text(getattr(policy, option.name))}" for option, setting in POLICY_SETTINGS]

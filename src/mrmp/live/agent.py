@@ -2,8 +2,9 @@
 
 As in the thesis (section 3.5), a *receiving thread* keeps reading the
 transport for the whole run (the thesis stops receiving at the destination, but
-a robot that arrived still occupies its cell, so it keeps answering), and the
-robot sends on every update of its state. The brain itself runs in the main
+a robot that arrived still occupies its cell, so it keeps answering), and a
+*client thread* (:class:`~mrmp.live.client_thread.ClientThread`) sends what the
+robot queues on every update of its state. The brain itself runs in the main
 thread only, fed with the messages the receiving thread queued and with the
 clock:
 

@@ -89,7 +89,7 @@ class SimulatedBody:
     grid:
         The map (entering a cell of cost c takes ``c * cell_time``).
     timing:
-        Seconds per cell and per right turn, at the robot's real speed.
+        Seconds per cell and per right turn (the scenario's timing; assumed, ``docs/thesis.md`` item 14).
     time_scale:
         Run this many times faster than the real robot.
     jitter:

@@ -1,14 +1,16 @@
-"""What every live robot driver shares: the receiving thread, sending, the fleet wait, the run loop, the report.
+"""What every live robot driver shares: the receiving and client threads, the fleet wait, the run loop, the report.
 
 A live driver runs one sans-IO robot brain in real time (thesis, section 3.5):
-a *receiving thread* keeps reading the transport for the whole run and queues
-what it opens, and the brain runs in the main thread only, fed with those
-messages and with the clock. :class:`LiveDriver` holds that machinery; a
+a *receiving thread* (the thesis's server) keeps reading the transport for the
+whole run and queues what it opens, a *client thread*
+(:class:`~mrmp.live.client_thread.ClientThread`, the thesis's client) sends
+every datagram the main loop queues, and the brain runs in the main thread
+only, fed with those messages and with the clock. :class:`LiveDriver` holds that machinery; a
 policy's driver (:class:`mrmp.live.agent.Agent`,
 :class:`mrmp.live.causal_agent.CausalAgent`) supplies its brain and its step.
 
-Every ``poll`` the loop hands the brain the queued messages (sending its
-answers), runs the policy's step, runs the brain's timers, and sends the state
+Every ``poll`` the loop hands the brain the queued messages (queueing its
+answers for the client thread), runs the policy's step, runs the brain's timers, and sends the state
 when nothing was sent for ``heartbeat`` seconds. Before its first step a robot
 waits (at most ``start_wait`` seconds) until it has heard from every peer, so
 that a fleet whose processes start one by one begins together; its clock starts
@@ -32,6 +34,7 @@ from mrmp.core.cell import Cell
 from mrmp.core.scenario import Scenario
 from mrmp.core.seeds import Stream, stream_random
 from mrmp.live.body import Body
+from mrmp.live.client_thread import ClientThread
 from mrmp.live.transport import FaultyTransport, Transport
 from mrmp.protocol.auth import Opener, Sealer
 from mrmp.protocol.messages import Message
@@ -159,6 +162,7 @@ class LiveDriver:
         self._receiving = threading.Event()
         self._lock = threading.Lock()
         self._peers = len(scenario.robots) - 1
+        self._client = ClientThread(transport, name=f"robot-{index}-client")
 
     # -- what a policy's driver supplies ----------------------------------------------------
 
@@ -237,17 +241,18 @@ class LiveDriver:
     # -- sending ---------------------------------------------------------------------------
 
     def _send(self, outgoing: list[Outgoing]) -> None:
-        report = self.report
+        """Seal each message and queue it for the client thread, counting it as sent."""
+        report, client = self.report, self._client
         for item in outgoing:
             data = self.sealer.seal(item.message)
             if item.recipients is None:
-                self.transport.send(data, None)
+                client.send(data, None)
                 report.messages_sent += self._peers
                 report.bytes_sent += len(data) * self._peers
                 report.datagrams_sent += 1
             else:
                 for recipient in item.recipients:
-                    self.transport.send(data, recipient)
+                    client.send(data, recipient)
                     report.messages_sent += 1
                     report.bytes_sent += len(data)
                     report.datagrams_sent += 1
@@ -261,6 +266,7 @@ class LiveDriver:
         self._receiving.set()
         receiver = threading.Thread(target=self._receive_loop, name=f"robot-{self.index}-server", daemon=True)
         receiver.start()
+        self._client.start()
         self._wait_for_fleet()
         started = clock()
         report.started_at = started
@@ -301,9 +307,12 @@ class LiveDriver:
             else:
                 report.stop_reason = "interrupted"
         finally:
-            self._receiving.clear()
-            receiver.join(timeout=1.0)
-            self._fill_report(clock())
+            try:
+                self._client.close()  # what is queued still goes out, while the receiving thread answers
+            finally:
+                self._receiving.clear()
+                receiver.join(timeout=1.0)
+                self._fill_report(clock())
         return report
 
     def _wait_for_fleet(self) -> None:

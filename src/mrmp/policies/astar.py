@@ -3,7 +3,10 @@
 This is the thesis's future work 1 and 2 (chapter 5): A* with costs for more
 complex environments, and more robots. Each robot plans an A* path (Hart,
 Nilsson & Raphael 1968) around static obstacles, optionally over headings so
-that turns cost time. It announces the next cell of its path, uses the thesis's
+that turns cost time; ``search`` replaces A* by another planner of
+:data:`mrmp.search.choices.SEARCH_TABLE` (Dijkstra, greedy best-first, or the
+thesis's update coordinate method, which never detours: a robot whose L is
+blocked stays). It announces the next cell of its path, uses the thesis's
 Obstacle Found test and priority (higher x, then higher y), and, when it is the
 lower-priority robot, either waits (``resolve="wait"``) or replans around the
 higher-priority robots in its way, treating their Present and Next cells as
@@ -26,6 +29,7 @@ from mrmp.core.errors import NoPathError
 from mrmp.core.scenario import Timing
 from mrmp.policies.base import Decision, Situation
 from mrmp.policies.priority import claimed_cells, conflicting_peers, outranks_all
+from mrmp.search.graph import Planner
 from mrmp.search.planners import astar
 
 
@@ -40,12 +44,23 @@ class AstarPolicy:
         Plan over (cell, heading) so that right turns cost ``timing.turn_time``.
     timing:
         The robot's timing, used when ``heading_aware``.
+    search:
+        The planner of its paths (:data:`mrmp.search.choices.SEARCH_TABLE`); A* when omitted.
     """
 
     name = "astar"
+    own_search = "astar"
+    """The search :data:`~mrmp.core.options.POLICY_DEFAULT_SEARCH` stands for."""
 
-    def __init__(self, resolve: str = "divert", heading_aware: bool = False, timing: Timing | None = None) -> None:
+    def __init__(
+        self,
+        resolve: str = "divert",
+        heading_aware: bool = False,
+        timing: Timing | None = None,
+        search: Planner = astar,
+    ) -> None:
         self.resolve = resolve
+        self.search = search
         self.heading_aware = heading_aware
         self.timing = timing or Timing()
         self._path: list[Cell] = []
@@ -54,7 +69,7 @@ class AstarPolicy:
     def _plan(self, situation: Situation, blocked: frozenset[Cell] = frozenset()) -> list[Cell] | None:
         heading = situation.heading if self.heading_aware else None
         try:
-            result = astar(
+            result = self.search(
                 situation.grid, situation.present, situation.goal, blocked=blocked, heading=heading, timing=self.timing
             )
         except NoPathError:

@@ -9,7 +9,7 @@ Examples
 --------
 >>> from mrmp.core.scenario import PolicyOptions
 >>> options_from(AstarOptions, PolicyOptions(name="astar", resolve="wait", radius=3))
-AstarOptions(resolve='wait', heading_aware=False)
+AstarOptions(resolve='wait', heading_aware=False, search='default')
 >>> ThesisOptions(resolve="wiat")
 Traceback (most recent call last):
 ...
@@ -22,7 +22,14 @@ import dataclasses
 from dataclasses import dataclass
 from typing import TypeVar
 
-from mrmp.core.options import check_settings, heading_aware_setting, radius_setting, resolve_setting, swap_setting
+from mrmp.core.options import (
+    check_settings,
+    heading_aware_setting,
+    radius_setting,
+    resolve_setting,
+    search_setting,
+    swap_setting,
+)
 from mrmp.core.scenario import PolicyOptions
 
 Options = TypeVar("Options")
@@ -30,9 +37,10 @@ Options = TypeVar("Options")
 
 @dataclass(frozen=True)
 class ThesisOptions:
-    """The thesis's rule (:class:`~mrmp.policies.thesis.ThesisPolicy`): how a conflict is resolved."""
+    """The thesis's rule (:class:`~mrmp.policies.thesis.ThesisPolicy`): how a conflict is resolved, and the search of Next."""
 
     resolve: str = resolve_setting()
+    search: str = search_setting()
 
     def __post_init__(self) -> None:
         check_settings(self)
@@ -40,10 +48,11 @@ class ThesisOptions:
 
 @dataclass(frozen=True)
 class AstarOptions:
-    """Reactive A* (:class:`~mrmp.policies.astar.AstarPolicy`): conflict resolution, and whether turns cost time."""
+    """Reactive A* (:class:`~mrmp.policies.astar.AstarPolicy`): conflict resolution, the search, whether turns cost time."""
 
     resolve: str = resolve_setting()
     heading_aware: bool = heading_aware_setting()
+    search: str = search_setting()
 
     def __post_init__(self) -> None:
         check_settings(self)

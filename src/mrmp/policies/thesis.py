@@ -11,7 +11,12 @@ thesis, University of Cincinnati, chapter 3:
   its route, the other continues;
 * section 3.6, *Change of Route*: the lower-priority robot sidesteps (below);
 * section 2.1, *velocity tuning*, the other technique the thesis names: with
-  ``resolve="wait"`` the lower-priority robot stops instead of diverting.
+  ``resolve="wait"`` the lower-priority robot stops instead of diverting;
+* future work 1, other searches for Next: with ``search`` one of the planners
+  of :data:`mrmp.search.choices.SEARCH_TABLE` (Dijkstra, greedy best-first,
+  A*), Next is the first step of that search's path from Present to the
+  destination around the static obstacles, planned afresh every step; the
+  rest of the rule is unchanged.
 
 Choices where the pseudo-code is silent or ambiguous are listed in
 ``docs/thesis.md`` and tested; in short: "Update Y" on line 5 steps toward the
@@ -20,7 +25,11 @@ already equals the destination means +1 (as "NORTH = x update"); a diversion
 cell that is off the grid, a static obstacle, or another robot's Present or Next
 is not entered (the robot waits); a static obstacle on Next is an obstacle
 that never yields; and the rule is memoryless: every step starts again from
-the update-coordinate method at the current cell.
+the update-coordinate method at the current cell (or the chosen search). Where
+the search finds no path (the update-coordinate L crosses a static obstacle, or
+the destination is walled off) Next is the update-coordinate step, and the rule
+meets the obstacle at Next as section 3.6 does; so the default search, the
+update coordinate method, gives exactly the thesis's Next.
 
 Examples
 --------
@@ -35,8 +44,11 @@ Examples
 from __future__ import annotations
 
 from mrmp.core.cell import Cell, step_toward
+from mrmp.core.errors import NoPathError
 from mrmp.policies.base import Decision, Situation
 from mrmp.policies.priority import claimed_cells, conflicting_peers, outranks_all
+from mrmp.search.graph import Planner
+from mrmp.search.update_coordinate import update_coordinate_path
 
 
 def update_coordinate_step(present: Cell, goal: Cell) -> Cell:
@@ -76,18 +88,41 @@ class ThesisPolicy:
     ----------
     resolve:
         ``"divert"`` (the thesis's Change of Route) or ``"wait"`` (velocity tuning).
+    search:
+        The planner whose path gives Next (:data:`mrmp.search.choices.SEARCH_TABLE`);
+        the thesis's update coordinate method when omitted.
+
+    Examples
+    --------
+    >>> from mrmp.core.grid import Grid
+    >>> from mrmp.core.heading import Heading
+    >>> from mrmp.search.planners import astar
+    >>> grid = Grid.from_rows([".....", ".....", ".....", ".@...", "....."])   # an obstacle at (1, 1)
+    >>> here = Situation(0, (0, 1), Heading.NORTH, (4, 1), grid, {})
+    >>> ThesisPolicy().intend(here), ThesisPolicy(search=astar).intend(here)   # x first into it; A* around it
+    ((1, 1), (0, 2))
     """
 
     name = "thesis"
+    own_search = "update-coordinate"
+    """The search :data:`~mrmp.core.options.POLICY_DEFAULT_SEARCH` stands for."""
 
-    def __init__(self, resolve: str = "divert") -> None:
+    def __init__(self, resolve: str = "divert", search: Planner = update_coordinate_path) -> None:
         self.resolve = resolve
+        self.search = search
 
     def intend(self, situation: Situation) -> Cell:
-        """Next of the update coordinate method (or Present once arrived)."""
-        if situation.present == situation.goal:
-            return situation.present
-        return update_coordinate_step(situation.present, situation.goal)
+        """The first step of the search's path to the destination (or Present once arrived).
+
+        Without a path, the update coordinate method's step (module docstring).
+        """
+        present, goal = situation.present, situation.goal
+        if present == goal:
+            return present
+        try:
+            return self.search(situation.grid, present, goal).path[1]
+        except NoPathError:
+            return update_coordinate_step(present, goal)
 
     def decide(self, situation: Situation, intended: Cell) -> Decision:
         """Apply Obstacle Avoidance, Diversion and Change of Route to the intended Next."""

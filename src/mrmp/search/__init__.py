@@ -18,7 +18,9 @@ paths"). This layer provides them, all with one call shape
   the PIBTs and LaCAM index by, with one distance convention (:data:`UNREACHABLE`).
 
 :data:`PLANNERS` maps the names ``update_coordinate``, ``dijkstra``,
-``best_first`` and ``astar`` to the planners.
+``best_first`` and ``astar`` to the planners; :data:`mrmp.search.choices.SEARCH_TABLE`
+is the table of them a per-robot policy chooses from (``policy.search``, ``mrmp run
+--search``), with the names the setting accepts and each search's properties.
 
 Examples
 --------

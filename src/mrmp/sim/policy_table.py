@@ -50,6 +50,7 @@ from mrmp.policies.thesis import ThesisPolicy
 from mrmp.robot.causal_pibt import CausalRobot
 from mrmp.robot.pibt_robot import PibtRobot
 from mrmp.robot.robot import Robot
+from mrmp.search.choices import chosen_search
 from mrmp.sim.asynchronous import AsynchronousSimulator
 from mrmp.sim.rounds import RoundsSimulator
 from mrmp.sim.ticking import TickObserver
@@ -149,7 +150,9 @@ POLICY_TABLE: dict[str, PolicyEntry] = {
         "thesis",
         ThesisOptions,
         Robot,
-        decision_rule=lambda options, timing: ThesisPolicy(resolve=options.resolve),
+        decision_rule=lambda options, timing: ThesisPolicy(
+            resolve=options.resolve, search=chosen_search(options.search, ThesisPolicy.own_search).planner
+        ),
         live_driver="agent",
         records_messages=True,
     ),
@@ -158,7 +161,10 @@ POLICY_TABLE: dict[str, PolicyEntry] = {
         AstarOptions,
         Robot,
         decision_rule=lambda options, timing: AstarPolicy(
-            resolve=options.resolve, heading_aware=options.heading_aware, timing=timing
+            resolve=options.resolve,
+            heading_aware=options.heading_aware,
+            timing=timing,
+            search=chosen_search(options.search, AstarPolicy.own_search).planner,
         ),
         live_driver="agent",
         records_messages=True,
