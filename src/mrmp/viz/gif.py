@@ -58,6 +58,7 @@ from mrmp.viz.layout import (
     Layout,
     is_live,
     make_layout,
+    trim_idle,
 )
 from mrmp.viz.legend import AXIS_TEXT, GOAL_NEUTRAL, LEGEND_TEXT
 from mrmp.viz.raster import Style, check_frame_options, frames_of_run
@@ -137,6 +138,7 @@ def write_gif(
         If ``frames_per_tick``, ``fps``, ``max_frames`` or ``speed`` is not
         positive, or ``colour_by`` is unknown.
     """
+    result = trim_idle(result)
     if fps is None:
         fps = LIVE_FPS if is_live(result) else SIMULATED_FPS
     check_frame_options(frames_per_tick, fps, max_frames)
@@ -149,7 +151,7 @@ def write_gif(
     samples = sorted({0, len(times) // 3, (2 * len(times)) // 3, len(times) - 1})
     palette = _shared_palette([painter.frame(times[index]) for index in samples], painter.colours)
     frames = [painter.frame(t).quantize(palette=palette, dither=Image.Dither.NONE) for t in times]
-    step_ms = max(20, round(1000.0 * frame_seconds))
+    step_ms = max(20, 10 * round(100.0 * frame_seconds))  # GIF delays are whole hundredths of a second
     durations = [step_ms] * len(frames)
     durations[-1] = max(step_ms, round(hold_s * 1000.0))
     target = Path(path)

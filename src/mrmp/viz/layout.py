@@ -36,7 +36,7 @@ import colorsys
 import math
 from bisect import bisect_right
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import NamedTuple
 
 from mrmp.core.cell import Cell
@@ -475,7 +475,7 @@ def _heading_at(robot: RobotResult, tick: int) -> Heading:
     return Heading(robot.headings[min(max(tick, 0), len(robot.headings) - 1)])
 
 
-def track(robot: RobotResult, ticks: int) -> list[Keyframe]:
+def track(robot: RobotResult, ticks: int, move_ticks: int = 1) -> list[Keyframe]:
     """Keyframes of ``robot``'s motion over ticks ``0 .. ticks``.
 
     Between two ticks a robot that changes heading first turns right (as many
@@ -484,25 +484,102 @@ def track(robot: RobotResult, ticks: int) -> list[Keyframe]:
     nothing changes pace are dropped, so the list is short for robots that wait.
     The first keyframe is at ``t = 0`` and the last at ``t = ticks``.
 
+    ``move_ticks`` is how many ticks a move may take: a live run samples its
+    robots several times per cell (:func:`move_ticks_of`), and a move seen at
+    one sample goes on while the robot stays in the new cell, up to
+    ``move_ticks`` ticks, rather than jumping in one.
+
     >>> still = RobotResult("A", (1, 1), (1, 1), path=[(1, 1)] * 5)
     >>> track(still, 4)
     [Keyframe(t=0.0, x=1.0, y=1.0, angle=0.0), Keyframe(t=4.0, x=1.0, y=1.0, angle=0.0)]
+    >>> sampled = RobotResult("A", (0, 0), (1, 0), path=[(0, 0), (1, 0), (1, 0), (1, 0), (1, 0), (1, 0)])
+    >>> [(frame.t, frame.x) for frame in track(sampled, 5, move_ticks=4)]
+    [(0.0, 0.0), (4.0, 1.0), (5.0, 1.0)]
     """
     heading = _heading_at(robot, 0)
     angle = heading_angle(heading)
     here = cell_at(robot, 0)
     frames = [Keyframe(0.0, float(here[0]), float(here[1]), angle)]
-    for tick in range(ticks):
+    tick = 0
+    while tick < ticks:
         there = cell_at(robot, tick + 1)
         next_heading = _heading_at(robot, tick + 1)
+        span = 1
+        if there != here:
+            while (
+                span < move_ticks
+                and tick + span < ticks
+                and cell_at(robot, tick + span + 1) == there
+                and _heading_at(robot, tick + span + 1) == next_heading
+            ):
+                span += 1
         turns = right_turns(heading, next_heading)
         if turns:
             angle += 90.0 * turns
-            turn_end = tick + (TURN_SHARE if there != here else 1.0)
+            turn_end = tick + (TURN_SHARE * span if there != here else 1.0)
             frames.append(Keyframe(float(turn_end), float(here[0]), float(here[1]), angle))
-        frames.append(Keyframe(float(tick + 1), float(there[0]), float(there[1]), angle))
+        frames.append(Keyframe(float(tick + span), float(there[0]), float(there[1]), angle))
         here, heading = there, next_heading
+        tick += span
     return simplify(frames)
+
+
+LIVE_SAMPLES_PER_MOVE = 4
+"""Ground-truth samples of a live run per cell move: its ``tick_seconds`` is a quarter of a move's time
+(:mod:`mrmp.live.launcher`)."""
+
+
+def move_ticks_of(result: RunResult) -> int:
+    """How many ticks a move may take when drawn: :data:`LIVE_SAMPLES_PER_MOVE` for a live run, else 1.
+
+    >>> move_ticks_of(RunResult("s", "p", 0, [], [], "done", 0, 0, 0.0))
+    1
+    """
+    return LIVE_SAMPLES_PER_MOVE if is_live(result) else 1
+
+
+def trim_idle(result: RunResult) -> RunResult:
+    """A live run without its still lead-in and tail: from a tick before the first move to the last move's end.
+
+    A live run's ground truth starts when its processes start and ends after
+    the last one stops; the picture shows the motion, its clock counting from
+    the tick before the first move. A simulated run is returned as it is.
+
+    >>> from dataclasses import replace
+    >>> robot = RobotResult("A", (0, 0), (0, 1), path=[(0, 0)] * 5 + [(0, 1)] * 10)
+    >>> run = RunResult("s", "p", 0, [robot], [], "done", 14, 1, 0.0, mode="live", tick_seconds=0.05)
+    >>> trimmed = trim_idle(run)
+    >>> trimmed.robots[0].path[:2], run_ticks(trimmed)
+    ([(0, 0), (0, 1)], 5)
+    >>> simulated = replace(run, tick_seconds=None)
+    >>> trim_idle(simulated) is simulated
+    True
+    """
+    if not is_live(result) or not result.robots:
+        return result
+    changes = [
+        tick
+        for robot in result.robots
+        for tick in range(1, len(robot.path))
+        if robot.path[tick] != robot.path[tick - 1]
+    ]
+    if not changes:
+        return result
+    first = max(0, min(changes) - 1)
+    last = min(run_ticks(result), max(changes) + LIVE_SAMPLES_PER_MOVE)
+    robots = [
+        replace(
+            robot,
+            path=robot.path[first : last + 1],
+            headings=robot.headings[first : last + 1] if robot.headings else [],
+        )
+        for robot in result.robots
+    ]
+    collisions = [
+        replace(collision, tick=collision.tick - first) for collision in result.collisions if first <= collision.tick <= last
+    ]
+    log = result.message_log[first : last + 1] if result.message_log is not None else None
+    return replace(result, robots=robots, collisions=collisions, ticks=last - first, message_log=log)
 
 
 def simplify(frames: Sequence[Keyframe], fields: Sequence[str] = ("x", "y", "angle")) -> list[Keyframe]:

@@ -77,6 +77,7 @@ from mrmp.viz.layout import (
     message_label_place,
     message_width,
     mix,
+    move_ticks_of,
     pose_at,
     robot_colours,
     robot_label,
@@ -86,6 +87,7 @@ from mrmp.viz.layout import (
     run_verdict,
     text_colour_on,
     track,
+    trim_idle,
 )
 from mrmp.viz.legend import (
     AXIS_TEXT,
@@ -203,6 +205,7 @@ def frames_of_run(
     """
     style = style if style is not None else Style()
     check_speed(style.speed)
+    result = trim_idle(result)
     if is_live(result):
         times, seconds = live_frame_times(result, fps, style.speed, max_frames)
     else:
@@ -258,6 +261,7 @@ class FramePainter:
     ) -> None:
         style = style if style is not None else Style(show_messages=show_messages)
         self.style = style
+        result = trim_idle(result)
         self.colouring = check_colouring(style.colour_by, len(result.robots))
         if layout is None:
             layout = make_layout(grid, len(result.robots), colouring=self.colouring, goal_lines=style.goal_lines)
@@ -275,7 +279,7 @@ class FramePainter:
         self.changes = [
             colour_changes(robot, ticks, self.colouring, colour) for robot, colour in zip(result.robots, self.colours)
         ]
-        self.tracks: list[list[Keyframe]] = [track(robot, ticks) for robot in result.robots]
+        self.tracks: list[list[Keyframe]] = [track(robot, ticks, move_ticks_of(result)) for robot in result.robots]
         self.moves: list[list[tuple[int, Cell]]] = [_moves(robot, ticks) for robot in result.robots]
         self.title = run_caption(result)
         self.verdict, self.good = run_verdict(result)

@@ -93,6 +93,7 @@ from mrmp.viz.layout import (
     message_label_place,
     message_width,
     mix,
+    move_ticks_of,
     robot_colours,
     robot_label,
     run_caption,
@@ -103,6 +104,7 @@ from mrmp.viz.layout import (
     text_colour_on,
     text_width,
     track,
+    trim_idle,
 )
 from mrmp.viz.legend import (
     AXIS_TEXT,
@@ -219,6 +221,7 @@ class _Style:
 def _svg_root(grid: Grid, result: RunResult, style: _Style) -> ET.Element:
     """The animation's ``<svg>`` element, indented; checks the options."""
     check_speed(style.speed)
+    result = trim_idle(result)
     seconds_per_tick = style.seconds_per_tick
     if seconds_per_tick is None:
         seconds_per_tick = float(result.tick_seconds or 0.0) / style.speed if is_live(result) else DEFAULT_SECONDS_PER_TICK
@@ -265,7 +268,7 @@ class _SvgRun:
         self.duration = max(self.ticks * seconds_per_tick + style.hold_s, 0.1)
         self.dur = f"{self.duration:.3f}s"
         self.colours = robot_colours(len(result.robots))
-        self.tracks: list[list[Keyframe]] = [track(robot, self.ticks) for robot in result.robots]
+        self.tracks: list[list[Keyframe]] = [track(robot, self.ticks, move_ticks_of(result)) for robot in result.robots]
         self.changes = [
             colour_changes(robot, self.ticks, self.colouring, colour) for robot, colour in zip(result.robots, self.colours)
         ]
