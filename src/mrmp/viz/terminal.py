@@ -9,8 +9,8 @@ The grid is drawn north up and east to the right, two characters per cell
   every id is one character, else a letter or digit of its own
   (:func:`short_labels`), which the legend under the grid maps to the full
   ids (``A r0  B r1 ...``);
-* a robot's goal as the lower-case character of its robot and ``◦``, for
-  example ``a◦`` (dim, in the robot's colour);
+* a robot's goal as the character of its robot (lower case when that tells
+  robots apart still) and ``◦``, for example ``a◦`` (dim, in the robot's colour);
 * a robot's trail, the last :data:`TRAIL_CELLS` cells it left, as ``• `` in
   its colour.
 
@@ -67,23 +67,22 @@ TRAIL = "• "
 """A cell among the last :data:`TRAIL_CELLS` a robot left."""
 TRAIL_CELLS = 3
 """How many cells a robot's trail shows in the terminal view."""
-LABELS = "ABCDEFGHIJKLMNOPQRSTUVWXYZ0123456789"
-"""The characters given to robots whose ids are not one character each (then ``•`` past these)."""
-MANY = "•"
+LABELS = "ABCDEFGHIJKLMNOPQRSTUVWXYZabcdefghijklmnopqrstuvwxyz0123456789"
+"""The characters given to robots whose ids are not one character each (then :data:`MANY` past these)."""
+MANY = "+"
 """The character of robots past the :data:`LABELS` (the legend says how many)."""
 FREE_STYLE = "grey42"
 BLOCKED_STYLE = "grey62"
 RESERVED_LINES = 3
 """Terminal lines kept for the caption and the prompt."""
-LEGEND_LINES = 3
+LEGEND_LINES = 4
 """Most terminal lines the legend of labels may take."""
 
 
 def short_labels(ids: Sequence[str]) -> list[str]:
     """One character per robot: the ids themselves when each is one distinct character, else :data:`LABELS` in order.
 
-    Goals show the lower-case label, so labels are told apart without case;
-    robots past :data:`LABELS` share :data:`MANY`.
+    Robots past :data:`LABELS` share :data:`MANY`.
 
     >>> short_labels(["A", "B"]), short_labels(["r3", "r13", "r23"])
     (['A', 'B'], ['A', 'B', 'C'])
@@ -203,6 +202,7 @@ def render_grid(
         for cell in trail:
             trail_in[_block(grid, cell, k)] = trail_index
     marks = list(labels) if labels is not None else short_labels(ids)
+    lower = len({mark.lower() for mark in marks}) == len(marks)  # goals in lower case tell robots apart still
     text = Text(no_wrap=True, overflow="crop")
     for row in range(rows):
         if row:
@@ -219,7 +219,7 @@ def render_grid(
                 continue
             owner = goal_in.get((row, column))
             if owner is not None:
-                text.append(marks[owner].lower() + GOAL_MARK, style=f"dim {styles[owner]}")
+                text.append((marks[owner].lower() if lower else marks[owner]) + GOAL_MARK, style=f"dim {styles[owner]}")
                 continue
             walker = trail_in.get((row, column))
             blocked, total = _blocked_share(grid, row, column, k)
