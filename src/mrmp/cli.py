@@ -427,6 +427,7 @@ def run(
     json_path: Annotated[str | None, typer.Option("--json", help="Write the whole result as JSON (- for stdout).")] = None,
     animate: Annotated[Path | None, typer.Option(help="Write an animation: .gif, .svg or .mp4 (needs ffmpeg).")] = None,
     show_messages: Annotated[bool, typer.Option("--show-messages", help="Record each tick's messages and draw them in the --animate animation (and the --json result).")] = False,
+    goal_lines: Annotated[bool, typer.Option("--goal-lines", help="Draw a line from each robot to its goal in the --animate animation.")] = False,
     watch: Annotated[bool, typer.Option("--watch", help="Draw the grid in the terminal as the robots move.")] = False,
     watch_fps: Annotated[float, typer.Option(help="--watch: ticks drawn per second.")] = 10.0,
     planner: Annotated[str | None, typer.Option(help="Plan centrally first (cbs, pp, lacam), then execute the plan.")] = None,
@@ -445,7 +446,7 @@ def run(
     # --resolve, --heading-aware, --radius, --swap and --search come from PolicyOptions' fields (with_policy_flags)
     request = RunRequest(
         json_path, animate, show_messages, watch, watch_fps, planner, time_limit, live, transport, time_scale,
-        delay_ms, jitter, miss_line, results, kill or [], unsafe,
+        delay_ms, jitter, miss_line, results, kill or [], unsafe, goal_lines=goal_lines,
     )
     console = Console(stderr=json_path == "-", highlight=False)
     try:
@@ -493,6 +494,7 @@ class RunRequest:
     results: Path | None
     kill: list[str]
     unsafe: bool
+    goal_lines: bool = False
 
 
 def _validate_run(scenario: Scenario, request: RunRequest) -> None:
@@ -589,7 +591,9 @@ def _output_run(result: RunResult, scenario: Scenario, request: RunRequest, cons
         if request.animate is not None:
             from mrmp.viz import write_animation
 
-            write_animation(scenario.grid, result, request.animate, show_messages=request.show_messages)
+            write_animation(
+                scenario.grid, result, request.animate, show_messages=request.show_messages, goal_lines=request.goal_lines
+            )
             console.print(f"animation written to {request.animate}")
     except (MrmpError, OSError) as error:
         Console(stderr=True).print(f"error: {error}", markup=False)
@@ -692,6 +696,7 @@ def animate_command(
     result_path: Annotated[Path, typer.Argument(metavar="RESULT", help="A run saved with mrmp run --json (it holds the map).")],
     out: Annotated[Path, typer.Option("--out", help="The animation to write: .gif, .svg or .mp4 (needs ffmpeg).")],
     show_messages: Annotated[bool, typer.Option("--show-messages", help="Draw each tick's messages (runs saved with them).")] = False,
+    goal_lines: Annotated[bool, typer.Option("--goal-lines", help="Draw a line from each robot to its goal.")] = False,
 ) -> None:
     """Draw a saved run as an animation."""
     from mrmp.io.results import read_result_json
@@ -712,7 +717,7 @@ def animate_command(
     except InputError as error:
         raise _fail(error.problems) from None
     try:
-        write_animation(grid, result, out, show_messages=show_messages)
+        write_animation(grid, result, out, show_messages=show_messages, goal_lines=goal_lines)
     except (MrmpError, OSError) as error:
         Console(stderr=True).print(f"error: {error}", markup=False)
         raise typer.Exit(2) from None

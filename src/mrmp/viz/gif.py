@@ -28,7 +28,7 @@ Examples
 ...     written = write_gif(Grid(2, 2), run, pathlib.Path(folder) / "demo.gif", frames_per_tick=3)
 ...     with Image.open(written) as image:
 ...         print(image.n_frames, image.size)
-4 (300, 220)
+4 (340, 309)
 """
 
 from __future__ import annotations
@@ -42,6 +42,7 @@ from PIL import Image
 from mrmp.core.grid import Grid
 from mrmp.core.result import RunResult
 from mrmp.viz._atomic import replacing
+from mrmp.viz.colouring import HEADING_COLOURS, check_colouring, progress_ramp
 from mrmp.viz.layout import (
     BACKGROUND,
     COLLISION,
@@ -52,11 +53,15 @@ from mrmp.viz.layout import (
     OBSTACLE,
     OBSTACLE_EDGE,
     RGB,
+    ROBOT_EDGE,
     SUCCESS,
     Layout,
+    is_live,
     make_layout,
+    trim_idle,
 )
-from mrmp.viz.raster import check_frame_options, frames_of_run
+from mrmp.viz.legend import AXIS_TEXT, GOAL_NEUTRAL, LEGEND_TEXT
+from mrmp.viz.raster import Style, check_frame_options, frames_of_run
 
 PIXEL_BUDGET = 90_000_000
 """Frames times pixels per frame that a GIF may hold before frames are sampled."""
@@ -66,6 +71,10 @@ SIZE_LIMIT = 9_500_000
 """A GIF written past this size (with the default frame cap) is drawn again with fewer frames."""
 MIN_FRAMES = 40
 """The budgets never cut a run below this many frames."""
+SIMULATED_FPS = 10.0
+"""Frames per second of a simulated run's GIF."""
+LIVE_FPS = 25.0
+"""Frames per second of a live run's GIF, played at its real speed."""
 
 
 def write_gif(
@@ -74,10 +83,13 @@ def write_gif(
     path: str | os.PathLike[str],
     *,
     frames_per_tick: int = 4,
-    fps: float = 10.0,
+    fps: float | None = None,
     hold_s: float = 1.5,
     max_frames: int | None = None,
     show_messages: bool = False,
+    colour_by: str | None = None,
+    goal_lines: bool = False,
+    speed: float = 1.0,
 ) -> Path:
     """Draw ``result`` on ``grid`` as a looping animated GIF at ``path``.
 
@@ -90,9 +102,11 @@ def write_gif(
     path:
         Where to write the GIF.
     frames_per_tick:
-        Frames drawn per tick (1 shows only the ticks themselves).
+        Frames drawn per tick of a simulated run (1 shows only the ticks themselves).
     fps:
-        Frames per second while playing.
+        Frames per second while playing: by default 10 for a simulated run
+        and 25 for a live one, which plays at its real speed times ``speed``
+        (:func:`mrmp.viz.raster.live_frame_times`).
     hold_s:
         How long the last frame stays on screen before the loop restarts.
     max_frames:
@@ -103,6 +117,14 @@ def write_gif(
     show_messages:
         Draw each tick's messages as arrows from sender to recipient (runs
         with a message log; see :func:`mrmp.viz.layout.message_arrows`).
+    colour_by:
+        What a robot's colour says: ``"robot"``, ``"progress"`` or
+        ``"heading"`` (by default ``"robot"`` for a few robots, ``"progress"``
+        for a crowd; see :mod:`mrmp.viz.colouring`).
+    goal_lines:
+        Draw a line from each robot to its goal.
+    speed:
+        A live run plays at ``speed`` times its real speed.
 
     Returns
     -------
@@ -113,18 +135,23 @@ def write_gif(
     Raises
     ------
     ValueError
-        If ``frames_per_tick``, ``fps`` or ``max_frames`` is not positive.
+        If ``frames_per_tick``, ``fps``, ``max_frames`` or ``speed`` is not
+        positive, or ``colour_by`` is unknown.
     """
+    result = trim_idle(result)
+    if fps is None:
+        fps = LIVE_FPS if is_live(result) else SIMULATED_FPS
     check_frame_options(frames_per_tick, fps, max_frames)
-    layout = make_layout(grid, len(result.robots))
+    style = Style(show_messages, check_colouring(colour_by, len(result.robots)), goal_lines, speed)
+    layout = make_layout(grid, len(result.robots), colouring=style.colour_by, goal_lines=goal_lines)
     max_frames_given = max_frames
     if max_frames is None:
         max_frames = _frame_cap(layout)
-    times, painter = frames_of_run(grid, result, layout, frames_per_tick, max_frames, show_messages)
+    times, frame_seconds, painter = frames_of_run(grid, result, layout, frames_per_tick, max_frames, style, fps)
     samples = sorted({0, len(times) // 3, (2 * len(times)) // 3, len(times) - 1})
     palette = _shared_palette([painter.frame(times[index]) for index in samples], painter.colours)
     frames = [painter.frame(t).quantize(palette=palette, dither=Image.Dither.NONE) for t in times]
-    step_ms = max(20, round(1000.0 / fps))
+    step_ms = max(20, 10 * round(100.0 * frame_seconds))  # GIF delays are whole hundredths of a second
     durations = [step_ms] * len(frames)
     durations[-1] = max(step_ms, round(hold_s * 1000.0))
     target = Path(path)
@@ -146,6 +173,9 @@ def write_gif(
             hold_s=hold_s,
             max_frames=fewer,
             show_messages=show_messages,
+            colour_by=colour_by,
+            goal_lines=goal_lines,
+            speed=speed,
         )
     return target
 
@@ -189,8 +219,14 @@ def _shared_palette(images: Sequence[Image.Image], colours: Sequence[RGB]) -> Im
         HEADER_DIM,
         COLLISION,
         SUCCESS,
+        ROBOT_EDGE,
+        GOAL_NEUTRAL,
+        AXIS_TEXT,
+        LEGEND_TEXT,
+        *progress_ramp(),
+        *HEADING_COLOURS.values(),
     ]
-    for colour in colours[:96]:
+    for colour in colours[:80]:
         if colour not in exact:
             exact.append(colour)
     sample = Image.new("RGB", (images[0].width, images[0].height * len(images)))

@@ -36,13 +36,14 @@ import colorsys
 import math
 from bisect import bisect_right
 from collections.abc import Sequence
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from typing import NamedTuple
 
 from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
 from mrmp.core.heading import Heading, right_turns
 from mrmp.core.result import RobotResult, RunResult
+from mrmp.viz.colouring import HEADING, PROGRESS, check_colouring
 
 RGB = tuple[int, int, int]
 """A colour as 0-255 red, green, blue."""
@@ -100,6 +101,10 @@ GOAL_INSET = 0.13
 """Gap between a goal square and its cell's edge, as a fraction of a cell."""
 GOAL_WIDTH = 0.075
 """Stroke of a goal square, as a fraction of a cell."""
+GOAL_LABEL_CELL = 40
+"""Goal squares in cells at least this many pixels wide carry their robot's id in a corner."""
+ROBOT_EDGE: RGB = (45, 50, 62)
+"""Outline and nose of robots whose colour changes (coloured by progress or heading)."""
 TURN_SHARE = 0.5
 """Fraction of a tick spent turning when a robot turns and moves in the same tick."""
 
@@ -124,6 +129,14 @@ class Layout:
     height: int
     header: int
     robots: int = 0
+    legend: int = 0
+    axis_left: int = 0
+    axis_bottom: int = 0
+
+    @property
+    def legend_top(self) -> int:
+        """Where the legend band begins (it runs to the bottom of the picture)."""
+        return self.height - self.legend
 
     @property
     def grid_width(self) -> int:
@@ -181,6 +194,9 @@ class Layout:
             self.height * factor,
             self.header * factor,
             self.robots,
+            self.legend * factor,
+            self.axis_left * factor,
+            self.axis_bottom * factor,
         )
 
     @property
@@ -203,31 +219,44 @@ class Layout:
 
     @property
     def font_size(self) -> int:
-        """Caption font size in pixels."""
-        return max(11, min(16, self.width // 28))
+        """Caption font size in pixels (the title's; the line under it is a little smaller)."""
+        return max(12, min(16, self.width // 28))
+
+    @property
+    def small_font(self) -> float:
+        """Font size of the legend and the axes' numbers, in pixels."""
+        return self.header * SMALL_FONT / HEADER_HEIGHT
 
 
 def make_layout(
     grid: Grid,
     robots: int = 0,
     *,
+    colouring: str | None = None,
+    goal_lines: bool = False,
     max_side: int = 720,
     max_cell: int = 72,
     min_cell: int = 2,
-    min_width: int = 300,
+    min_width: int = 340,
 ) -> Layout:
-    """Choose the cell size and margins for drawing ``grid``.
+    """Choose the cell size and margins for drawing ``grid``, with its axes and legend.
 
     The cell size is the largest that keeps the longer side of the grid within
-    ``max_side`` pixels, between ``min_cell`` and ``max_cell``. A narrow grid is
-    centred in a picture at least ``min_width`` wide so the caption fits.
+    ``max_side`` pixels, between ``min_cell`` and ``max_cell``. The grid has
+    the x numbers on its left and the y numbers under it; a narrow grid is
+    centred in a picture at least ``min_width`` wide. The caption band (two
+    lines) is at the top, the legend band (:func:`legend_slots` entries of
+    :data:`LEGEND_SLOT` pixels beside the compass) at the bottom.
 
     Parameters
     ----------
     grid:
         The grid to draw.
     robots:
-        Number of robots, which decides labels and trail styles.
+        Number of robots, which decides labels, trail styles and the legend.
+    colouring, goal_lines:
+        What robots' colours say (default: :func:`mrmp.viz.colouring.default_colouring`)
+        and whether lines join robots to their goals: both change the legend.
     max_side, max_cell, min_cell, min_width:
         Size limits in pixels.
 
@@ -236,18 +265,66 @@ def make_layout(
     >>> make_layout(Grid(32, 32)).cell, make_layout(Grid(64, 64)).cell
     (22, 11)
     >>> layout = make_layout(Grid(1, 2))
-    >>> layout.width >= 300 and layout.left > layout.cell // 2
+    >>> layout.width >= 340 and layout.left > layout.cell // 2
+    True
+    >>> layout = make_layout(Grid(5, 5), 2)
+    >>> layout.top + layout.grid_height + layout.axis_bottom <= layout.legend_top < layout.height
     True
     """
     cell = max(min_cell, min(max_cell, max_side // max(grid.x_size, grid.y_size)))
     margin = max(6, min(18, cell // 3))
-    header = 40
+    header = HEADER_HEIGHT
+    digits = len(str(max(grid.x_size - 1, 0)))
+    axis_left = round(SMALL_FONT * (0.62 * digits + 0.9))
+    axis_bottom = round(SMALL_FONT * 1.7)
+    right_margin = max(margin, round(SMALL_FONT * 2.4))  # room for the y axis's name
+    top_margin = max(margin, round(SMALL_FONT * 1.5))  # room for the x axis's name
     grid_width = grid.y_size * cell
-    width = max(grid_width + 2 * margin, min_width)
-    left = (width - grid_width) // 2
-    top = header + margin
-    height = top + grid.x_size * cell + margin
-    return Layout(grid.x_size, grid.y_size, cell, left, top, width, height, header, robots)
+    block = axis_left + grid_width + right_margin
+    width = max(block + 2 * margin, min_width)
+    left = (width - block) // 2 + axis_left
+    top = header + top_margin
+    slots = legend_slots(robots, check_colouring(colouring, robots), goal_lines)
+    columns = max(1, (width - 2 * LEGEND_PAD - COMPASS_WIDTH) // LEGEND_SLOT)
+    rows = max(2, -(-slots // columns))
+    legend = LEGEND_PAD + rows * LEGEND_ROW + LEGEND_PAD
+    height = top + grid.x_size * cell + axis_bottom + legend
+    return Layout(grid.x_size, grid.y_size, cell, left, top, width, height, header, robots, legend, axis_left, axis_bottom)
+
+
+HEADER_HEIGHT = 52
+"""Height of the caption band: the title, then the run's size, colouring and clock."""
+SMALL_FONT = 11
+"""Font size of the legend and the axes, in pixels, in a picture of :data:`HEADER_HEIGHT`."""
+LEGEND_SLOT = 150
+"""Width of one legend entry, in pixels."""
+LEGEND_ROW = 20
+"""Height of one row of legend entries, in pixels."""
+LEGEND_PAD = 8
+"""Space around the legend's entries, in pixels."""
+COMPASS_WIDTH = 78
+"""Width kept at the legend's right for the compass (N and E arrows, with x and y)."""
+LEGEND_ROBOTS = 10
+"""Runs of up to this many robots coloured by robot list each robot in the legend, with its start and goal."""
+
+
+def legend_slots(robots: int, colouring: str, goal_lines: bool) -> int:
+    """How many legend entries a run has (the progress ramp counts two).
+
+    Entries: each robot (coloured by robot, up to :data:`LEGEND_ROBOTS`) or
+    one entry saying what a robot is, or the ramp, or the four headings; then
+    the goal, the trail and, when drawn, the line to the goal.
+
+    >>> legend_slots(2, "robot", False), legend_slots(50, "progress", True), legend_slots(50, "heading", False)
+    (4, 5, 6)
+    """
+    if colouring == PROGRESS:
+        colours = 2
+    elif colouring == HEADING:
+        colours = 4
+    else:
+        colours = robots if 0 < robots <= LEGEND_ROBOTS else 1
+    return colours + 2 + (1 if goal_lines else 0)
 
 
 # -- colours --------------------------------------------------------------------------
@@ -398,7 +475,7 @@ def _heading_at(robot: RobotResult, tick: int) -> Heading:
     return Heading(robot.headings[min(max(tick, 0), len(robot.headings) - 1)])
 
 
-def track(robot: RobotResult, ticks: int) -> list[Keyframe]:
+def track(robot: RobotResult, ticks: int, move_ticks: int = 1) -> list[Keyframe]:
     """Keyframes of ``robot``'s motion over ticks ``0 .. ticks``.
 
     Between two ticks a robot that changes heading first turns right (as many
@@ -407,25 +484,102 @@ def track(robot: RobotResult, ticks: int) -> list[Keyframe]:
     nothing changes pace are dropped, so the list is short for robots that wait.
     The first keyframe is at ``t = 0`` and the last at ``t = ticks``.
 
+    ``move_ticks`` is how many ticks a move may take: a live run samples its
+    robots several times per cell (:func:`move_ticks_of`), and a move seen at
+    one sample goes on while the robot stays in the new cell, up to
+    ``move_ticks`` ticks, rather than jumping in one.
+
     >>> still = RobotResult("A", (1, 1), (1, 1), path=[(1, 1)] * 5)
     >>> track(still, 4)
     [Keyframe(t=0.0, x=1.0, y=1.0, angle=0.0), Keyframe(t=4.0, x=1.0, y=1.0, angle=0.0)]
+    >>> sampled = RobotResult("A", (0, 0), (1, 0), path=[(0, 0), (1, 0), (1, 0), (1, 0), (1, 0), (1, 0)])
+    >>> [(frame.t, frame.x) for frame in track(sampled, 5, move_ticks=4)]
+    [(0.0, 0.0), (4.0, 1.0), (5.0, 1.0)]
     """
     heading = _heading_at(robot, 0)
     angle = heading_angle(heading)
     here = cell_at(robot, 0)
     frames = [Keyframe(0.0, float(here[0]), float(here[1]), angle)]
-    for tick in range(ticks):
+    tick = 0
+    while tick < ticks:
         there = cell_at(robot, tick + 1)
         next_heading = _heading_at(robot, tick + 1)
+        span = 1
+        if there != here:
+            while (
+                span < move_ticks
+                and tick + span < ticks
+                and cell_at(robot, tick + span + 1) == there
+                and _heading_at(robot, tick + span + 1) == next_heading
+            ):
+                span += 1
         turns = right_turns(heading, next_heading)
         if turns:
             angle += 90.0 * turns
-            turn_end = tick + (TURN_SHARE if there != here else 1.0)
+            turn_end = tick + (TURN_SHARE * span if there != here else 1.0)
             frames.append(Keyframe(float(turn_end), float(here[0]), float(here[1]), angle))
-        frames.append(Keyframe(float(tick + 1), float(there[0]), float(there[1]), angle))
+        frames.append(Keyframe(float(tick + span), float(there[0]), float(there[1]), angle))
         here, heading = there, next_heading
+        tick += span
     return simplify(frames)
+
+
+LIVE_SAMPLES_PER_MOVE = 4
+"""Ground-truth samples of a live run per cell move: its ``tick_seconds`` is a quarter of a move's time
+(:mod:`mrmp.live.launcher`)."""
+
+
+def move_ticks_of(result: RunResult) -> int:
+    """How many ticks a move may take when drawn: :data:`LIVE_SAMPLES_PER_MOVE` for a live run, else 1.
+
+    >>> move_ticks_of(RunResult("s", "p", 0, [], [], "done", 0, 0, 0.0))
+    1
+    """
+    return LIVE_SAMPLES_PER_MOVE if is_live(result) else 1
+
+
+def trim_idle(result: RunResult) -> RunResult:
+    """A live run without its still lead-in and tail: from a tick before the first move to the last move's end.
+
+    A live run's ground truth starts when its processes start and ends after
+    the last one stops; the picture shows the motion, its clock counting from
+    the tick before the first move. A simulated run is returned as it is.
+
+    >>> from dataclasses import replace
+    >>> robot = RobotResult("A", (0, 0), (0, 1), path=[(0, 0)] * 5 + [(0, 1)] * 10)
+    >>> run = RunResult("s", "p", 0, [robot], [], "done", 14, 1, 0.0, mode="live", tick_seconds=0.05)
+    >>> trimmed = trim_idle(run)
+    >>> trimmed.robots[0].path[:2], run_ticks(trimmed)
+    ([(0, 0), (0, 1)], 5)
+    >>> simulated = replace(run, tick_seconds=None)
+    >>> trim_idle(simulated) is simulated
+    True
+    """
+    if not is_live(result) or not result.robots:
+        return result
+    changes = [
+        tick
+        for robot in result.robots
+        for tick in range(1, len(robot.path))
+        if robot.path[tick] != robot.path[tick - 1]
+    ]
+    if not changes:
+        return result
+    first = max(0, min(changes) - 1)
+    last = min(run_ticks(result), max(changes) + LIVE_SAMPLES_PER_MOVE)
+    robots = [
+        replace(
+            robot,
+            path=robot.path[first : last + 1],
+            headings=robot.headings[first : last + 1] if robot.headings else [],
+        )
+        for robot in result.robots
+    ]
+    collisions = [
+        replace(collision, tick=collision.tick - first) for collision in result.collisions if first <= collision.tick <= last
+    ]
+    log = result.message_log[first : last + 1] if result.message_log is not None else None
+    return replace(result, robots=robots, collisions=collisions, ticks=last - first, message_log=log)
 
 
 def simplify(frames: Sequence[Keyframe], fields: Sequence[str] = ("x", "y", "angle")) -> list[Keyframe]:
@@ -518,6 +672,27 @@ def label_size(label: str, cell: float) -> float:
     return min(0.24 * cell, fits)
 
 
+def goal_label_place(layout: Layout, goal: Cell) -> tuple[float, float]:
+    """Where a goal square's id is written: inside its top-left corner (the text's baseline start).
+
+    >>> layout = make_layout(Grid(5, 5))
+    >>> x, y = goal_label_place(layout, (4, 0))
+    >>> layout.left < x < layout.left + layout.cell / 3 and layout.top < y < layout.top + layout.cell / 3
+    True
+    """
+    left, top, _, _ = layout.cell_box(goal)
+    return (left + layout.cell * (GOAL_INSET + 0.05), top + layout.cell * (GOAL_INSET + 0.19))
+
+
+def text_width(text: str, font_size: float, bold: bool = False) -> float:
+    """Estimated width in pixels of ``text`` in DejaVu Sans (for SVG, whose text the browser measures).
+
+    >>> text_width("abcd", 10)
+    22.0
+    """
+    return (0.62 if bold else 0.55) * font_size * len(text)
+
+
 def shorten(text: str, room: float, font_size: float, bold: bool = False) -> str:
     """``text`` cut with an ellipsis to about ``room`` pixels, estimating DejaVu Sans widths.
 
@@ -543,6 +718,67 @@ def run_caption(result: RunResult) -> str:
     """
     parts = [part for part in (result.scenario, result.policy) if part]
     return " · ".join(parts) if parts else "mrmp run"
+
+
+def is_live(result: RunResult) -> bool:
+    """Whether ``result`` is a live run sampled every ``tick_seconds`` (its clock is shown in seconds).
+
+    >>> is_live(RunResult("s", "p", 0, [], [], "done", 0, 0, 0.0, mode="live", tick_seconds=0.05))
+    True
+    """
+    return result.tick_seconds is not None and result.tick_seconds > 0
+
+
+def clock_text(result: RunResult, tick: int) -> str:
+    """The clock shown at ``tick``: ``tick 3 / 7`` for a simulated run, ``0.15 s / 0.35 s`` for a live one.
+
+    >>> run = RunResult("s", "p", 0, [RobotResult("A", (0, 0), (0, 0), path=[(0, 0)] * 8)], [], "done", 7, 0, 0.0)
+    >>> clock_text(run, 3)
+    'tick 3 / 7'
+    >>> from dataclasses import replace
+    >>> clock_text(replace(run, mode="live", tick_seconds=0.05), 3)
+    '0.15 s / 0.35 s'
+    """
+    ticks = run_ticks(result)
+    if is_live(result):
+        seconds = float(result.tick_seconds or 0.0)
+        return f"{tick * seconds:.2f} s / {ticks * seconds:.2f} s"
+    return f"tick {tick} / {ticks}"
+
+
+def speed_text(speed: float) -> str:
+    """How fast a live run's animation plays: ``real time`` or, say, ``played at 0.5x``.
+
+    >>> speed_text(1.0), speed_text(0.25)
+    ('real time', 'played at 0.25x')
+    """
+    return "real time" if speed == 1.0 else f"played at {speed:g}x"
+
+
+def run_subtitle(result: RunResult, colouring_caption: str, speed: float = 1.0) -> str:
+    """The caption's second line: how many robots, what their colour says, and for a live run its speed.
+
+    >>> run_subtitle(RunResult("s", "p", 0, [], [], "done", 0, 0, 0.0), "colour: robot")
+    '0 robots · colour: robot'
+    """
+    count = len(result.robots)
+    parts = [f"{count} robot{'' if count == 1 else 's'}", colouring_caption]
+    if is_live(result):
+        parts.append(f"live, {speed_text(speed)}")
+    return " · ".join(parts)
+
+
+def check_speed(speed: float) -> float:
+    """Refuse a playing speed that is not positive.
+
+    >>> check_speed(0)
+    Traceback (most recent call last):
+    ...
+    ValueError: speed must be positive, got 0
+    """
+    if not speed > 0:
+        raise ValueError(f"speed must be positive, got {speed}")
+    return speed
 
 
 def run_verdict(result: RunResult) -> tuple[str, bool]:

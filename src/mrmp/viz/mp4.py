@@ -33,8 +33,9 @@ from mrmp.core.errors import MrmpError
 from mrmp.core.grid import Grid
 from mrmp.core.result import RunResult
 from mrmp.viz._atomic import replacing
+from mrmp.viz.colouring import check_colouring
 from mrmp.viz.layout import BACKGROUND, make_layout
-from mrmp.viz.raster import FramePainter, check_frame_options, frames_of_run
+from mrmp.viz.raster import FramePainter, Style, check_frame_options, frames_of_run
 
 PIXEL_BUDGET = 400_000_000
 """Frames times pixels per frame drawn for one video before frames are sampled (drawing time)."""
@@ -81,6 +82,9 @@ def write_mp4(
     hold_s: float = 1.5,
     max_frames: int | None = None,
     show_messages: bool = False,
+    colour_by: str | None = None,
+    goal_lines: bool = False,
+    speed: float = 1.0,
 ) -> Path:
     """Draw ``result`` on ``grid`` as an H.264 MP4 video at ``path``.
 
@@ -104,6 +108,10 @@ def write_mp4(
         gets fewer frames per tick, or frames spread evenly over it.
     show_messages:
         Draw each tick's messages as arrows from sender to recipient.
+    colour_by, goal_lines, speed:
+        As for :func:`mrmp.viz.gif.write_gif`: what robots' colours say,
+        lines to goals, and how fast a live run plays (its real speed times
+        ``speed``).
 
     Returns
     -------
@@ -126,14 +134,16 @@ def write_mp4(
     program = ffmpeg_path()
     if program is None:
         raise MissingProgram(f"cannot write '{os.fspath(path)}': {FFMPEG} is not installed (needed for .mp4)")
-    layout = make_layout(grid, len(result.robots))
+    style = Style(show_messages, check_colouring(colour_by, len(result.robots)), goal_lines, speed)
+    layout = make_layout(grid, len(result.robots), colouring=style.colour_by, goal_lines=goal_lines)
     if max_frames is None:
         max_frames = max(MIN_FRAMES, PIXEL_BUDGET // (layout.width * layout.height))
-    times, painter = frames_of_run(grid, result, layout, frames_per_tick, max_frames, show_messages)
+    times, frame_seconds, painter = frames_of_run(grid, result, layout, frames_per_tick, max_frames, style, fps)
+    rate = 1.0 / frame_seconds  # a live run capped to fewer frames plays them slower, at its real speed
     size = video_size(layout.width, layout.height)
     target = Path(path)
     with replacing(target) as temporary:
-        _encode(program, painter, times, size, fps, hold_frames(hold_s, fps), temporary)
+        _encode(program, painter, times, size, rate, hold_frames(hold_s, rate), temporary)
     return target
 
 

@@ -1,8 +1,11 @@
 """Plots of a benchmark, as PNG files: how each policy scales with the number of robots, and how it bears faults.
 
 For every map, :func:`write_report_plots` draws one figure of small
-multiples against N, the number of robots, one line per policy (and per fault
-setting when there are several, by line style):
+multiples against N, the number of robots: one row per figure below, one
+column per fault setting (so no two lines of a panel differ only by their
+faults), one line per policy, each policy with its own colour and marker and
+nudged sideways a little (:func:`dodge`), so that policies with the same value,
+say all at 100% or all at 0%, show side by side instead of hiding each other:
 
 * success rate (one-shot runs);
 * SoC/LB, mean over the successful runs;
@@ -35,6 +38,7 @@ True
 from __future__ import annotations
 
 import io
+import itertools
 import os
 import re
 import textwrap
@@ -57,11 +61,13 @@ DPI = 100
 PANEL_SIZE = (5.4, 3.4)
 """Width and height of one small multiple, in inches."""
 
-LINE_STYLES = ("-", "--", ":", "-.")
-"""Line style of each fault setting of a map, in order (none first)."""
+MARKERS = ("o", "s", "^", "D", "v", "P", "X", "*", "<", ">")
+"""Marker of each policy, in the order of :func:`_policy_colors`."""
 
-MARKERS = ("o", "s", "^", "D", "v", "P")
-"""Marker of each fault setting of a map, in order (none first)."""
+DODGE = 0.022
+"""Sideways nudge between two policies' points on a log axis of N, in decades."""
+LINEAR_DODGE = 0.06
+"""Sideways nudge between two policies' points on a linear axis of N, as a share of the smallest gap between two N."""
 
 
 @dataclass(frozen=True)
@@ -161,12 +167,80 @@ def _plain_log_y(axes: Axes) -> None:
     axes.yaxis.set_minor_formatter(NullFormatter())
 
 
-def _series_label(policy: str, faults: FaultSetting, several_settings: bool) -> str:
-    return f"{policy}, faults: {faults.label}" if several_settings else policy
+def dodge(agents: Sequence[int], order: int, count: int, log: bool) -> list[float]:
+    """The x positions of the ``order``-th of ``count`` policies at ``agents``: nudged apart around each N.
+
+    On a log axis the nudge is a factor (:data:`DODGE` decades per policy);
+    on a linear one a share (:data:`LINEAR_DODGE`) of the smallest gap between two values of N.
+
+    >>> [round(x, 2) for x in dodge([10, 100], 0, 3, log=True)]
+    [9.51, 95.06]
+    >>> dodge([10, 20], 2, 3, log=False)
+    [10.6, 20.6]
+    """
+    shift = order - (count - 1) / 2
+    if log:
+        return [agents_value * 10 ** (DODGE * shift) for agents_value in agents]
+    values = sorted(set(agents))
+    gap = min((b - a for a, b in itertools.pairwise(values)), default=1)
+    return [agents_value + shift * gap * LINEAR_DODGE for agents_value in agents]
+
+
+def _n_is_log(agents: Sequence[int]) -> bool:
+    values = sorted(set(agents))
+    return bool(values) and values[-1] >= 4 * values[0]
+
+
+def _draw_panel(
+    axes: Axes,
+    metric: _Metric,
+    chosen: Sequence[GroupSummary],
+    faults: FaultSetting,
+    colors: dict[str, Any],
+    handles: dict[str, Any],
+    *,
+    titled_faults: bool,
+    labelled: bool,
+) -> None:
+    """One small multiple: ``metric`` against N under ``faults``, a dodged line per policy (its handle kept in ``handles``)."""
+    policies = list(colors)
+    of_setting = [summary for summary in chosen if summary.key.faults == faults]
+    all_agents = [summary.key.agents for summary in chosen]
+    log_x = _n_is_log(all_agents)
+    series: dict[str, list[tuple[int, float]]] = {}
+    for summary in of_setting:
+        value = metric.value(summary)
+        if value is not None:
+            series.setdefault(summary.key.policy, []).append((summary.key.agents, value))
+    for policy, points in sorted(series.items(), key=lambda item: policies.index(item[0])):
+        points.sort()
+        order = policies.index(policy)
+        (line,) = axes.plot(
+            dodge([agents for agents, _ in points], order, len(policies), log_x),
+            [value for _, value in points],
+            marker=MARKERS[order % len(MARKERS)],
+            markersize=6.5,
+            markeredgecolor="white",
+            markeredgewidth=0.8,
+            linewidth=1.6,
+            color=colors[policy],
+            label=policy,
+        )
+        handles.setdefault(policy, line)
+    _style_n_axis(axes, all_agents)
+    title = f"{metric.title} · faults: {faults.label}" if titled_faults else metric.title
+    axes.set_title(title, fontsize=10.5)
+    if labelled:
+        axes.set_ylabel(metric.y_label)
+    axes.grid(True, which="major", alpha=0.3)
+    if metric.percent:
+        axes.set_ylim(-6, 106)
+    elif metric.log_y:
+        _plain_log_y(axes)
 
 
 def _draw_per_n(map_name: str, summaries: Sequence[GroupSummary], colors: dict[str, Any]) -> Figure | None:
-    """The small multiples of one map, or None when it has nothing to draw."""
+    """The small multiples of one map (metrics by rows, fault settings by columns), or None when it has nothing to draw."""
     panels = []
     for metric in METRICS:
         chosen = [summary for summary in summaries if summary.key.lifelong == metric.lifelong]
@@ -174,50 +248,41 @@ def _draw_per_n(map_name: str, summaries: Sequence[GroupSummary], colors: dict[s
             panels.append((metric, chosen))
     if not panels:
         return None
-    columns = 2 if len(panels) > 1 else 1
-    rows = (len(panels) + columns - 1) // columns
-    figure = _new_figure(PANEL_SIZE[0] * columns, PANEL_SIZE[1] * rows + 0.9)
     settings = sorted({summary.key.faults for summary in summaries})
-    several = len(settings) > 1
+    policies = list(colors)
+    if len(settings) == 1:  # metrics two by two
+        columns, rows = (2 if len(panels) > 1 else 1), (len(panels) + 1) // 2
+        places = [(metric, chosen, settings[0], index // 2, index % 2) for index, (metric, chosen) in enumerate(panels)]
+    else:  # a row per metric, a column per fault setting
+        columns, rows = len(settings), len(panels)
+        places = [
+            (metric, chosen, faults, row, column)
+            for row, (metric, chosen) in enumerate(panels)
+            for column, faults in enumerate(settings)
+        ]
+    figure = _new_figure(PANEL_SIZE[0] * columns, PANEL_SIZE[1] * rows + 0.9)
     figure.suptitle(f"{map_name}: scaling with the number of robots", fontsize=13, fontweight="bold")
     handles: dict[str, Any] = {}
-    for index, (metric, chosen) in enumerate(panels):
-        axes = figure.add_subplot(rows, columns, index + 1)
-        series: dict[tuple[str, FaultSetting], list[tuple[int, float]]] = {}
-        for summary in chosen:
-            value = metric.value(summary)
-            if value is not None:
-                series.setdefault((summary.key.policy, summary.key.faults), []).append((summary.key.agents, value))
-        for order, ((policy, faults), points) in enumerate(sorted(series.items())):
-            points.sort()
-            label = _series_label(policy, faults, several)
-            (line,) = axes.plot(
-                [agents for agents, _ in points],
-                [value for _, value in points],
-                marker=MARKERS[settings.index(faults) % len(MARKERS)],
-                markersize=max(4.0, 7.0 - order),
-                linewidth=max(1.4, 3.0 - 0.4 * order),  # earlier lines wider: they show under equal later ones
-                alpha=0.9,
-                linestyle=LINE_STYLES[settings.index(faults) % len(LINE_STYLES)],
-                color=colors[policy],
-                label=label,
-            )
-            handles.setdefault(label, line)
-        _style_n_axis(axes, [summary.key.agents for summary in chosen])
-        axes.set_title(metric.title, fontsize=11)
-        axes.set_ylabel(metric.y_label)
-        axes.grid(True, which="major", alpha=0.3)
-        if metric.percent:
-            axes.set_ylim(-4, 104)
-        elif metric.log_y:
-            _plain_log_y(axes)
-        elif metric.from_zero:
+    row_axes: dict[int, Axes] = {}
+    drawn: list[tuple[_Metric, Axes]] = []
+    for metric, chosen, faults, row, column in places:
+        shared = row_axes.get(row) if len(settings) > 1 else None
+        axes = figure.add_subplot(rows, columns, row * columns + column + 1, sharey=shared)
+        row_axes.setdefault(row, axes)
+        drawn.append((metric, axes))
+        _draw_panel(
+            axes, metric, chosen, faults, colors, handles, titled_faults=len(settings) > 1, labelled=column == 0
+        )
+    for metric, axes in drawn:
+        if metric.from_zero:  # once every panel is drawn: an axis shared along a row fits them all
+            axes.autoscale(axis="y")
             axes.set_ylim(bottom=0)
+    ordered = [policy for policy in policies if policy in handles]
     figure.legend(
-        list(handles.values()),
-        list(handles),
+        [handles[policy] for policy in ordered],
+        ordered,
         loc="outside lower center",
-        ncols=min(len(handles), 4),
+        ncols=min(len(ordered), 7),
         frameon=False,
     )
     return figure

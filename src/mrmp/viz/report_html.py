@@ -1,4 +1,9 @@
-"""A benchmark report as one self-contained HTML page: what was run, the headline table, the plots, the notes.
+"""A benchmark report as one self-contained HTML page: the compact table and the plots first, then the detail.
+
+The page reads top-down: a compact table of success and SoC/LB, one row per
+map and N and one column per policy (:func:`compact_table`, the table of the
+README); the plots; what was run; the headline table of every configuration,
+map by map; and the notes (timeouts, errors, collisions).
 
 The page is plain HTML with inline CSS (no script, nothing fetched): every
 plot is embedded as a base64 ``data:`` URI, and also written as a PNG file in
@@ -19,6 +24,8 @@ Examples
 >>> page = files.html.read_text()
 >>> "<h3>empty-8-8</h3>" in page, page.count('src="data:image/png;base64,')
 (True, 1)
+>>> page.index('id="summary"') < page.index('id="plots"') < page.index('id="detail"')
+True
 """
 
 from __future__ import annotations
@@ -62,6 +69,9 @@ tr.policy-start td { border-top: 2px solid #c9d1d9; }
 h3 { font-size: 15px; margin: 20px 0 4px; }
 td.number, th.number { text-align: right; font-variant-numeric: tabular-nums; white-space: nowrap; }
 table.facts th { background: none; width: 170px; }
+table.compact td { white-space: nowrap; }
+nav.contents { font-size: 13px; color: #59636e; margin: 4px 0 8px; }
+nav.contents a { margin-right: 12px; }
 .good { color: #116329; font-weight: 600; }
 .partial { color: #9a6700; font-weight: 600; }
 .bad { color: #b91c1c; font-weight: 600; }
@@ -172,6 +182,107 @@ def _map_table(table: TextTable, summaries: Sequence[GroupSummary]) -> str:
     return "<table>\n<thead><tr>" + header + "</tr></thead>\n<tbody>\n" + "\n".join(rows) + "\n</tbody>\n</table>"
 
 
+@dataclass(frozen=True)
+class CompactCell:
+    """One policy at one map and N, over every seed and fault setting: runs, successes, timeouts, mean SoC/LB."""
+
+    runs: int
+    successes: int
+    timeouts: int
+    mean_soc_over_lb: float | None
+
+    @property
+    def text(self) -> str:
+        """``100%, 1.11`` (success, then mean SoC/LB of the successful runs), ``0%``, or ``t/o`` when every run timed out.
+
+        >>> CompactCell(4, 2, 0, 1.234).text, CompactCell(2, 0, 2, None).text, CompactCell(2, 0, 1, None).text
+        ('50%, 1.23', 't/o', '0%')
+        """
+        if self.runs and self.timeouts == self.runs:
+            return "t/o"
+        share = f"{100 * self.successes / self.runs:.0f}%" if self.runs else "-"
+        return share if self.mean_soc_over_lb is None else f"{share}, {self.mean_soc_over_lb:.2f}"
+
+
+@dataclass(frozen=True)
+class CompactTable:
+    """The compact table: ``rows`` of ``(map, N)``, ``policies`` as columns, ``cells`` keyed by ``(map, N, policy)``."""
+
+    rows: tuple[tuple[str, int], ...]
+    policies: tuple[str, ...]
+    cells: dict[tuple[str, int, str], CompactCell]
+
+
+def compact_table(records: Sequence[BenchRecord]) -> CompactTable:
+    """Success and mean SoC/LB of each policy at each map and N, pooled over seeds and fault settings (one-shot runs).
+
+    Maps come in the order the results first name them, N in increasing
+    order; decentralized policies first, then the central planners, each in
+    the order first run.
+
+    >>> from mrmp.io.report_input import BenchRecord, FaultSetting
+    >>> records = [BenchRecord("a", "done", "m", 4, "pibt", 0, FaultSetting(), False, success=True, soc_over_lb=1.5),
+    ...            BenchRecord("b", "done", "m", 4, "pibt", 1, FaultSetting(), False, success=False),
+    ...            BenchRecord("c", "timeout", "m", 4, "cbs", 0, FaultSetting(), False, kind="centralized")]
+    >>> table = compact_table(records)
+    >>> table.rows, table.policies, table.cells[("m", 4, "pibt")].text, table.cells[("m", 4, "cbs")].text
+    ((('m', 4),), ('pibt', 'cbs'), '50%, 1.50', 't/o')
+    """
+    one_shot = [record for record in records if not record.lifelong]
+    maps = list(dict.fromkeys(record.map for record in one_shot))
+    agents = {name: sorted({record.agents for record in one_shot if record.map == name}) for name in maps}
+    ordered = list(dict.fromkeys(record.policy for record in one_shot))
+    central = {record.policy for record in one_shot if record.kind == "centralized"}
+    policies = [policy for policy in ordered if policy not in central] + [policy for policy in ordered if policy in central]
+    groups: dict[tuple[str, int, str], list[BenchRecord]] = {}
+    for record in one_shot:
+        groups.setdefault((record.map, record.agents, record.policy), []).append(record)
+    cells = {}
+    for key, runs in groups.items():
+        successful = [record.soc_over_lb for record in runs if record.succeeded and record.soc_over_lb is not None]
+        cells[key] = CompactCell(
+            runs=len(runs),
+            successes=sum(1 for record in runs if record.succeeded),
+            timeouts=sum(1 for record in runs if record.status == "timeout"),
+            mean_soc_over_lb=sum(successful) / len(successful) if successful else None,
+        )
+    rows = tuple((name, count) for name in maps for count in agents[name])
+    return CompactTable(rows, tuple(policies), cells)
+
+
+def compact_html(table: CompactTable) -> str:
+    """The compact table as HTML: a line between maps, each cell coloured by its success.
+
+    >>> table = CompactTable((("m", 4),), ("pibt",), {("m", 4, "pibt"): CompactCell(2, 2, 0, 1.25)})
+    >>> print(compact_html(table).splitlines()[-3])
+    <tr class="policy-start"><td>m</td><td class="number">4</td><td class="good">100%, 1.25</td></tr>
+    """
+    header = "<th>map</th><th class=\"number\">N</th>" + "".join(f"<th>{escape(policy)}</th>" for policy in table.policies)
+    lines = []
+    previous = None
+    for map_name, agents in table.rows:
+        cells = []
+        for policy in table.policies:
+            cell = table.cells.get((map_name, agents, policy))
+            if cell is None:
+                cells.append("<td>-</td>")
+                continue
+            kind = "good" if cell.successes == cell.runs else "bad" if cell.successes == 0 else "partial"
+            cells.append(f'<td class="{kind}">{escape(cell.text)}</td>')
+        start = ' class="policy-start"' if map_name != previous else ""
+        previous = map_name
+        lines.append(f'<tr{start}><td>{escape(map_name)}</td><td class="number">{agents}</td>' + "".join(cells) + "</tr>")
+    return (
+        '<table class="compact">\n<thead><tr>' + header + "</tr></thead>\n<tbody>\n" + "\n".join(lines) + "\n</tbody>\n</table>"
+    )
+
+
+COMPACT_LEGEND = (
+    "Each cell: successful runs over all runs of the policy at that map and N, over every seed and fault setting, "
+    "then the mean SoC/LB of the successful runs; t/o: every run hit the time limit."
+)
+
+
 def _figure(plot: PlotFile, page_folder: Path) -> str:
     data = base64.b64encode(plot.png).decode("ascii")
     try:
@@ -247,6 +358,11 @@ def render_report_html(
         named = ", ".join(facts.benches) if facts.benches else results.path.parent.name or results.path.name
         title = f"mrmp benchmark: {named}"
     figures = "\n".join(_figure(plot, page_folder) for plot in plots) or "<p>No plot: no run finished.</p>"
+    table = compact_table(results.records)
+    if table.rows:
+        summary = f'{compact_html(table)}\n<p class="legend">{escape(COMPACT_LEGEND)}</p>'
+    else:
+        summary = "<p>No one-shot run: see the plots and every configuration below.</p>"
     return f"""<!DOCTYPE html>
 <html lang="en">
 <head>
@@ -259,14 +375,18 @@ def render_report_html(
 <main>
 <h1>{escape(title)}</h1>
 <p class="source">{facts.runs} runs of {len(summaries)} configurations, read from <code>{escape(str(results.path))}</code></p>
-<h2>What was run</h2>
+<nav class="contents"><a href="#summary">summary</a><a href="#plots">plots</a><a href="#run">what was run</a>\
+<a href="#detail">every configuration</a><a href="#notes">notes</a></nav>
+<h2 id="summary">Summary</h2>
+{summary}
+<h2 id="plots">Plots</h2>
+{figures}
+<h2 id="run">What was run</h2>
 {_facts(results, facts)}
-<h2>Results</h2>
+<h2 id="detail">Every configuration</h2>
 {headline_html(summaries)}
 <p class="legend">{escape(LEGEND)}</p>
-<h2>Plots</h2>
-{figures}
-<h2>Notes</h2>
+<h2 id="notes">Notes</h2>
 {_notes(results)}
 </main>
 </body>

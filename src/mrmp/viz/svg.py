@@ -34,8 +34,8 @@ Examples
 >>> run = RunResult("demo", "thesis", 0, [robot], [], "arrived", 1, 1, 0.0)
 >>> with tempfile.TemporaryDirectory() as folder:
 ...     root = ET.parse(write_svg(Grid(2, 2), run, pathlib.Path(folder) / "demo.svg")).getroot()
->>> root.tag, root.get("width"), root.get("height")
-('{http://www.w3.org/2000/svg}svg', '300', '220')
+>>> root.tag, root.get("width"), root.get("viewBox")
+('{http://www.w3.org/2000/svg}svg', '100%', '0 0 340 309')
 """
 
 from __future__ import annotations
@@ -44,51 +44,79 @@ import itertools
 import math
 import os
 import xml.etree.ElementTree as ET
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from pathlib import Path
 
 from mrmp.core.grid import Grid
 from mrmp.core.result import RunResult
 from mrmp.viz._atomic import replacing
+from mrmp.viz.colouring import ROBOT, check_colouring, colour_changes, colouring_caption, progress_ramp
 from mrmp.viz.layout import (
     BACKGROUND,
     COLLISION,
     COST_TEXT,
     FONT_FAMILY,
     GOAL_INSET,
+    GOAL_LABEL_CELL,
     GOAL_WIDTH,
     GRID_LINE,
     HEADER,
     HEADER_DIM,
     HEADER_TEXT,
     HEADING_MARKER,
+    LEGEND_ROW,
     MESSAGE_LABEL_CELL,
     OBSTACLE,
     OBSTACLE_EDGE,
     PALETTE,
+    RGB,
+    ROBOT_EDGE,
     ROBOT_RADIUS,
     SUCCESS,
     Keyframe,
+    MessageArrow,
+    arrow_head,
     arrow_shape,
     cell_at,
+    check_speed,
+    clock_text,
     cost_tint,
     darker,
+    goal_label_place,
     hex_colour,
+    is_live,
     label_size,
     make_layout,
+    marker_points,
     message_arrows,
     message_label_place,
     message_width,
     mix,
+    move_ticks_of,
     robot_colours,
     robot_label,
     run_caption,
+    run_subtitle,
     run_ticks,
     run_verdict,
-    shorten,
     simplify,
     text_colour_on,
+    text_width,
     track,
+    trim_idle,
+)
+from mrmp.viz.legend import (
+    AXIS_TEXT,
+    EAST_LABEL,
+    GOAL_NEUTRAL,
+    LEGEND_TEXT,
+    NORTH_LABEL,
+    LegendPlace,
+    axis_labels,
+    compass,
+    legend_items,
+    place_legend,
 )
 
 SVG_NAMESPACE = "http://www.w3.org/2000/svg"
@@ -101,9 +129,12 @@ def write_svg(
     result: RunResult,
     path: str | os.PathLike[str],
     *,
-    seconds_per_tick: float = 0.4,
+    seconds_per_tick: float | None = None,
     hold_s: float = 1.5,
     show_messages: bool = False,
+    colour_by: str | None = None,
+    goal_lines: bool = False,
+    speed: float = 1.0,
 ) -> Path:
     """Draw ``result`` on ``grid`` as a looping animated SVG at ``path``.
 
@@ -116,12 +147,21 @@ def write_svg(
     path:
         Where to write the SVG (UTF-8).
     seconds_per_tick:
-        Playing time of one tick.
+        Playing time of one tick; by default 0.4 s, and for a live run its
+        ``tick_seconds`` over ``speed``, so that it plays at its real speed.
     hold_s:
         How long the final state stays on screen before the loop restarts.
     show_messages:
         Draw each tick's messages as arrows from sender to recipient (runs
         with a message log).
+    colour_by:
+        What a robot's colour says: ``"robot"``, ``"progress"`` or
+        ``"heading"`` (:mod:`mrmp.viz.colouring`; by default ``"robot"`` for
+        a few robots, ``"progress"`` for a crowd).
+    goal_lines:
+        Draw a line from each robot to its goal, until it is there.
+    speed:
+        A live run plays at ``speed`` times its real speed (the caption says so).
 
     Returns
     -------
@@ -132,9 +172,10 @@ def write_svg(
     Raises
     ------
     ValueError
-        If ``seconds_per_tick`` is not positive or ``hold_s`` is negative.
+        If ``seconds_per_tick`` or ``speed`` is not positive, ``hold_s`` is
+        negative or ``colour_by`` unknown.
     """
-    root = _svg_root(grid, result, seconds_per_tick, hold_s, show_messages)
+    root = _svg_root(grid, result, _Style(seconds_per_tick, hold_s, show_messages, colour_by, goal_lines, speed))
     target = Path(path)
     with replacing(target) as temporary:
         ET.ElementTree(root).write(temporary, encoding="utf-8", xml_declaration=True)
@@ -142,7 +183,15 @@ def write_svg(
 
 
 def svg_text(
-    grid: Grid, result: RunResult, *, seconds_per_tick: float = 0.4, hold_s: float = 1.5, show_messages: bool = False
+    grid: Grid,
+    result: RunResult,
+    *,
+    seconds_per_tick: float | None = None,
+    hold_s: float = 1.5,
+    show_messages: bool = False,
+    colour_by: str | None = None,
+    goal_lines: bool = False,
+    speed: float = 1.0,
 ) -> str:
     """The animated SVG of :func:`write_svg` as text, to embed in HTML (no XML declaration).
 
@@ -153,19 +202,40 @@ def svg_text(
     >>> text.startswith("<svg") and text.endswith("</svg>")
     True
     """
-    root = _svg_root(grid, result, seconds_per_tick, hold_s, show_messages)
+    root = _svg_root(grid, result, _Style(seconds_per_tick, hold_s, show_messages, colour_by, goal_lines, speed))
     return ET.tostring(root, encoding="unicode")
 
 
-def _svg_root(grid: Grid, result: RunResult, seconds_per_tick: float, hold_s: float, show_messages: bool) -> ET.Element:
-    """The animation's ``<svg>`` element, indented; checks the timing arguments."""
+@dataclass(frozen=True)
+class _Style:
+    """The options of one SVG picture (see :func:`write_svg`)."""
+
+    seconds_per_tick: float | None = None
+    hold_s: float = 1.5
+    show_messages: bool = False
+    colour_by: str | None = None
+    goal_lines: bool = False
+    speed: float = 1.0
+
+
+def _svg_root(grid: Grid, result: RunResult, style: _Style) -> ET.Element:
+    """The animation's ``<svg>`` element, indented; checks the options."""
+    check_speed(style.speed)
+    result = trim_idle(result)
+    seconds_per_tick = style.seconds_per_tick
+    if seconds_per_tick is None:
+        seconds_per_tick = float(result.tick_seconds or 0.0) / style.speed if is_live(result) else DEFAULT_SECONDS_PER_TICK
     if not seconds_per_tick > 0:
         raise ValueError(f"seconds_per_tick must be positive, got {seconds_per_tick}")
-    if not hold_s >= 0:
-        raise ValueError(f"hold_s must not be negative, got {hold_s}")
-    root = _SvgRun(grid, result, seconds_per_tick, hold_s, show_messages).build()
+    if not style.hold_s >= 0:
+        raise ValueError(f"hold_s must not be negative, got {style.hold_s}")
+    root = _SvgRun(grid, result, seconds_per_tick, style).build()
     ET.indent(root, space=" ")
     return root
+
+
+DEFAULT_SECONDS_PER_TICK = 0.4
+"""Playing time of a tick of a simulated run."""
 
 
 def _n(value: float) -> str:
@@ -178,22 +248,30 @@ def _n(value: float) -> str:
     return "0" if text in ("-0", "") else text
 
 
+def _same(colour: RGB) -> RGB:
+    return colour
+
+
 class _SvgRun:
     """Builds the SVG element tree of one run."""
 
-    def __init__(
-        self, grid: Grid, result: RunResult, seconds_per_tick: float, hold_s: float, show_messages: bool = False
-    ) -> None:
-        self.show_messages = show_messages
+    def __init__(self, grid: Grid, result: RunResult, seconds_per_tick: float, style: _Style) -> None:
+        self.show_messages = style.show_messages
+        self.goal_lines = style.goal_lines
+        self.speed = style.speed
         self.grid = grid
         self.result = result
-        self.layout = make_layout(grid, len(result.robots))
+        self.colouring = check_colouring(style.colour_by, len(result.robots))
+        self.layout = make_layout(grid, len(result.robots), colouring=self.colouring, goal_lines=style.goal_lines)
         self.ticks = run_ticks(result)
         self.spt = seconds_per_tick
-        self.duration = max(self.ticks * seconds_per_tick + hold_s, 0.1)
+        self.duration = max(self.ticks * seconds_per_tick + style.hold_s, 0.1)
         self.dur = f"{self.duration:.3f}s"
         self.colours = robot_colours(len(result.robots))
-        self.tracks: list[list[Keyframe]] = [track(robot, self.ticks) for robot in result.robots]
+        self.tracks: list[list[Keyframe]] = [track(robot, self.ticks, move_ticks_of(result)) for robot in result.robots]
+        self.changes = [
+            colour_changes(robot, self.ticks, self.colouring, colour) for robot, colour in zip(result.robots, self.colours)
+        ]
 
     # -- timing helpers -----------------------------------------------------------------
 
@@ -257,10 +335,12 @@ class _SvgRun:
             {
                 "xmlns": SVG_NAMESPACE,
                 "version": "1.1",
-                "width": str(layout.width),
-                "height": str(layout.height),
+                "width": "100%",
                 "viewBox": f"0 0 {layout.width} {layout.height}",
                 "font-family": FONT_FAMILY,
+                "data-width": str(layout.width),
+                "data-height": str(layout.height),
+                "data-colour-by": self.colouring,
             },
         )
         ET.SubElement(
@@ -268,6 +348,7 @@ class _SvgRun:
         ).text = f"{run_caption(self.result)}: {self.ticks} ticks, {len(self.result.robots)} robots"
         ET.SubElement(root, "rect", {"width": "100%", "height": "100%", "fill": hex_colour(BACKGROUND)})
         self._grid(ET.SubElement(root, "g", {"id": "grid"}))
+        self._axes(ET.SubElement(root, "g", {"id": "axes", "font-size": _n(layout.small_font), "fill": hex_colour(AXIS_TEXT)}))
         self._goals(ET.SubElement(root, "g", {"id": "goals"}))
         collisions = ET.SubElement(root, "g", {"id": "collisions"})
         self._collision_cells(collisions)
@@ -276,12 +357,194 @@ class _SvgRun:
                 root, "g", {"id": "trails", "fill": "none", "stroke-linecap": "round", "stroke-linejoin": "round"}
             )
         )
+        if self.goal_lines:
+            self._goal_lines(ET.SubElement(root, "g", {"id": "goal-lines", "stroke-linecap": "round"}))
         self._robots(ET.SubElement(root, "g", {"id": "robots"}))
         if self.show_messages:
             self._messages(ET.SubElement(root, "g", {"id": "messages"}))
         self._collision_rings(ET.SubElement(root, "g", {"id": "collision-rings", "fill": "none"}))
         self._caption(ET.SubElement(root, "g", {"id": "caption"}))
+        self._legend(ET.SubElement(root, "g", {"id": "legend", "font-size": _n(layout.small_font)}))
         return root
+
+    def _colour_samples(self, index: int, paint: Callable[[RGB], RGB] = _same) -> list[tuple[float, str]]:
+        """The colour changes of robot ``index`` as ``(tick time, CSS colour)``, each passed through ``paint``."""
+        return [(tick_time, hex_colour(paint(colour))) for tick_time, colour in self.changes[index]]
+
+    def _paint(self, element: ET.Element, attribute: str, index: int, paint: Callable[[RGB], RGB] = _same) -> None:
+        """Set ``attribute`` of ``element`` to robot ``index``'s colour, animated when the colour changes."""
+        samples = self._colour_samples(index, paint)
+        element.set(attribute, samples[0][1])
+        if len(samples) > 1:
+            self._animate(element, attribute, samples, discrete=True)
+
+    def _axes(self, group: ET.Element) -> None:
+        """The x numbers up the left side, the y numbers along the foot, and the axes' names."""
+        for label in axis_labels(self.layout):
+            text = ET.SubElement(
+                group,
+                "text",
+                {"x": _n(label.x), "y": _n(label.y), "dy": "0.35em", "text-anchor": label.anchor, "class": "axis"},
+            )
+            if label.text in ("x", "y"):
+                text.set("font-style", "italic")
+                text.set("font-weight", "bold")
+                text.text = f"{label.text} ↑" if label.text == "x" else f"{label.text} →"
+            else:
+                text.text = label.text
+
+    def _goal_lines(self, group: ET.Element) -> None:
+        """A line from each robot (moving) to its goal (fixed), in the robot's colour."""
+        layout = self.layout
+        width = _n(max(1.0, layout.cell * 0.05))
+        for index, robot in enumerate(self.result.robots):
+            goal_x, goal_y = layout.centre(robot.goal)
+            moves = simplify(self.tracks[index], ("x", "y"))
+            start_x, start_y = layout.point(moves[0].x, moves[0].y)
+            line = ET.SubElement(
+                group,
+                "line",
+                {
+                    "class": "goal-line",
+                    "data-robot": robot.id,
+                    "x1": _n(start_x),
+                    "y1": _n(start_y),
+                    "x2": _n(goal_x),
+                    "y2": _n(goal_y),
+                    "stroke-width": width,
+                    "stroke-opacity": "0.7",
+                },
+            )
+            ET.SubElement(line, "title").text = f"robot {robot.id} to its goal {robot.goal}"
+            self._paint(line, "stroke", index)
+            if len(moves) > 1:
+                points = [layout.point(frame.x, frame.y) for frame in moves]
+                self._animate(line, "x1", [(frame.t, _n(x)) for frame, (x, _) in zip(moves, points)])
+                self._animate(line, "y1", [(frame.t, _n(y)) for frame, (_, y) in zip(moves, points)])
+
+    def _legend(self, group: ET.Element) -> None:
+        """What the colours and marks mean, and the compass."""
+        layout = self.layout
+        row = layout.small_font / 11 * LEGEND_ROW
+        ET.SubElement(
+            group,
+            "rect",
+            {
+                "y": str(layout.legend_top),
+                "width": str(layout.width),
+                "height": str(layout.legend),
+                "fill": hex_colour(mix(GRID_LINE, BACKGROUND, 0.35)),
+            },
+        )
+        items = legend_items(self.result, self.colouring, self.goal_lines, self.colours)
+        for place in place_legend(items, layout):
+            entry = ET.SubElement(group, "g", {"class": f"legend-{place.item.kind}"})
+            if place.item.detail:
+                ET.SubElement(entry, "title").text = place.item.detail
+            self._swatch(entry, place, row)
+            text = ET.SubElement(
+                entry, "text", {"x": _n(place.text_x), "y": _n(place.y), "dy": "0.35em", "fill": hex_colour(LEGEND_TEXT)}
+            )
+            text.text = place.text
+        self._compass(ET.SubElement(group, "g", {"id": "compass"}))
+
+    def _swatch(self, entry: ET.Element, place: LegendPlace, row: float) -> None:
+        """The mark of a legend entry, in a box ``row`` pixels high at the entry's left."""
+        item = place.item
+        x, y = place.x + row / 2, place.y
+        size = row * 0.7
+        colour = hex_colour(item.colour)
+        if item.kind in ("robot", "heading"):
+            ET.SubElement(
+                entry,
+                "circle",
+                {"cx": _n(x), "cy": _n(y), "r": _n(size * 0.45), "fill": colour, "stroke": hex_colour(darker(item.colour, 0.4))},
+            )
+            if item.kind == "heading":
+                nose = marker_points((x, y), item.angle, size, _SMALL_MARKER)
+                ET.SubElement(entry, "polygon", {"points": _points(nose), "fill": hex_colour(darker(item.colour, 0.45))})
+        elif item.kind == "goal":
+            ET.SubElement(
+                entry,
+                "rect",
+                {
+                    "x": _n(x - size / 2),
+                    "y": _n(y - size / 2),
+                    "width": _n(size),
+                    "height": _n(size),
+                    "rx": _n(size * 0.15),
+                    "fill": hex_colour(mix(item.colour, BACKGROUND, 0.12)),
+                    "stroke": colour,
+                    "stroke-width": _n(max(1.0, size * 0.14)),
+                },
+            )
+        elif item.kind == "ramp":
+            ramp = progress_ramp()
+            width = row * 2.4 - 4
+            step = width / len(ramp)
+            for number, shade in enumerate(ramp):
+                ET.SubElement(
+                    entry,
+                    "rect",
+                    {
+                        "x": _n(place.x + 2 + number * step),
+                        "y": _n(y - size / 2),
+                        "width": _n(step + 0.3),
+                        "height": _n(size),
+                        "fill": hex_colour(shade),
+                    },
+                )
+        else:  # trail, goal-line: a short line
+            ET.SubElement(
+                entry,
+                "line",
+                {
+                    "x1": _n(place.x + 2),
+                    "y1": _n(y),
+                    "x2": _n(place.x + row - 2),
+                    "y2": _n(y),
+                    "stroke": colour,
+                    "stroke-width": _n(max(1.5, row * (0.18 if item.kind == "trail" else 0.1))),
+                    "stroke-linecap": "round",
+                    "stroke-opacity": "0.6" if item.kind == "trail" else "0.8",
+                },
+            )
+
+    def _compass(self, group: ET.Element) -> None:
+        """Arrows to NORTH (where x grows) and EAST (where y grows)."""
+        point = compass(self.layout)
+        colour = hex_colour(LEGEND_TEXT)
+        for tip, text_at, text, anchor in (
+            (point.north_tip, point.north_text, NORTH_LABEL, "start"),
+            (point.east_tip, point.east_text, EAST_LABEL, "start"),
+        ):
+            ET.SubElement(
+                group,
+                "line",
+                {
+                    "x1": _n(point.corner[0]),
+                    "y1": _n(point.corner[1]),
+                    "x2": _n(tip[0]),
+                    "y2": _n(tip[1]),
+                    "stroke": colour,
+                    "stroke-width": _n(point.width),
+                },
+            )
+            head = arrow_head(MessageArrow(0, 0, 0, (), point.corner, tip), point.head)
+            ET.SubElement(group, "polygon", {"points": _points(head), "fill": colour})
+            label = ET.SubElement(
+                group,
+                "text",
+                {
+                    "x": _n(text_at[0]),
+                    "y": _n(text_at[1]),
+                    "dy": "0.35em",
+                    "text-anchor": anchor,
+                    "fill": colour,
+                    "font-weight": "bold",
+                },
+            )
+            label.text = text
 
     def _grid(self, group: ET.Element) -> None:
         layout, grid = self.layout, self.grid
@@ -358,11 +621,14 @@ class _SvgRun:
         )
 
     def _goals(self, group: ET.Element) -> None:
+        """Each goal as a hollow square: in its robot's colour (with the robot's id in big cells), else neutral."""
         layout = self.layout
         inset = layout.cell * GOAL_INSET
+        own = self.colouring == ROBOT
         for robot, colour in zip(self.result.robots, self.colours):
+            shown = colour if own else GOAL_NEUTRAL
             left, top, _, _ = layout.cell_box(robot.goal)
-            ET.SubElement(
+            square = ET.SubElement(
                 group,
                 "rect",
                 {
@@ -373,11 +639,27 @@ class _SvgRun:
                     "width": _n(layout.cell - 2 * inset),
                     "height": _n(layout.cell - 2 * inset),
                     "rx": _n(layout.cell * 0.1),
-                    "fill": hex_colour(mix(colour, BACKGROUND, 0.12)),
-                    "stroke": hex_colour(colour),
+                    "fill": hex_colour(mix(shown, BACKGROUND, 0.12)),
+                    "stroke": hex_colour(shown),
                     "stroke-width": _n(max(1.0, layout.cell * GOAL_WIDTH)),
                 },
             )
+            ET.SubElement(square, "title").text = f"goal of robot {robot.id}: {robot.goal}"
+            if own and layout.cell >= GOAL_LABEL_CELL:
+                place = goal_label_place(layout, robot.goal)
+                label = ET.SubElement(
+                    group,
+                    "text",
+                    {
+                        "class": "goal-label",
+                        "x": _n(place[0]),
+                        "y": _n(place[1]),
+                        "font-size": _n(layout.cell * 0.17),
+                        "font-weight": "bold",
+                        "fill": hex_colour(darker(colour, 0.25)),
+                    },
+                )
+                label.text = robot_label(robot.id)
 
     def _collision_windows(self) -> list[tuple[tuple[int, int], list[tuple[float, str]]]]:
         """Each collision cell with its opacity samples: flash at the tick, then faint."""
@@ -455,13 +737,13 @@ class _SvgRun:
                     "class": "trail",
                     "data-robot": robot.id,
                     "points": " ".join(f"{_n(x)},{_n(y)}" for x, y in points),
-                    "stroke": hex_colour(self.colours[index]),
-                    "stroke-opacity": "0.5" if keep is None else "0.6",
+                    "stroke-opacity": "0.5" if keep is None else "0.6" if self.colouring == ROBOT else "0.35",
                     "stroke-width": _n(width),
                     "stroke-dasharray": f"{_n(window)} {_n(gap)}",
                     "stroke-dashoffset": _n(window),
                 },
             )
+            self._paint(polyline, "stroke", index)
             self._animate(polyline, "stroke-dashoffset", samples)
 
     def _distances(self, index: int) -> list[tuple[float, float]]:
@@ -480,9 +762,10 @@ class _SvgRun:
         nose_outside = layout.cell >= 18
         shape = HEADING_MARKER if nose_outside else _SMALL_MARKER
         nose = " ".join(f"{_n(x * layout.cell)},{_n(y * layout.cell)}" for x, y in shape)
+        own = self.colouring == ROBOT
         for index, robot in enumerate(self.result.robots):
             colour = self.colours[index]
-            edge = darker(colour, 0.4)
+            edge = darker(colour, 0.4) if own else ROBOT_EDGE
             frames = self.tracks[index]
             x0, y0 = layout.point(frames[0].x, frames[0].y)
             body = ET.SubElement(
@@ -495,7 +778,7 @@ class _SvgRun:
                     "transform": f"translate({_n(x0)},{_n(y0)})",
                 },
             )
-            ET.SubElement(body, "title").text = f"robot {robot.id}: {robot.start} to {robot.goal}"
+            ET.SubElement(body, "title").text = f"robot {robot.id}: start {robot.start}, goal {robot.goal}"
             moves = simplify(frames, ("x", "y"))
             self._animate(
                 body,
@@ -503,14 +786,15 @@ class _SvgRun:
                 [(frame.t, "{},{}".format(*map(_n, layout.point(frame.x, frame.y)))) for frame in moves],
                 transform="translate",
             )
-            disc = {"r": _n(radius), "fill": hex_colour(colour)}
+            disc = {"r": _n(radius)}
             if nose_outside:  # the nose peeks out from under the disc
                 disc.update({"stroke": hex_colour(edge), "stroke-width": _n(max(1.0, layout.cell * 0.045))})
                 heading = ET.SubElement(body, "g", {"class": "heading", "transform": f"rotate({_n(frames[0].angle)})"})
-                ET.SubElement(body, "circle", disc)
+                circle = ET.SubElement(body, "circle", disc)
             else:  # small cells: the marker is drawn over the disc
-                ET.SubElement(body, "circle", disc)
+                circle = ET.SubElement(body, "circle", disc)
                 heading = ET.SubElement(body, "g", {"class": "heading", "transform": f"rotate({_n(frames[0].angle)})"})
+            self._paint(circle, "fill", index)
             turns = simplify(frames, ("angle",))
             self._animate(heading, "transform", [(frame.t, _n(frame.angle)) for frame in turns], transform="rotate")
             ET.SubElement(heading, "polygon", {"points": nose, "fill": hex_colour(edge)})
@@ -523,9 +807,9 @@ class _SvgRun:
                         "dy": "0.35em",
                         "font-size": _n(max(6.0, label_size(robot_label(robot.id), layout.cell))),
                         "font-weight": "bold",
-                        "fill": hex_colour(text_colour_on(colour)),
                     },
                 )
+                self._paint(label, "fill", index, text_colour_on)
                 label.text = robot_label(robot.id)
 
     def _messages(self, group: ET.Element) -> None:
@@ -586,9 +870,11 @@ class _SvgRun:
             self._animate(element, "opacity", samples, discrete=True)
 
     def _caption(self, group: ET.Element) -> None:
+        """Two lines: the title (squeezed, never cut, when too long), then the run's size, colouring and clock."""
         layout = self.layout
         size = layout.font_size
-        middle = layout.header / 2 - 1
+        small = round(size * 0.82)
+        first, second = layout.header * 0.3, layout.header * 0.68
         pad = 12
         ET.SubElement(
             group, "rect", {"width": str(layout.width), "height": str(layout.header), "fill": hex_colour(HEADER)}
@@ -597,22 +883,36 @@ class _SvgRun:
             group,
             "text",
             {
+                "class": "title",
                 "x": str(pad),
-                "y": _n(middle),
+                "y": _n(first),
                 "font-size": str(size),
                 "font-weight": "bold",
                 "dy": "0.35em",
                 "fill": hex_colour(HEADER_TEXT),
             },
         )
+        title.text = run_caption(self.result)
+        title_room = layout.width - 2 * pad
+        if text_width(title.text, size, bold=True) > title_room:  # squeezed to fit, every character kept
+            title.set("textLength", _n(title_room))
+            title.set("lengthAdjust", "spacingAndGlyphs")
         verdict, good = run_verdict(self.result)
-        longest = f"tick {self.ticks} / {self.ticks}  ·  {verdict}"  # the widest tick counter
-        room = layout.width - 3 * pad - 0.55 * size * len(longest)
-        title.text = shorten(run_caption(self.result), room, size, bold=True)
-        ticks = ET.SubElement(group, "g", {"id": "ticks", "font-size": str(size), "text-anchor": "end"})
+        subtitle = ET.SubElement(
+            group,
+            "text",
+            {"x": str(pad), "y": _n(second), "font-size": str(small), "dy": "0.35em", "fill": hex_colour(HEADER_DIM)},
+        )
+        subtitle.text = run_subtitle(self.result, colouring_caption(self.colouring), self.speed)
+        longest = f"{clock_text(self.result, self.ticks)}  ·  {verdict}"
+        room = layout.width - 3.0 * pad - text_width(longest, small)
+        if text_width(subtitle.text, small) > room:
+            subtitle.set("textLength", _n(max(room, 10)))
+            subtitle.set("lengthAdjust", "spacingAndGlyphs")
+        ticks = ET.SubElement(group, "g", {"id": "ticks", "font-size": str(small), "text-anchor": "end"})
         for tick in range(self.ticks + 1):
             final = tick == self.ticks
-            text = f"tick {tick} / {self.ticks}" + (f"  ·  {verdict}" if final else "")
+            text = clock_text(self.result, tick) + (f"  ·  {verdict}" if final else "")
             colour = (SUCCESS if good else _BAD_NEWS) if final else HEADER_TEXT
             label = ET.SubElement(
                 ticks,
@@ -620,7 +920,7 @@ class _SvgRun:
                 {
                     "class": "tick",
                     "x": str(layout.width - pad),
-                    "y": _n(middle),
+                    "y": _n(second),
                     "dy": "0.35em",
                     "fill": hex_colour(colour),
                     "opacity": "1" if tick == 0 else "0",
@@ -663,6 +963,11 @@ class _SvgRun:
                 [(0.0, hex_colour(mix(PALETTE[0], HEADER_TEXT, 0.85))), (float(self.ticks), end)],
                 discrete=True,
             )
+
+
+def _points(points: Sequence[tuple[float, float]]) -> str:
+    """SVG ``points`` of a polygon."""
+    return " ".join(f"{_n(x)},{_n(y)}" for x, y in points)
 
 
 def _n_key(key: float) -> str:

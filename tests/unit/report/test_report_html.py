@@ -3,7 +3,7 @@
 import base64
 import re
 
-from report_fixtures import make_record, unfinished, write_jsonl
+from report_fixtures import NO_FAULTS, make_record, unfinished, write_jsonl
 
 from mrmp.bench.aggregate import summarize
 from mrmp.io.report_input import read_bench_results
@@ -15,7 +15,7 @@ def test_report_of_real_runs_has_every_row_and_embeds_every_plot(tmp_path, simul
     files = write_report(results, tmp_path / "out" / "report.html")
     page = files.html.read_text(encoding="utf-8")
     summaries = summarize(results.records)
-    body = page.split("<h2>Results</h2>")[1].split("</table>")[0]
+    body = page.split('<h2 id="detail">Every configuration</h2>')[1].split("</table>")[0]
     assert body.startswith("\n<h3>empty-8-8</h3>\n<table>")
     rows = re.findall(r"<tr(?: class=\"policy-start\")?><td>(astar|pibt)</td>", body)
     assert len(rows) == len(summaries) == 9  # 2 policies x 2 N x 2 losses, and the lifelong runs
@@ -51,7 +51,7 @@ def test_notes_name_timeouts_errors_collisions_and_a_truncated_line(tmp_path):
     ]
     results = read_bench_results(write_jsonl(tmp_path / "results.jsonl", records, tail='{"format": "mrmp-bench-1", "run'))
     page = write_report(results, tmp_path / "report.html").html.read_text()
-    notes = page.split("<h2>Notes</h2>")[1]
+    notes = page.split('<h2 id="notes">Notes</h2>')[1]
     assert "1 truncated line set aside" in notes
     assert "timeout</span> empty-8-8, pibt, N=4, seed 2, faults none (line 3): time limit 60 s" in notes
     assert "error</span> empty-8-8, pibt, N=8, seed 3, faults none (line 4): planner crashed" in notes
@@ -94,3 +94,41 @@ def test_an_unwritable_report_is_an_input_error(tmp_path):
     (tmp_path / "report.html").mkdir()
     with pytest.raises(InputError, match="cannot write the report"):
         write_report(results, tmp_path / "report.html")
+
+
+def test_the_page_leads_with_the_compact_table_and_the_plots(tmp_path, simulated_records):
+    results = read_bench_results(write_jsonl(tmp_path / "bench" / "results.jsonl", simulated_records))
+    page = write_report(results, tmp_path / "report.html").html.read_text(encoding="utf-8")
+    headings = re.findall(r'<h2 id="([a-z]+)">', page)
+    assert headings == ["summary", "plots", "run", "detail", "notes"]
+    first_plot = page.index('src="data:image/png')
+    assert first_plot < page.index('<h2 id="detail">'), "the plots come before the detail"
+    assert page[: page.index('<h2 id="plots">')].count("<tr") < 10, "few rows before the first plot"
+    summary = page.split('<h2 id="summary">Summary</h2>')[1].split("</table>")[0]
+    first_run = list(dict.fromkeys(record["policy"] for record in simulated_records))
+    columns = "".join(f"<th>{policy}</th>" for policy in first_run)
+    assert f"<th>map</th><th class=\"number\">N</th>{columns}</tr>" in summary, "policies in the order first run"
+    rows = re.findall(r"<tr(?: class=\"policy-start\")?><td>empty-8-8</td><td class=\"number\">(\d+)</td>", summary)
+    assert rows == ["2", "4"], "one row per map and N of the one-shot runs"
+
+
+def test_compact_cells_pool_seeds_and_faults(tmp_path):
+    from mrmp.io.report_input import FaultSetting
+    from mrmp.viz.report_html import compact_table
+
+    lossy = {**NO_FAULTS, "loss": 0.3}
+    records = [
+        make_record(run_id="a", seed=0, soc_over_lb=1.2),
+        make_record(run_id="b", seed=1, soc_over_lb=1.4),
+        make_record(run_id="c", seed=0, faults=lossy, success=False, soc_over_lb=None),
+        unfinished("timeout", "time limit", run_id="d", seed=1, faults=lossy),
+        unfinished("timeout", "time limit", run_id="e", seed=0, policy="cbs", kind="centralized"),
+    ]
+    results = read_bench_results(write_jsonl(tmp_path / "results.jsonl", records))
+    table = compact_table(results.records)
+    assert table.policies == ("pibt", "cbs"), "central planners after the robots' own policies"
+    cell = table.cells[("empty-8-8", 4, "pibt")]
+    assert (cell.runs, cell.successes, cell.timeouts) == (4, 2, 1)
+    assert cell.text == "50%, 1.30"
+    assert table.cells[("empty-8-8", 4, "cbs")].text == "t/o"
+    assert len({record.faults for record in results.records}) == 2 and FaultSetting() in {r.faults for r in results.records}

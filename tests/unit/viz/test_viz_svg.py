@@ -39,7 +39,8 @@ def test_svg_parses_with_one_animated_group_per_robot(swap: tuple[Grid, RunResul
     root = parse(write_svg(grid, result, tmp_path / "swap.svg"))
     layout = make_layout(grid, len(result.robots))
     assert root.tag == f"{SVG}svg"
-    assert (root.get("width"), root.get("height")) == (str(layout.width), str(layout.height))
+    assert root.get("width") == "100%" and root.get("height") is None, "the picture scales to its container"
+    assert root.get("viewBox") == f"0 0 {layout.width} {layout.height}"
     groups = robot_groups(root)
     assert [group.get("data-robot") for group in groups] == ["A", "B"]
     for group in groups:

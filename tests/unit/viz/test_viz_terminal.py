@@ -20,7 +20,7 @@ from mrmp.core.scenario import PolicyOptions
 from mrmp.experiments.execution import execute_in_simulator
 from mrmp.io import load_scenario
 from mrmp.sim.simulator import simulate
-from mrmp.viz.terminal import TerminalView, render_grid, scale_for
+from mrmp.viz.terminal import TRAIL, TerminalView, legend_text, render_grid, scale_for, short_labels
 
 ROOT = Path(__file__).resolve().parents[3]
 SWAP = ROOT / "examples" / "thesis-swap.yaml"
@@ -34,9 +34,37 @@ def test_a_tiny_grid_exactly() -> None:
     )
     assert picture.plain.split("\n") == [
         "a◦B↓· ██",
-        "· ██2◦2←",
+        "· ██c◦C←",
         "A→· · b◦",
     ]
+
+
+def test_robots_with_long_ids_get_letters_of_their_own_and_a_legend() -> None:
+    ids = ["r3", "r13", "r23"]  # the same last character: once all drawn as "3"
+    labels = short_labels(ids)
+    assert labels == ["A", "B", "C"]
+    picture = render_grid(Grid(1, 3), ids, [(0, 0), (0, 1), (0, 2)], [E, E, E], labels=labels)
+    assert picture.plain == "A→B→C→"
+    assert legend_text(ids, labels, 80, 3) == ["A r3  B r13  C r23"]
+    many = [f"robot-{n}" for n in range(100)]
+    lines = legend_text(many, short_labels(many), 60, 3)
+    assert len(lines) == 3 and all(len(line) <= 60 for line in lines) and lines[-1].endswith("(100 robots)")
+
+
+def test_trails_show_the_last_cells_left() -> None:
+    picture = render_grid(Grid(1, 5), ["A"], [(0, 4)], [E], trails=[[(0, 1), (0, 2), (0, 3)]])
+    assert picture.plain == "· • • • A→"
+    styles = {span.style for span in picture.spans if picture.plain[span.start : span.end] == TRAIL}
+    assert styles and all("dim" not in str(style) for style in styles)
+
+
+def test_the_view_shows_a_legend_of_labels_for_long_ids() -> None:
+    scenario = load_scenario(ROOT / "examples" / "warehouse-astar.yaml")
+    console = Console(file=io.StringIO(), width=80, height=40, color_system=None)
+    view = TerminalView(scenario, console, fps=1000)
+    lines = view.picture().plain.split("\n")
+    ids = [spec.id for spec in scenario.robots]
+    assert lines[-1].startswith(f"A {ids[0]}  B {ids[1]}"), lines[-1]
 
 
 def test_robots_are_coloured_and_goals_dim() -> None:
@@ -96,7 +124,8 @@ def test_the_view_follows_the_run_and_paces_it() -> None:
     assert view.tick == result.ticks
     final = [line.rstrip() for line in view.picture().plain.split("\n")]
     assert final[0] == "thesis-swap · thesis · tick 6"
-    assert final[1] == "· · A←· ·", "A arrived from the east, heading west"
+    assert final[1] == "· · A←• ·", "A arrived from the east, heading west; its trail behind it"
+    assert final[2:5] == ["· · • • ·", "· · • • ·", "· · • · ·"], "the last three cells each robot left"
     assert final[5] == "· · B↓· ·"
 
 
@@ -127,10 +156,10 @@ def test_watch_draws_in_a_terminal_and_ends_with_the_summary() -> None:
         assert "thesis-swap · thesis · tick 6" in lines
         grid_top = lines.index("thesis-swap · thesis · tick 6") + 1
         assert [line.rstrip() for line in lines[grid_top : grid_top + 5]] == [
-            "· · A←· ·",
-            "· · · · ·",
-            "· · · · ·",
-            "· · · · ·",
+            "· · A←• ·",
+            "· · • • ·",
+            "· · • • ·",
+            "· · • · ·",
             "· · B↓· ·",
         ]
         assert any(line.startswith("success (all arrived at tick 6)") for line in lines), screen
