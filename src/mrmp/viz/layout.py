@@ -66,6 +66,8 @@ HEADER_DIM: RGB = (150, 158, 178)
 """Secondary caption text (policy, progress track)."""
 SUCCESS: RGB = (102, 204, 128)
 """Caption colour of a successful run."""
+BAD_NEWS: RGB = (255, 128, 128)
+"""Caption colour of a failed run."""
 COLLISION: RGB = (228, 26, 48)
 """Collision flash."""
 COST_HIGH: RGB = (240, 180, 90)

@@ -40,6 +40,7 @@ from mrmp.core.result import RobotResult, RunResult
 from mrmp.viz.colouring import ROBOT, check_colouring, colour_at, colour_changes, colouring_caption, progress_ramp
 from mrmp.viz.layout import (
     BACKGROUND,
+    BAD_NEWS,
     COLLISION,
     COST_TEXT,
     GOAL_INSET,
@@ -54,7 +55,6 @@ from mrmp.viz.layout import (
     OBSTACLE,
     OBSTACLE_EDGE,
     PALETTE,
-    RGB,
     ROBOT_EDGE,
     ROBOT_RADIUS,
     SUCCESS,
@@ -101,9 +101,6 @@ from mrmp.viz.legend import (
     legend_items,
     place_legend,
 )
-
-_BAD_NEWS: RGB = (255, 128, 128)
-"""Caption colour of a failed run."""
 
 
 def frame_times(ticks: int, frames_per_tick: int, max_frames: int) -> list[float]:
@@ -564,7 +561,7 @@ class FramePainter:
         right = clock_text(self.result, tick)
         if finished:
             right += f"  ·  {self.verdict}"
-        right_colour = (SUCCESS if self.good else _BAD_NEWS) if finished else HEADER_TEXT
+        right_colour = (SUCCESS if self.good else BAD_NEWS) if finished else HEADER_TEXT
         draw.text((big.width - pad, second), right, fill=right_colour, font=tick_font, anchor="rm")
         longest = f"{clock_text(self.result, self.ticks)}  ·  {self.verdict}"  # the same subtitle on every frame
         room = big.width - 3 * pad - draw.textlength(longest, font=tick_font)
@@ -574,7 +571,7 @@ class FramePainter:
         bar = max(2, 3 * ss)
         share = t / self.ticks if self.ticks else 1.0
         draw.rectangle((0, big.header - bar, big.width, big.header - 1), fill=mix(HEADER_DIM, HEADER, 0.35))
-        accent = (SUCCESS if self.good else _BAD_NEWS) if finished else PALETTE[0]
+        accent = (SUCCESS if self.good else BAD_NEWS) if finished else PALETTE[0]
         draw.rectangle(
             (0, big.header - bar, round(big.width * share), big.header - 1), fill=mix(accent, HEADER_TEXT, 0.85)
         )

@@ -54,6 +54,7 @@ from mrmp.viz._atomic import replacing
 from mrmp.viz.colouring import ROBOT, check_colouring, colour_changes, colouring_caption, progress_ramp
 from mrmp.viz.layout import (
     BACKGROUND,
+    BAD_NEWS,
     COLLISION,
     COST_TEXT,
     FONT_FAMILY,
@@ -121,7 +122,6 @@ from mrmp.viz.legend import (
 
 SVG_NAMESPACE = "http://www.w3.org/2000/svg"
 _SMALL_MARKER: tuple[tuple[float, float], ...] = ((0.0, -0.46), (-0.2, -0.04), (0.2, -0.04))
-_BAD_NEWS = (255, 128, 128)
 
 
 def write_svg(
@@ -913,7 +913,7 @@ class _SvgRun:
         for tick in range(self.ticks + 1):
             final = tick == self.ticks
             text = clock_text(self.result, tick) + (f"  ·  {verdict}" if final else "")
-            colour = (SUCCESS if good else _BAD_NEWS) if final else HEADER_TEXT
+            colour = (SUCCESS if good else BAD_NEWS) if final else HEADER_TEXT
             label = ET.SubElement(
                 ticks,
                 "text",
@@ -956,7 +956,7 @@ class _SvgRun:
         )
         if self.ticks:
             self._animate(progress, "width", [(0.0, "0"), (float(self.ticks), str(layout.width))])
-            end = hex_colour(mix(SUCCESS if good else _BAD_NEWS, HEADER_TEXT, 0.85))
+            end = hex_colour(mix(SUCCESS if good else BAD_NEWS, HEADER_TEXT, 0.85))
             self._animate(
                 progress,
                 "fill",
