@@ -11,7 +11,7 @@ import functools
 import inspect
 import sys
 from collections.abc import Callable
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
@@ -31,7 +31,8 @@ from mrmp.core.limits import (
 )
 from mrmp.core.options import setting_types, settings
 from mrmp.core.result import RunResult
-from mrmp.core.scenario import NetworkFaults, PolicyOptions, Scenario, scenario_problems
+from mrmp.core.scenario import PolicyOptions, Scenario
+from mrmp.experiments.run_options import FLAG_NAMES, apply_run_options, parse_range
 from mrmp.io import load_movingai_scenario, load_scenario, validate_file, write_result_json
 from mrmp.live.transport_table import TRANSPORTS
 from mrmp.sim.policy_table import policy_entry, policy_names
@@ -58,25 +59,6 @@ def _fail(problems: list[Problem] | tuple[Problem, ...]) -> typer.Exit:
     return typer.Exit(2)
 
 
-def parse_range(text: str, option: str, unit: str = "ticks", whole: bool = True) -> tuple[float, float]:
-    """Read ``N`` or ``A..B`` (whole numbers when ``whole``), with ``0 <= A <= B``.
-
-    >>> parse_range("0..3", "--delay"), parse_range("2", "--delay")
-    ((0, 3), (2, 2))
-    >>> parse_range("20..80", "--delay-ms", "milliseconds", whole=False)
-    (20.0, 80.0)
-    """
-    low, separator, high = text.partition("..")
-    number = int if whole else float
-    try:
-        bounds = (number(low), number(high)) if separator else (number(low), number(low))
-    except ValueError:
-        raise InputError(Problem(option, f"expected N or A..B {unit}, got {text!r}")) from None
-    if not 0 <= bounds[0] <= bounds[1]:
-        raise InputError(Problem(option, f"expected 0 <= A <= B {unit}, got {text!r}"))
-    return bounds
-
-
 def _load(
     scenario_path: Path | None, map_path: Path | None, scen_path: Path | None, agents: int | None
 ) -> Scenario:
@@ -93,44 +75,6 @@ def _load(
     if agents is not None and agents <= 0:
         raise InputError(Problem("--agents", f"must be positive, got {agents}"))
     return load_movingai_scenario(map_path, scen_path, agents)
-
-
-def _with_policy(scenario: Scenario, name: str | None, policy_settings: dict[str, Any]) -> tuple[PolicyOptions, list[Problem]]:
-    """The scenario's policy with ``--policy`` and the setting flags given applied, and the problems found."""
-    changes = {key: value for key, value in policy_settings.items() if value is not None}
-    if name is not None:
-        changes["name"] = name
-    if not changes:
-        return scenario.policy, []
-    try:
-        return replace(scenario.policy, **changes), []
-    except InputError as error:
-        return scenario.policy, list(error.problems)
-
-
-def _apply_options(
-    scenario: Scenario, policy_name: str | None = None, policy_settings: dict[str, Any] | None = None, **options: object
-) -> Scenario:
-    policy, policy_problems = _with_policy(scenario, policy_name, policy_settings or {})
-    network = scenario.network
-    network_changes: dict[str, object] = {
-        key: options[key] for key in ("loss", "duplicate", "reorder") if options.get(key) is not None
-    }
-    if options.get("delay") is not None:
-        network_changes["delay_min"], network_changes["delay_max"] = parse_range(str(options["delay"]), "--delay")
-    if network_changes:
-        network = NetworkFaults(**{**network.__dict__, **network_changes})
-    changes: dict[str, object] = {"policy": policy, "network": network}
-    for key in ("seed", "max_ticks", "safety", "lifelong"):
-        if options.get(key) is not None:
-            changes[key] = options[key]
-    updated = scenario.with_changes(**changes)
-    problems = scenario_problems(updated) + policy_problems
-    if policy_name is not None and policy_name not in policy_names():
-        problems.append(Problem("--policy", f"unknown policy {policy_name!r}; known: {', '.join(policy_names())}"))
-    if problems:
-        raise InputError(problems)
-    return updated
 
 
 def with_policy_flags(command: Callable[..., None]) -> Callable[..., None]:
@@ -450,10 +394,11 @@ def run(
     )
     console = Console(stderr=json_path == "-", highlight=False)
     try:
-        scenario = _apply_options(
+        scenario = apply_run_options(
             _load(scenario_path, map_path, scen_path, agents),
             policy,
             policy_settings,
+            names=FLAG_NAMES,
             loss=loss,
             delay=delay,
             duplicate=duplicate,
