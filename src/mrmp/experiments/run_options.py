@@ -79,11 +79,11 @@ def delay_range(delay: object, option: str = "delay") -> tuple[int, int]:
     if isinstance(delay, str):
         low, high = parse_range(delay, option)
         return int(low), int(high)
-    low, high = delay if isinstance(delay, tuple | list) and len(delay) == 2 else (delay, delay)
-    whole = all(isinstance(value, int) and not isinstance(value, bool) for value in (low, high))
-    if not (whole and 0 <= low <= high):
+    pair = tuple(delay) if isinstance(delay, tuple | list) and len(delay) == 2 else (delay, delay)
+    bounds = [value for value in pair if isinstance(value, int) and not isinstance(value, bool)]
+    if not (len(bounds) == 2 and 0 <= bounds[0] <= bounds[1]):
         raise InputError(Problem(option, f"expected ticks N or (A, B) with 0 <= A <= B, got {delay!r}"))
-    return low, high
+    return bounds[0], bounds[1]
 
 
 def apply_run_options(
