@@ -618,7 +618,7 @@ def _simulated_run(scenario: Scenario, request: RunRequest, plan: PlanningResult
 
 
 def _live_run(scenario: Scenario, request: RunRequest, plan: PlanningResult | None, console: Console) -> RunResult:
-    """Run ``scenario`` live: one OS process per robot over a loopback network."""
+    """Run ``scenario`` live: one OS process per robot over a loopback network, its progress shown on a terminal."""
     from mrmp.live.launcher import LiveOptions, run_live
 
     options = LiveOptions(
@@ -633,7 +633,13 @@ def _live_run(scenario: Scenario, request: RunRequest, plan: PlanningResult | No
         seed=scenario.seed,
         plan=plan,
     )
-    return run_live(scenario, options, say=lambda text: console.print(text, markup=False))
+    from mrmp.viz.progress import LiveProgressLine
+
+    with LiveProgressLine(console) as progress:
+        return run_live(
+            scenario, options, say=lambda text: console.print(text, markup=False),
+            on_progress=progress.on_progress if console.is_terminal else None,
+        )  # fmt: skip
 
 
 def _output_run(result: RunResult, scenario: Scenario, request: RunRequest, console: Console) -> None:
