@@ -113,15 +113,13 @@ def _version(value: bool) -> None:
 
 
 def _installed_version() -> str:
-    """The installed distribution's version (the package's own when it is not installed)."""
+    """The installed distribution's version."""
     from importlib.metadata import PackageNotFoundError, version
 
     try:
         return version("mrmp")
     except PackageNotFoundError:
-        import mrmp
-
-        return mrmp.__version__
+        return "(not installed: pip install -e . in the checkout)"
 
 
 @app.callback()
