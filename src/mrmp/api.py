@@ -138,15 +138,40 @@ def run(
     return Result(execute_in_simulator(configured, plan, record_messages=record_messages), configured, plan)
 
 
-def animate(result: Result, path: str | os.PathLike[str], show_messages: bool = False) -> Path:
+def animate(
+    result: Result,
+    path: str | os.PathLike[str],
+    show_messages: bool = False,
+    goal_lines: bool = False,
+    colour_by: str | None = None,
+    speed: float = 1.0,
+) -> Path:
     """Write ``result`` as an animation, GIF, SVG or MP4 by ``path``'s suffix; returns the path written.
 
+    The options are those of ``mrmp run --animate``: ``show_messages``
+    draws each tick's messages (a run made with ``record_messages=True``),
+    ``goal_lines`` a line from each robot to its goal, ``colour_by`` colours
+    the robots by ``"robot"``, ``"progress"`` or ``"heading"`` (by default
+    ``"robot"`` for a few robots, ``"progress"`` for a crowd), and ``speed``
+    plays a live run that many times faster than real time.
+
     >>> import tempfile
-    >>> folder = tempfile.mkdtemp()
-    >>> animate(run("examples/thesis-swap.yaml"), Path(folder) / "swap.svg").suffix
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> animate(run("examples/thesis-swap.yaml"), folder / "swap.svg").suffix
     '.svg'
+    >>> drawn = animate(run("examples/thesis-swap.yaml"), folder / "lines.svg", goal_lines=True, colour_by="heading")
+    >>> text = drawn.read_text()
+    >>> 'id="goal-lines"' in text, 'facing north' in text
+    (True, True)
+    >>> animate(run("examples/thesis-swap.yaml"), folder / "x.svg", colour_by="rainbow")
+    Traceback (most recent call last):
+    ...
+    ValueError: colour_by must be one of robot, progress, heading, got 'rainbow'
     """
-    return write_animation(result.scenario.grid, result.run, path, show_messages=show_messages)
+    return write_animation(
+        result.scenario.grid, result.run, path,
+        show_messages=show_messages, goal_lines=goal_lines, colour_by=colour_by, speed=speed,
+    )  # fmt: skip
 
 
 @dataclass(frozen=True)

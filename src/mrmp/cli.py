@@ -100,6 +100,32 @@ def choices(names: Iterable[str]) -> str:
     return "[" + "|".join(names) + "]"
 
 
+def _colourings() -> tuple[str, ...]:
+    from mrmp.viz.colouring import COLOURINGS
+
+    return COLOURINGS
+
+
+def _colour_by_option(panel: str | None = None) -> Any:
+    """The ``--colour-by`` option of ``mrmp run --animate`` and ``mrmp animate``, its choices from the viz's table."""
+    from mrmp.viz.colouring import CROWD
+
+    return typer.Option(
+        help="Colour the robots by their id, the share of their path done, or their heading.",
+        metavar=choices(_colourings()),
+        show_default=f"robot up to {CROWD} robots, else progress",
+        autocompletion=_colourings,
+        rich_help_panel=panel,
+    )
+
+
+def _check_drawing(colour_by: str | None, speed: float) -> None:
+    """Refuse, before the run, a colouring or speed the animation cannot use."""
+    if colour_by is not None and colour_by not in _colourings():
+        raise InputError(Problem("--colour-by", f"unknown colouring {colour_by!r}; known: {', '.join(_colourings())}"))
+    _positive(speed, "--speed")
+
+
 def _planner_names() -> tuple[str, ...]:
     from mrmp.centralized.registry import PLANNER_NAMES
 
@@ -480,6 +506,8 @@ def run(
     animate: Annotated[Path | None, typer.Option(help="Write an animation: .gif, .svg or .mp4 (needs ffmpeg).", rich_help_panel=OUTPUT)] = None,
     show_messages: Annotated[bool, typer.Option("--show-messages", help="Record each tick's messages and draw them in the --animate animation (and the --json result).", rich_help_panel=OUTPUT)] = False,
     goal_lines: Annotated[bool, typer.Option("--goal-lines", help="Draw a line from each robot to its goal in the --animate animation.", rich_help_panel=OUTPUT)] = False,
+    colour_by: Annotated[str | None, _colour_by_option(OUTPUT)] = None,
+    speed: Annotated[float, typer.Option(help="--animate: play a live run this many times faster than real time.", rich_help_panel=OUTPUT)] = 1.0,
     watch: Annotated[bool, typer.Option("--watch", help="Draw the grid in the terminal as the robots move.", rich_help_panel=OUTPUT)] = False,
     watch_fps: Annotated[float, typer.Option(help="--watch: ticks drawn per second.", rich_help_panel=OUTPUT)] = 10.0,
     planner: Annotated[str | None, typer.Option(help="Plan centrally first, then the robots execute the plan.", metavar=choices(_planner_names()), show_default="none: the policy decides", autocompletion=_planner_names, rich_help_panel=PLANNING)] = None,
@@ -497,7 +525,7 @@ def run(
     # --resolve, --heading-aware, --radius, --swap and --search come from PolicyOptions' fields (with_policy_flags)
     request = RunRequest(
         None if json_path is None else str(json_path), animate, show_messages, watch, watch_fps, planner, time_limit, live, transport, time_scale,
-        delay_ms, jitter, miss_line, results, kill or [], unsafe, goal_lines=goal_lines,
+        delay_ms, jitter, miss_line, results, kill or [], unsafe, goal_lines=goal_lines, colour_by=colour_by, speed=speed,
     )
     console = Console(stderr=request.json_path == "-", highlight=False)
     try:
@@ -547,6 +575,8 @@ class RunRequest:
     kill: list[str]
     unsafe: bool
     goal_lines: bool = False
+    colour_by: str | None = None
+    speed: float = 1.0
 
 
 def _validate_run(scenario: Scenario, request: RunRequest) -> None:
@@ -570,6 +600,7 @@ def _validate_run(scenario: Scenario, request: RunRequest) -> None:
         animation_issue = animation_problem(request.animate)
         if animation_issue is not None:
             raise InputError(Problem("--animate", animation_issue))
+        _check_drawing(request.colour_by, request.speed)
     if request.show_messages:
         written = request.animate is not None or request.json_path is not None
         _check_show_messages(scenario, written, request.live, request.planner is not None)
@@ -650,7 +681,8 @@ def _output_run(result: RunResult, scenario: Scenario, request: RunRequest, cons
             from mrmp.viz import write_animation
 
             write_animation(
-                scenario.grid, result, request.animate, show_messages=request.show_messages, goal_lines=request.goal_lines
+                scenario.grid, result, request.animate, show_messages=request.show_messages, goal_lines=request.goal_lines,
+                colour_by=request.colour_by, speed=request.speed,
             )
             console.print(f"animation written to {request.animate}")
     except (MrmpError, OSError) as error:
@@ -755,6 +787,8 @@ def animate_command(
     out: Annotated[Path, typer.Option("--out", help="The animation to write: .gif, .svg or .mp4 (needs ffmpeg).")],
     show_messages: Annotated[bool, typer.Option("--show-messages", help="Draw each tick's messages (runs saved with them).")] = False,
     goal_lines: Annotated[bool, typer.Option("--goal-lines", help="Draw a line from each robot to its goal.")] = False,
+    colour_by: Annotated[str | None, _colour_by_option()] = None,
+    speed: Annotated[float, typer.Option(help="Play a live run this many times faster than real time.")] = 1.0,
 ) -> None:
     """Draw a saved run as an animation."""
     from mrmp.io.results import read_result_json
@@ -765,6 +799,7 @@ def animate_command(
         animation_issue = animation_problem(out)
         if animation_issue is not None:
             raise InputError(Problem("--out", animation_issue))
+        _check_drawing(colour_by, speed)
         result, grid = read_result_json(result_path)
         if grid is None:
             raise InputError(Problem(str(result_path), "no map is stored with this run: save it with mrmp run --json"))
@@ -775,7 +810,7 @@ def animate_command(
     except InputError as error:
         raise _fail(error.problems) from None
     try:
-        write_animation(grid, result, out, show_messages=show_messages, goal_lines=goal_lines)
+        write_animation(grid, result, out, show_messages=show_messages, goal_lines=goal_lines, colour_by=colour_by, speed=speed)
     except (MrmpError, OSError) as error:
         Console(stderr=True).print(f"error: {error}", markup=False)
         raise typer.Exit(2) from None

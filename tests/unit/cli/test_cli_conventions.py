@@ -139,3 +139,17 @@ def test_shell_completion_completes_choices_from_the_tables() -> None:
     assert complete("mrmp run --planner ") == list(PLANNER_NAMES)
     shown = subprocess.run([sys.executable, "-m", "mrmp", "--show-completion", "bash"], capture_output=True, text=True, check=False)
     assert shown.returncode == 0 and "complete -o default -F _mrmp_completion mrmp" in shown.stdout
+
+
+def test_animations_take_the_colouring_and_speed_the_api_takes(tmp_path: Path) -> None:
+    drawn = tmp_path / "swap.svg"
+    result = invoke("run", EXAMPLES / "thesis-swap.yaml", "--animate", drawn, "--colour-by", "heading", "--goal-lines")
+    assert result.exit_code == 0 and "facing north" in drawn.read_text() and 'id="goal-lines"' in drawn.read_text()
+    saved = tmp_path / "swap.json"
+    assert invoke("run", EXAMPLES / "thesis-swap.yaml", "--json", saved).exit_code == 0
+    again = tmp_path / "again.svg"
+    assert invoke("animate", saved, "--out", again, "--colour-by", "heading").exit_code == 0
+    assert "facing north" in again.read_text()
+    for args, fragment in ((["--colour-by", "rainbow"], "--colour-by: unknown colouring 'rainbow'"), (["--speed", "0"], "--speed: must be positive")):
+        refused = invoke("run", EXAMPLES / "thesis-swap.yaml", "--animate", tmp_path / "x.svg", *args)
+        assert refused.exit_code == 2 and fragment in refused.output and not (tmp_path / "x.svg").exists()
