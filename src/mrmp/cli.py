@@ -48,10 +48,18 @@ FLAG = ""
 
 
 def _flags_without_value_type(params: list[Any]) -> list[Any]:
-    """``params`` with their on/off flags (``--help`` too) given an empty metavar, so that help shows no ``<bool>``."""
+    """``params`` with their on/off flags (``--help`` too) given an empty metavar, so that help shows no ``<bool>``.
+
+    Options whose choices come from a table of a heavy module (the colourings
+    of :mod:`mrmp.viz`) get their metavar and default here, on first use, so
+    that commands without them (``mrmp agent``, ``mrmp referee``) start
+    without importing it.
+    """
     for param in params:
         if getattr(param, "is_flag", False) and param.metavar is None:
             param.metavar = FLAG
+        elif param.name in _LATE_DETAILS and param.metavar is None:
+            param.metavar, param.show_default = _LATE_DETAILS[param.name]()
     return params
 
 
@@ -108,15 +116,22 @@ def _colourings() -> tuple[str, ...]:
 
 def _colour_by_option(panel: str | None = None) -> Any:
     """The ``--colour-by`` option of ``mrmp run --animate`` and ``mrmp animate``, its choices from the viz's table."""
-    from mrmp.viz.colouring import CROWD
-
     return typer.Option(
         help="Colour the robots by their id, the share of their path done, or their heading.",
-        metavar=choices(_colourings()),
-        show_default=f"robot up to {CROWD} robots, else progress",
         autocompletion=_colourings,
         rich_help_panel=panel,
     )
+
+
+def _colour_by_details() -> tuple[str, str]:
+    """``--colour-by``'s metavar and default, from :mod:`mrmp.viz.colouring`."""
+    from mrmp.viz.colouring import COLOURINGS, CROWD
+
+    return choices(COLOURINGS), f"robot up to {CROWD} robots, else progress"
+
+
+_LATE_DETAILS: dict[str, Callable[[], tuple[str, str]]] = {"colour_by": _colour_by_details}
+"""Options whose metavar and shown default are looked up when the command's parameters are first listed."""
 
 
 def _check_drawing(colour_by: str | None, speed: float) -> None:
