@@ -49,6 +49,9 @@ class AstarPolicy:
     """
 
     name = "astar"
+    interaction_radius = 2
+    """Conflicts are peers whose Present or Next is the robot's Next (within two cells, as for the thesis's
+    rule); the parked robots it plans around are those it knows of, within the same radius."""
     own_search = "astar"
     """The search :data:`~mrmp.core.options.POLICY_DEFAULT_SEARCH` stands for."""
 

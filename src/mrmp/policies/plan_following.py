@@ -14,6 +14,13 @@ planner of :mod:`mrmp.centralized` returns such plans, and
 :func:`~mrmp.centralized.dependencies.action_dependencies` refuses any other), whose
 dependency graph is then acyclic, never deadlocks.
 
+Its robot's states need to reach no robot near it (the policy reads no
+peer's cells: ``interaction_radius`` 0), only the robots whose moves wait for
+its moves: each state goes to the *dependents* of the last
+:data:`LISTENER_WINDOW` moves it completed (:meth:`PlanFollowingPolicy.listeners`),
+so a dependent hears a completed move in the state of every tick while the
+robot makes its next moves, lost copies made up by the following ones.
+
 The dependencies themselves are computed from the plan by
 :func:`mrmp.centralized.dependencies.action_dependencies`; this policy only
 follows them, knowing its peers only through their messages.
@@ -41,6 +48,9 @@ from collections.abc import Mapping, Sequence
 from mrmp.core.cell import Cell
 from mrmp.policies.base import Decision, Situation
 
+LISTENER_WINDOW = 8
+"""How many of its last completed moves a robot's states tell their dependents of."""
+
 
 class PlanFollowingPolicy:
     """Execute one robot's share of a central plan, honouring its action dependencies.
@@ -52,13 +62,23 @@ class PlanFollowingPolicy:
     dependencies:
         For a move index, the ``(robot, progress)`` pairs it waits for: robot
         ``robot`` must have completed at least ``progress`` moves.
+    dependents:
+        For a number of completed moves ``k`` of this robot, the robots one of
+        whose moves waits for it to have completed ``k`` moves (whom its states
+        must reach); when omitted, unknown, and its states go to every peer.
     """
 
     name = "plan"
 
-    def __init__(self, moves: Sequence[Cell], dependencies: Mapping[int, Sequence[tuple[int, int]]]) -> None:
+    def __init__(
+        self,
+        moves: Sequence[Cell],
+        dependencies: Mapping[int, Sequence[tuple[int, int]]],
+        dependents: Mapping[int, Sequence[int]] | None = None,
+    ) -> None:
         self.moves = list(moves)
         self.dependencies = {move: list(needs) for move, needs in dependencies.items()}
+        self.dependents = None if dependents is None else {done: tuple(robots) for done, robots in dependents.items()}
         self.done = 0
         self.waits_for: list[int] = []
 
@@ -70,11 +90,30 @@ class PlanFollowingPolicy:
         """Whether every dependency of the next move is met, by what the peers have said."""
         waiting = []
         for robot, progress in self.dependencies.get(self.done, ()):
-            peer = situation.peers.get(robot)
-            if peer is None or peer.progress < progress:
+            if situation.progress_of(robot) < progress:
                 waiting.append(robot)
         self.waits_for = waiting
         return not waiting
+
+    @property
+    def interaction_radius(self) -> int | None:
+        """0 when the dependents are known (the policy reads no peer's cells), else None (states go fleet-wide)."""
+        return None if self.dependents is None else 0
+
+    def listeners(self) -> tuple[int, ...]:
+        """The robots waiting for one of this robot's last :data:`LISTENER_WINDOW` completed moves.
+
+        >>> policy = PlanFollowingPolicy([(0, 1), (0, 2)], {}, dependents={1: [3], 2: [4, 3]})
+        >>> policy.done = 2
+        >>> policy.listeners()
+        (3, 4)
+        """
+        if self.dependents is None:
+            return ()
+        robots: set[int] = set()
+        for done in range(max(1, self.done - LISTENER_WINDOW + 1), self.done + 1):
+            robots.update(self.dependents.get(done, ()))
+        return tuple(sorted(robots))
 
     def intend(self, situation: Situation) -> Cell:
         """The next cell of the plan once its dependencies are met, else the present cell."""
