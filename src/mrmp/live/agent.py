@@ -13,7 +13,10 @@ clock:
 * when the body reports the new cell, announce at once (the client thread
   "sends the updated information as soon as it is updated");
 * send the state at least every ``heartbeat`` seconds, so that lost messages
-  are repaired and silent robots are noticed;
+  are repaired and silent robots are noticed: to the peers believed within the
+  policy's interaction radius plus what two robots close between two fleet
+  heartbeats, and to every peer every ``fleet_heartbeat`` seconds
+  (:mod:`mrmp.live.driver`; a policy without an interaction radius, every time);
 * run the safety layer's timers (resend or abandon a claim).
 
 Before its first step a robot waits (at most ``start_wait`` seconds) until it
@@ -36,9 +39,9 @@ from enum import Enum
 from mrmp.core.cell import Cell
 from mrmp.core.scenario import Scenario
 from mrmp.live.body import Body
-from mrmp.live.driver import AgentReport, AgentTiming, LiveDriver
+from mrmp.live.driver import AgentReport, AgentTiming, LiveDriver, live_state_radius
 from mrmp.live.transport import Transport
-from mrmp.policies.base import Policy
+from mrmp.policies.base import Policy, interaction_radius
 from mrmp.protocol.auth import Opener, Sealer
 from mrmp.robot.robot import Outgoing, Robot
 from mrmp.sim.policy_table import make_policy
@@ -87,16 +90,19 @@ class Agent(LiveDriver):
         policy: Policy | None = None,
     ) -> None:
         super().__init__(scenario, index, transport, body, sealer, opener, timing, seed, clock)
+        rule = policy if policy is not None else make_policy(scenario.policy, scenario.timing)
+        radius = interaction_radius(rule)
         self.robot: Robot = Robot(
             scenario.robots[index],
             index,
             scenario.grid,
-            policy if policy is not None else make_policy(scenario.policy, scenario.timing),
+            rule,
             [robot.start for robot in scenario.robots],
             guarded=guarded,
             claim_timeout=timing.claim_timeout,
             retry_interval=timing.claim_retry,
             silence_timeout=timing.silence_timeout,
+            state_radius=None if radius is None else live_state_radius(radius, timing, self.cell_seconds),
         )
         self._phase = Phase.LISTEN
         self._next_decision = 0.0
@@ -122,6 +128,11 @@ class Agent(LiveDriver):
 
     def _fleet_wait_messages(self) -> list[Outgoing]:
         return [Outgoing(self.robot.state_message())]
+
+    def _believed_within(self, radius: int) -> list[int]:
+        x, y = self.robot.present
+        peers = self.robot.belief.peers.values()
+        return [peer.index for peer in peers if abs(peer.present[0] - x) + abs(peer.present[1] - y) <= radius]
 
     def _safety_counts(self) -> dict[str, int]:
         robot = self.robot

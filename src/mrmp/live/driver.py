@@ -11,7 +11,14 @@ policy's driver (:class:`mrmp.live.agent.Agent`,
 
 Every ``poll`` the loop hands the brain the queued messages (queueing its
 answers for the client thread), runs the policy's step, runs the brain's timers, and sends the state
-when nothing was sent for ``heartbeat`` seconds. Before its first step a robot
+when nothing was sent for ``heartbeat`` seconds. UDP unicast has no radio, so a
+radius broadcast (an :class:`~mrmp.robot.messaging.Outgoing` with ``radius``)
+goes to the peers the brain believes within the radius; for discovery, the
+state goes to every peer once every ``fleet_heartbeat`` seconds. A brain's
+state radius is its interaction radius plus the cells two robots can close
+between two fleet heartbeats (:func:`live_state_radius`), so a robot coming
+near is heard of before it is within the interaction radius
+(``docs/protocol.md``, "Neighbourhoods"). Before its first step a robot
 waits (at most ``start_wait`` seconds) until it has heard from every peer, so
 that a fleet whose processes start one by one begins together; its clock starts
 then. The run ends when this robot and every peer have arrived (and a short
@@ -22,6 +29,7 @@ or on a stop request.
 
 from __future__ import annotations
 
+import math
 import queue
 import threading
 import time
@@ -47,6 +55,7 @@ class AgentTiming:
 
     listen_time: float = 0.05
     heartbeat: float = 0.2
+    fleet_heartbeat: float = 1.0
     claim_retry: float = 0.15
     claim_timeout: float = 1.0
     silence_timeout: float = 1.5
@@ -55,6 +64,20 @@ class AgentTiming:
     poll: float = 0.004
     timeout: float = 120.0
     start_wait: float = 15.0
+
+
+def live_state_radius(interaction: int, timing: AgentTiming, cell_seconds: float) -> int:
+    """The radius (cells) of a live robot's states: ``interaction`` plus what two robots close in a fleet heartbeat.
+
+    Between two fleet-wide states each of two robots can drive
+    ``fleet_heartbeat / cell_seconds`` cells toward the other; a robot that
+    addresses every peer it believes within this radius therefore reaches every
+    peer that can have come within ``interaction`` cells since it last heard of it.
+
+    >>> live_state_radius(2, AgentTiming(), cell_seconds=0.4)
+    8
+    """
+    return interaction + 2 * math.ceil(timing.fleet_heartbeat / cell_seconds)
 
 
 @dataclass
@@ -163,6 +186,8 @@ class LiveDriver:
         self._lock = threading.Lock()
         self._peers = len(scenario.robots) - 1
         self._client = ClientThread(transport, name=f"robot-{index}-client")
+        self.cell_seconds = scenario.timing.cell_time / getattr(body, "time_scale", 1.0)
+        """Seconds the body takes for a cell (a body without a time scale runs in real time)."""
 
     # -- what a policy's driver supplies ----------------------------------------------------
 
@@ -192,6 +217,10 @@ class LiveDriver:
 
     def _fleet_wait_messages(self) -> list[Outgoing]:
         """The state to send every heartbeat while waiting for the fleet."""
+        raise NotImplementedError
+
+    def _believed_within(self, radius: int) -> list[int]:
+        """The peers the brain believes within ``radius`` cells of itself (where a radius broadcast goes)."""
         raise NotImplementedError
 
     def _begin(self, started: float) -> None:
@@ -245,6 +274,9 @@ class LiveDriver:
         report, client = self.report, self._client
         for item in outgoing:
             data = self.sealer.seal(item.message)
+            if item.radius is not None:
+                near = self._believed_within(item.radius)
+                item = item._replace(recipients=(*near, *(peer for peer in item.recipients or () if peer not in near)))
             if item.recipients is None:
                 client.send(data, None)
                 report.messages_sent += self._peers
@@ -274,8 +306,8 @@ class LiveDriver:
         if on_progress is not None:  # the launcher learns at once when this robot's run began
             self._fill_report(started)
             on_progress(report)
-        self._send(self._state_messages(started))
-        last_state = started
+        self._send(fleet_wide(self._state_messages(started)))
+        last_state = last_fleet_state = started
         self._begin(started)
         everyone_done_since: float | None = None
         last_progress = started
@@ -289,7 +321,10 @@ class LiveDriver:
                 if self._step(now, started):
                     last_state = now
                 self._send(self.robot.expire(now))
-                if now - last_state >= timing.heartbeat:
+                if now - last_fleet_state >= timing.fleet_heartbeat:
+                    self._send(fleet_wide(self._state_messages(now)))
+                    last_state = last_fleet_state = now
+                elif now - last_state >= timing.heartbeat:
                     self._send(self._state_messages(now))
                     last_state = now
                 if self._everyone_done(now):
@@ -360,3 +395,13 @@ class LiveDriver:
         if isinstance(self.transport, FaultyTransport):
             report.faults = dict(self.transport.counts.__dict__)
         report.safety = self._safety_counts()
+
+
+def fleet_wide(outgoing: list[Outgoing]) -> list[Outgoing]:
+    """``outgoing`` addressed to every peer (the fleet heartbeat).
+
+    >>> from mrmp.protocol.messages import StateMessage
+    >>> fleet_wide([Outgoing(StateMessage(0, 1, (0, 0), (0, 1)), (2,), 3)])[0].fleet_wide
+    True
+    """
+    return [item._replace(recipients=None, radius=None) for item in outgoing]
