@@ -255,19 +255,17 @@ def action_dependencies(paths: Sequence[Sequence[Cell]]) -> tuple[list[list[Cell
 
 def action_dependents(
     dependencies: Sequence[Mapping[int, Sequence[tuple[int, int]]]],
-) -> list[dict[int, list[int]]]:
-    """The dependencies turned around: per robot, for a number of its completed moves, the robots waiting for it.
+) -> list[dict[int, list[tuple[int, int]]]]:
+    """The dependencies turned around: per robot, for a number of its completed moves, the ``(robot, move)`` waiting for it.
 
     >>> action_dependents([{0: [(1, 1)]}, {}, {2: [(1, 1), (0, 1)]}])
-    [{1: [2]}, {1: [0, 2]}, {}]
+    [{1: [(2, 2)]}, {1: [(0, 0), (2, 2)]}, {}]
     """
-    dependents: list[dict[int, list[int]]] = [{} for _ in dependencies]
+    dependents: list[dict[int, list[tuple[int, int]]]] = [{} for _ in dependencies]
     for robot, needs in enumerate(dependencies):
-        for waits in needs.values():
+        for move, waits in sorted(needs.items()):
             for other, progress in waits:
-                waiting = dependents[other].setdefault(progress, [])
-                if robot not in waiting:
-                    waiting.append(robot)
+                dependents[other].setdefault(progress, []).append((robot, move))
     return dependents
 
 

@@ -67,6 +67,7 @@ class AstarPolicy:
         self.heading_aware = heading_aware
         self.timing = timing or Timing()
         self._path: list[Cell] = []
+        self._parked: dict[int, Cell] = {}
         self.replans = 0
 
     def _plan(self, situation: Situation, blocked: frozenset[Cell] = frozenset()) -> list[Cell] | None:
@@ -98,7 +99,7 @@ class AstarPolicy:
             self._advance(intended)
             return Decision(intended, "clear")
         conflict_ids = tuple(peer.index for peer in conflicts)
-        parked = [peer for peer in situation.peers.values() if peer.parked]
+        parked = self._remember_parked(situation)
         blocked_by_parked = any(peer.parked for peer in conflicts)
         if not blocked_by_parked:
             if outranks_all(present, situation.index, conflicts):
@@ -106,7 +107,7 @@ class AstarPolicy:
                 return Decision(intended, "priority", conflict_ids)
             if self.resolve == "wait":
                 return Decision(present, "wait", conflict_ids)
-        avoid = frozenset(cell for peer in [*conflicts, *parked] for cell in (peer.present, peer.next))
+        avoid = frozenset(cell for peer in conflicts for cell in (peer.present, peer.next)) | parked
         self.replans += 1
         path = self._plan(situation, blocked=avoid)
         if path is None or len(path) < 2 or path[1] in claimed_cells(situation.peers):
@@ -115,6 +116,17 @@ class AstarPolicy:
         self._path = path
         self._advance(step)
         return Decision(step, "divert", conflict_ids)
+
+    def _remember_parked(self, situation: Situation) -> frozenset[Cell]:
+        """The cells of the parked robots this robot knows of: those it sees now, and those it saw parked
+        and has not heard of since (a robot hearing only its neighbourhood keeps them when it moves on)."""
+        remembered = self._parked
+        for index, peer in situation.peers.items():
+            if peer.parked:
+                remembered[index] = peer.present
+            else:
+                remembered.pop(index, None)
+        return frozenset(remembered.values())
 
     def _advance(self, entered: Cell) -> None:
         if len(self._path) > 1 and self._path[1] == entered:

@@ -123,11 +123,15 @@ def interaction_radius(policy: object) -> int | None:
     return radius if isinstance(radius, int) else None
 
 
-def listeners(policy: object) -> Iterable[int]:
+def listeners(policy: object, heard: Iterable[int] = (), progress: Mapping[int, int] | None = None) -> Iterable[int]:
     """The peers beyond the interaction radius that must hear this robot's state now (policy method ``listeners``).
+
+    ``heard`` are the peers heard from since the robot's last state and
+    ``progress`` the most moves each peer is known to have completed, for a
+    policy that answers the peers that wait for it.
 
     >>> list(listeners(object()))
     []
     """
     method = getattr(policy, "listeners", None)
-    return method() if callable(method) else ()
+    return method(heard, progress) if callable(method) else ()

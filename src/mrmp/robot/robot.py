@@ -126,6 +126,7 @@ class Robot(MessageEndpoint):
         self.wanted: Cell | None = None
         self.moving = False
         self.belief = Belief()
+        self._heard_since: set[int] = set()
         self.safety = SafetyLayer(
             index, starts, claim_timeout=claim_timeout, retry_interval=retry_interval, keep_releases=guarded
         )
@@ -178,7 +179,9 @@ class Robot(MessageEndpoint):
             self.intended = self.policy.intend(self.situation())
         if self.state_radius is None:
             return [Outgoing(self.state_message())]
-        return [Outgoing(self.state_message(), tuple(listeners(self.policy)), self.state_radius)]
+        heard, self._heard_since = self._heard_since, set()
+        extra = tuple(listeners(self.policy, heard, self.belief.progress))
+        return [Outgoing(self.state_message(), extra, self.state_radius)]
 
     def decide(self, now: float) -> list[Outgoing]:
         """Apply the policy; when guarded, return the claim for the chosen cell."""
@@ -242,6 +245,8 @@ class Robot(MessageEndpoint):
     @handlers.on(StateMessage)
     def _take_state(self, message: StateMessage, now: float) -> list[Outgoing]:
         self.belief.update(message, now)
+        if self.state_radius is not None:
+            self._heard_since.add(message.sender)
         return []
 
     @handlers.on(ClaimMessage)
