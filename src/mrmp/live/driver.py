@@ -22,7 +22,9 @@ near is heard of before it is within the interaction radius
 waits (at most ``start_wait`` seconds) until it has heard from every peer, so
 that a fleet whose processes start one by one begins together; its clock starts
 then. The run ends when this robot and every peer have arrived (and a short
-linger has passed so that late requests are still answered), when every peer
+linger has passed so that late requests are still answered, at least a fleet
+heartbeat, so that a far peer that has left its goal again is heard of; the
+robot then sends its state to every peer), when every peer
 that has not arrived has been silent for ``give_up_after`` seconds, on timeout,
 or on a stop request.
 """
@@ -311,6 +313,7 @@ class LiveDriver:
         self._begin(started)
         everyone_done_since: float | None = None
         last_progress = started
+        linger = max(timing.linger, timing.fleet_heartbeat + timing.heartbeat)  # a far peer's news takes a fleet heartbeat
         try:
             while not self.stop_requested.is_set():
                 now = clock()
@@ -329,8 +332,9 @@ class LiveDriver:
                     last_state = now
                 if self._everyone_done(now):
                     everyone_done_since = everyone_done_since if everyone_done_since is not None else now
-                    if now - everyone_done_since >= timing.linger:
+                    if now - everyone_done_since >= linger:
                         report.stop_reason = "all arrived" if not report.silent_peers else "arrived; peers silent"
+                        self._send(fleet_wide(self._state_messages(now)))  # every peer's last news of it is fresh
                         break
                 else:
                     everyone_done_since = None
