@@ -76,7 +76,7 @@ def safety_timers(delay_max: int) -> tuple[int, int]:
     return retry, 3 * retry + 1
 
 
-LOSS_LEASE = 3
+LOSS_LEASE = 2
 """Extra ticks a robot keeps a peer's state on a lossy network: it forgets a peer only after that many more
 heartbeats in a row were lost."""
 
@@ -85,20 +85,22 @@ def neighbourhood(policy: Policy, faults: NetworkFaults) -> tuple[int | None, in
     """The state radius and knowledge lease (ticks) of a robot running ``policy`` over a network with ``faults``.
 
     The lease covers the network's longest delay (and :data:`LOSS_LEASE` more
-    heartbeats when it loses messages); the radius is the policy's interaction
-    radius plus the lease, the farthest a peer heard within the lease can have
-    come meanwhile (``docs/protocol.md``, "Neighbourhoods"). A policy without
-    an interaction radius: (None, None), states to every peer, kept for ever.
+    heartbeats when it loses messages). The radius is the policy's interaction
+    radius plus twice the lease: two robots approaching each other close two
+    cells a tick, so every state either sent in the last ``lease`` ticks by a
+    robot now within the interaction radius reached this robot
+    (``docs/protocol.md``, "Neighbourhoods"). A policy without an interaction
+    radius: (None, None), states to every peer, kept for ever.
 
     >>> from mrmp.policies.thesis import ThesisPolicy
     >>> neighbourhood(ThesisPolicy(), NetworkFaults()), neighbourhood(ThesisPolicy(), NetworkFaults(loss=0.1, delay_max=2))
-    ((2, 0), (7, 5))
+    ((2, 0), (10, 4))
     """
     radius = interaction_radius(policy)
     if radius is None:
         return None, None
     lease = faults.delay_max + (LOSS_LEASE if faults.loss > 0 else 0)
-    return radius + lease, lease
+    return radius + 2 * lease, lease
 
 
 class LockstepSimulator:
