@@ -26,11 +26,15 @@ from __future__ import annotations
 
 from mrmp.core.cell import Cell
 from mrmp.core.errors import NoPathError
+from mrmp.core.heading import Heading
 from mrmp.core.scenario import Timing
 from mrmp.policies.base import Decision, Situation
 from mrmp.policies.priority import claimed_cells, conflicting_peers, outranks_all
 from mrmp.search.graph import Planner
 from mrmp.search.planners import astar
+
+PLAN_CACHE = 64
+"""How many plans around the static obstacles alone a robot keeps (a robot refused a cell plans from it again)."""
 
 
 class AstarPolicy:
@@ -68,17 +72,27 @@ class AstarPolicy:
         self.timing = timing or Timing()
         self._path: list[Cell] = []
         self._parked: dict[int, Cell] = {}
+        self._unblocked: dict[tuple[Cell, Cell, Heading | None], tuple[Cell, ...] | None] = {}
         self.replans = 0
 
     def _plan(self, situation: Situation, blocked: frozenset[Cell] = frozenset()) -> list[Cell] | None:
         heading = situation.heading if self.heading_aware else None
+        key = (situation.present, situation.goal, heading)
+        if not blocked and key in self._unblocked:  # the map is static and the search deterministic
+            cached = self._unblocked[key]
+            return None if cached is None else list(cached)
         try:
             result = self.search(
                 situation.grid, situation.present, situation.goal, blocked=blocked, heading=heading, timing=self.timing
             )
         except NoPathError:
-            return None
-        return list(result.path)
+            result = None
+        path = None if result is None else tuple(result.path)
+        if not blocked:
+            if len(self._unblocked) >= PLAN_CACHE:
+                self._unblocked.clear()
+            self._unblocked[key] = path
+        return None if path is None else list(path)
 
     def intend(self, situation: Situation) -> Cell:
         """The next cell of the current plan, planning afresh when off it."""
