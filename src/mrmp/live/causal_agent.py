@@ -38,7 +38,7 @@ from mrmp.core.cell import Cell
 from mrmp.core.scenario import Scenario
 from mrmp.core.seeds import Stream, stream_random
 from mrmp.live.body import Body
-from mrmp.live.driver import AgentTiming, LiveDriver, fleet_wide, live_state_radius
+from mrmp.live.driver import AgentTiming, LiveDriver, believed_near, fleet_wide, live_state_radius
 from mrmp.live.transport import Transport
 from mrmp.protocol.auth import Opener, Sealer
 from mrmp.robot.causal_pibt import LOCK_RADIUS, CausalRobot
@@ -86,7 +86,7 @@ class CausalAgent(LiveDriver):
             lock_timeout=max(1.0, 20 * retry),
             claim_timeout=timing.claim_timeout,
             heading=spec.heading,
-            state_radius=live_state_radius(LOCK_RADIUS, timing, self.cell_seconds),
+            state_radius=live_state_radius(LOCK_RADIUS),
         )
         self._next_activation = 0.0
         self._extended_at: float | None = None
@@ -117,7 +117,12 @@ class CausalAgent(LiveDriver):
         return fleet_wide(self.robot.heartbeat())
 
     def _believed_within(self, radius: int) -> list[int]:
-        return sorted(self.robot.peers.near(self.robot.tail, radius))
+        now, peers = self.clock(), self.robot.peers
+        known = (
+            (index, peer.cells[0], peers.heard.get(index, (self.report.started_at, False))[0])
+            for index, peer in peers.known.items()
+        )
+        return believed_near(known, self.robot.tail, radius, now, self.cell_seconds)
 
     def _safety_counts(self) -> dict[str, int]:
         robot = self.robot

@@ -14,10 +14,10 @@ answers for the client thread), runs the policy's step, runs the brain's timers,
 when nothing was sent for ``heartbeat`` seconds. UDP unicast has no radio, so a
 radius broadcast (an :class:`~mrmp.robot.messaging.Outgoing` with ``radius``)
 goes to the peers the brain believes within the radius; for discovery, the
-state goes to every peer once every ``fleet_heartbeat`` seconds. A brain's
-state radius is its interaction radius plus the cells two robots can close
-between two fleet heartbeats (:func:`live_state_radius`), so a robot coming
-near is heard of before it is within the interaction radius
+state goes to every peer once every ``fleet_heartbeat`` seconds. A peer is
+believed within the radius when its last known cell is, widened by the cells it
+can have driven since it was heard (:func:`believed_near`), so a robot coming
+near is addressed before it is within the interaction radius
 (``docs/protocol.md``, "Neighbourhoods"). Before its first step a robot
 waits (at most ``start_wait`` seconds) until it has heard from every peer, so
 that a fleet whose processes start one by one begins together; its clock starts
@@ -36,7 +36,7 @@ import queue
 import threading
 import time
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
@@ -68,18 +68,38 @@ class AgentTiming:
     start_wait: float = 15.0
 
 
-def live_state_radius(interaction: int, timing: AgentTiming, cell_seconds: float) -> int:
-    """The radius (cells) of a live robot's states: ``interaction`` plus what two robots close in a fleet heartbeat.
+LIVE_SLACK = 2
+"""Cells added to a live robot's interaction radius: a body between two cells, a state in flight."""
 
-    Between two fleet-wide states each of two robots can drive
-    ``fleet_heartbeat / cell_seconds`` cells toward the other; a robot that
-    addresses every peer it believes within this radius therefore reaches every
-    peer that can have come within ``interaction`` cells since it last heard of it.
 
-    >>> live_state_radius(2, AgentTiming(), cell_seconds=0.4)
-    8
+def live_state_radius(interaction: int) -> int:
+    """The radius (cells) of a live robot's states: its interaction radius plus :data:`LIVE_SLACK`.
+
+    >>> live_state_radius(2)
+    4
     """
-    return interaction + 2 * math.ceil(timing.fleet_heartbeat / cell_seconds)
+    return interaction + LIVE_SLACK
+
+
+def believed_near(
+    peers: Iterable[tuple[int, Cell, float]], here: Cell, radius: int, now: float, cell_seconds: float
+) -> list[int]:
+    """The peers to address with a radius broadcast: each ``(index, last known cell, heard at)`` whose cell is
+    within ``radius`` cells of ``here`` plus the cells it can have driven since it was heard.
+
+    A peer within ``radius`` now was, when last heard ``age`` seconds ago, at most
+    ``ceil(age / cell_seconds)`` cells further: so it is addressed, and a peer
+    known freshly is addressed only when it is near.
+
+    >>> believed_near([(1, (0, 6), 9.9), (2, (0, 6), 8.0), (3, (0, 20), 8.0)], (0, 0), 4, now=10.0, cell_seconds=0.5)
+    [2]
+    """
+    x, y = here
+    return [
+        index
+        for index, (cx, cy), heard_at in peers
+        if abs(cx - x) + abs(cy - y) <= radius + math.ceil(max(0.0, now - heard_at) / cell_seconds)
+    ]
 
 
 @dataclass

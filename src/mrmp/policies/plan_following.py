@@ -52,7 +52,6 @@ from mrmp.core.cell import Cell
 from mrmp.policies.base import Decision, Situation
 
 
-
 class PlanFollowingPolicy:
     """Execute one robot's share of a central plan, honouring its action dependencies.
 

@@ -34,7 +34,7 @@ Examples
 from __future__ import annotations
 
 from dataclasses import dataclass
-from typing import Self
+from typing import Any, Self
 
 from mrmp.core.cell import Cell
 from mrmp.core.heading import Heading
@@ -62,9 +62,10 @@ class Message:
         >>> ClaimMessage(2, 0, 5, (1, 1)).with_seq(9)
         ClaimMessage(sender=2, seq=9, claim=5, cell=(1, 1))
         """
-        cls = type(self)
-        names = cls.__slots__  # a slotted dataclass: its fields, in order
-        return cls(self.sender, seq, *[getattr(self, name) for name in names[2:]])  # type: ignore[arg-type]
+        cls: Any = type(self)
+        names: tuple[str, ...] = cls.__slots__  # a slotted dataclass: its fields, in order
+        copy: Self = cls(self.sender, seq, *[getattr(self, name) for name in names[2:]])
+        return copy
 
 
 class PibtMessage(Message):

@@ -36,7 +36,7 @@ from mrmp.protocol.messages import StateMessage
 class Belief:
     """The latest known state of every peer that has been heard from."""
 
-    __slots__ = ("peers", "progress", "stale_messages", "_seqs")
+    __slots__ = ("_seqs", "peers", "progress", "stale_messages")
 
     def __init__(self) -> None:
         self.peers: dict[int, PeerState] = {}

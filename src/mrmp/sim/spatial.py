@@ -42,7 +42,7 @@ class SpatialIndex:
         Side of a bucket, in cells (at least 1).
     """
 
-    __slots__ = ("size", "_buckets", "_cells")
+    __slots__ = ("_buckets", "_cells", "size")
 
     def __init__(self, cells: Sequence[Cell], size: int = DEFAULT_BUCKET) -> None:
         if size < 1:
