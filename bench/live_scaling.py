@@ -8,7 +8,7 @@ decision to the start of the move, which includes the claim's round trip)
 p50/p99, and the wall-clock makespan against the ideal (the longest single-robot
 path time at the run's speed).
 
-Usage: python bench/live_scaling.py [--sizes 2,8,16,32] [--time-scale 5] [--transport udp]
+Usage: python bench/live_scaling.py [--sizes 2,8,16,32] (48 and more work too) [--time-scale 5] [--transport udp]
 """
 
 from __future__ import annotations

@@ -47,7 +47,7 @@ mrmp.centralized.dependencies.PlanDeadlockError: the plan deadlocks when execute
 
 from __future__ import annotations
 
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 
 from mrmp.core.cell import Cell
@@ -57,6 +57,7 @@ __all__ = [
     "PlanDeadlockError",
     "Rotation",
     "action_dependencies",
+    "action_dependents",
     "check_executable",
     "find_rotations",
     "plan_moves",
@@ -250,6 +251,22 @@ def action_dependencies(paths: Sequence[Sequence[Cell]]) -> tuple[list[list[Cell
     moves = [cells for cells, _ in moves_and_ticks]
     check_executable(moves, dependencies, [ticks for _, ticks in moves_and_ticks])
     return moves, dependencies
+
+
+def action_dependents(
+    dependencies: Sequence[Mapping[int, Sequence[tuple[int, int]]]],
+) -> list[dict[int, list[tuple[int, int]]]]:
+    """The dependencies turned around: per robot, for a number of its completed moves, the ``(robot, move)`` waiting for it.
+
+    >>> action_dependents([{0: [(1, 1)]}, {}, {2: [(1, 1), (0, 1)]}])
+    [{1: [(2, 2)]}, {1: [(0, 0), (2, 2)]}, {}]
+    """
+    dependents: list[dict[int, list[tuple[int, int]]]] = [{} for _ in dependencies]
+    for robot, needs in enumerate(dependencies):
+        for move, waits in sorted(needs.items()):
+            for other, progress in waits:
+                dependents[other].setdefault(progress, []).append((robot, move))
+    return dependents
 
 
 def check_executable(

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from mrmp.centralized.dependencies import action_dependencies
+from mrmp.centralized.dependencies import action_dependencies, action_dependents
 from mrmp.centralized.plan import PlanningResult
 from mrmp.core.errors import MrmpError
 from mrmp.policies.plan_following import PlanFollowingPolicy
@@ -36,7 +36,10 @@ def plan_policies(plan: PlanningResult) -> list[PlanFollowingPolicy]:
     if plan.paths is None:
         raise MrmpError(f"{plan.planner}: no plan to execute ({plan.status}: {plan.message})")
     moves, dependencies = action_dependencies(plan.paths)
-    return [PlanFollowingPolicy(robot_moves, needs) for robot_moves, needs in zip(moves, dependencies)]
+    return [
+        PlanFollowingPolicy(robot_moves, needs, waiting)
+        for robot_moves, needs, waiting in zip(moves, dependencies, action_dependents(dependencies))
+    ]
 
 
 def distributed_bytes(policies: Sequence[PlanFollowingPolicy]) -> int:

@@ -11,9 +11,13 @@ clock:
 * announce Present and Next; listen for ``listen_time``; decide (and, guarded,
   claim the chosen cell); start the body's move once allowed;
 * when the body reports the new cell, announce at once (the client thread
-  "sends the updated information as soon as it is updated");
+  "sends the updated information as soon as it is updated"); after a pause,
+  announce again, sending the state only when it changed or a heartbeat is due;
 * send the state at least every ``heartbeat`` seconds, so that lost messages
-  are repaired and silent robots are noticed;
+  are repaired and silent robots are noticed: to the peers believed within the
+  policy's interaction radius (widened by what each can have driven since it was
+  heard), and to every peer every ``fleet_heartbeat`` seconds
+  (:mod:`mrmp.live.driver`; a policy without an interaction radius, every time);
 * run the safety layer's timers (resend or abandon a claim).
 
 Before its first step a robot waits (at most ``start_wait`` seconds) until it
@@ -36,9 +40,9 @@ from enum import Enum
 from mrmp.core.cell import Cell
 from mrmp.core.scenario import Scenario
 from mrmp.live.body import Body
-from mrmp.live.driver import AgentReport, AgentTiming, LiveDriver
+from mrmp.live.driver import AgentReport, AgentTiming, LiveDriver, believed_near, live_state_radius
 from mrmp.live.transport import Transport
-from mrmp.policies.base import Policy
+from mrmp.policies.base import Policy, interaction_radius
 from mrmp.protocol.auth import Opener, Sealer
 from mrmp.robot.robot import Outgoing, Robot
 from mrmp.sim.policy_table import make_policy
@@ -87,20 +91,25 @@ class Agent(LiveDriver):
         policy: Policy | None = None,
     ) -> None:
         super().__init__(scenario, index, transport, body, sealer, opener, timing, seed, clock)
+        rule = policy if policy is not None else make_policy(scenario.policy, scenario.timing)
+        radius = interaction_radius(rule)
         self.robot: Robot = Robot(
             scenario.robots[index],
             index,
             scenario.grid,
-            policy if policy is not None else make_policy(scenario.policy, scenario.timing),
+            rule,
             [robot.start for robot in scenario.robots],
             guarded=guarded,
             claim_timeout=timing.claim_timeout,
             retry_interval=timing.claim_retry,
             silence_timeout=timing.silence_timeout,
+            state_radius=None if radius is None else live_state_radius(radius),
         )
         self._phase = Phase.LISTEN
         self._next_decision = 0.0
         self._decided_at = 0.0
+        self._said: tuple[object, ...] | None = None
+        self._said_at = 0.0
 
     # -- what the driver reads of the brain --------------------------------------------------
 
@@ -123,11 +132,26 @@ class Agent(LiveDriver):
     def _fleet_wait_messages(self) -> list[Outgoing]:
         return [Outgoing(self.robot.state_message())]
 
+    def _believed_within(self, radius: int) -> list[int]:
+        peers = ((peer.index, peer.present, peer.heard_at) for peer in self.robot.belief.peers.values())
+        return believed_near(peers, self.robot.present, radius, self.clock(), self.cell_seconds)
+
     def _safety_counts(self) -> dict[str, int]:
         robot = self.robot
         return {**robot.safety.stats.__dict__, "stale_states": robot.belief.stale_messages}
 
     # -- the step ----------------------------------------------------------------------------
+
+    def _announce_if_new(self, now: float) -> bool:
+        """Announce again after a pause; send the state only when it changed or a heartbeat is due (else the peers have it)."""
+        robot = self.robot
+        outgoing = robot.announce(now)
+        said = (robot.present, robot.intended, robot.heading, robot.arrived, robot.progress)
+        if said == self._said and now - self._said_at < self.timing.heartbeat:
+            return False
+        self._said, self._said_at = said, now
+        self._send(outgoing)
+        return True
 
     def _begin(self, started: float) -> None:
         self._phase, self._next_decision, self._decided_at = Phase.LISTEN, started + self.timing.listen_time, started
@@ -141,6 +165,7 @@ class Agent(LiveDriver):
                 robot.arrived_at(body.cell, body.heading)
                 self._record_move(now, started, robot.arrived)
                 self._send(robot.announce(now))
+                self._said, self._said_at = (robot.present, robot.intended, robot.heading, robot.arrived, robot.progress), now
                 sent_state = True
                 self._phase, self._next_decision = Phase.LISTEN, now + timing.listen_time
         elif self._phase is Phase.LISTEN and now >= self._next_decision:
@@ -156,7 +181,6 @@ class Agent(LiveDriver):
                 pause = timing.heartbeat if robot.arrived else timing.listen_time * (1 + self.random.random())
                 self._phase, self._next_decision = Phase.PAUSE, now + pause
         if self._phase is Phase.PAUSE and now >= self._next_decision:
-            self._send(robot.announce(now))
-            sent_state = True
+            sent_state = self._announce_if_new(now)
             self._phase, self._next_decision = Phase.LISTEN, now + timing.listen_time
         return sent_state

@@ -16,7 +16,9 @@ clock. Every ``poll``:
   them); activations come every ``listen_time`` seconds, times a random factor
   in [0.5, 1.5), so robots interleave differently in every run;
 * run the brain's timers (resend lock requests, releases and claims) and send
-  the state every ``heartbeat`` seconds.
+  the state every ``heartbeat`` seconds, to the peers believed within its state
+  radius, and to every peer every ``fleet_heartbeat`` seconds
+  (:mod:`mrmp.live.driver`).
 
 Before its first activation a robot waits (at most ``start_wait`` seconds)
 until it has heard every peer. The run ends as :class:`~mrmp.live.agent.Agent`'s
@@ -36,10 +38,10 @@ from mrmp.core.cell import Cell
 from mrmp.core.scenario import Scenario
 from mrmp.core.seeds import Stream, stream_random
 from mrmp.live.body import Body
-from mrmp.live.driver import AgentTiming, LiveDriver
+from mrmp.live.driver import AgentTiming, LiveDriver, believed_near, fleet_wide, live_state_radius
 from mrmp.live.transport import Transport
 from mrmp.protocol.auth import Opener, Sealer
-from mrmp.robot.causal_pibt import CausalRobot
+from mrmp.robot.causal_pibt import LOCK_RADIUS, CausalRobot
 from mrmp.robot.robot import Outgoing
 
 LOCK_RETRY_FRACTION = 3
@@ -84,6 +86,7 @@ class CausalAgent(LiveDriver):
             lock_timeout=max(1.0, 20 * retry),
             claim_timeout=timing.claim_timeout,
             heading=spec.heading,
+            state_radius=live_state_radius(LOCK_RADIUS),
         )
         self._next_activation = 0.0
         self._extended_at: float | None = None
@@ -111,7 +114,15 @@ class CausalAgent(LiveDriver):
         return self.robot.heartbeat()
 
     def _fleet_wait_messages(self) -> list[Outgoing]:
-        return self.robot.heartbeat()
+        return fleet_wide(self.robot.heartbeat())
+
+    def _believed_within(self, radius: int) -> list[int]:
+        now, peers = self.clock(), self.robot.peers
+        known = (
+            (index, peer.cells[0], peers.heard.get(index, (self.report.started_at, False))[0])
+            for index, peer in peers.known.items()
+        )
+        return believed_near(known, self.robot.tail, radius, now, self.cell_seconds)
 
     def _safety_counts(self) -> dict[str, int]:
         robot = self.robot

@@ -11,22 +11,32 @@ policy's driver (:class:`mrmp.live.agent.Agent`,
 
 Every ``poll`` the loop hands the brain the queued messages (queueing its
 answers for the client thread), runs the policy's step, runs the brain's timers, and sends the state
-when nothing was sent for ``heartbeat`` seconds. Before its first step a robot
+when nothing was sent for ``heartbeat`` seconds. UDP unicast has no radio, so a
+radius broadcast (an :class:`~mrmp.robot.messaging.Outgoing` with ``radius``)
+goes to the peers the brain believes within the radius; for discovery, the
+state goes to every peer once every ``fleet_heartbeat`` seconds. A peer is
+believed within the radius when its last known cell is, widened by the cells it
+can have driven since it was heard (:func:`believed_near`), so a robot coming
+near is addressed before it is within the interaction radius
+(``docs/protocol.md``, "Neighbourhoods"). Before its first step a robot
 waits (at most ``start_wait`` seconds) until it has heard from every peer, so
 that a fleet whose processes start one by one begins together; its clock starts
 then. The run ends when this robot and every peer have arrived (and a short
-linger has passed so that late requests are still answered), when every peer
+linger has passed so that late requests are still answered, at least a fleet
+heartbeat, so that a far peer that has left its goal again is heard of; the
+robot then sends its state to every peer), when every peer
 that has not arrived has been silent for ``give_up_after`` seconds, on timeout,
 or on a stop request.
 """
 
 from __future__ import annotations
 
+import math
 import queue
 import threading
 import time
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
 from typing import Any, Protocol
 
@@ -47,6 +57,7 @@ class AgentTiming:
 
     listen_time: float = 0.05
     heartbeat: float = 0.2
+    fleet_heartbeat: float = 1.0
     claim_retry: float = 0.15
     claim_timeout: float = 1.0
     silence_timeout: float = 1.5
@@ -55,6 +66,40 @@ class AgentTiming:
     poll: float = 0.004
     timeout: float = 120.0
     start_wait: float = 15.0
+
+
+LIVE_SLACK = 2
+"""Cells added to a live robot's interaction radius: a body between two cells, a state in flight."""
+
+
+def live_state_radius(interaction: int) -> int:
+    """The radius (cells) of a live robot's states: its interaction radius plus :data:`LIVE_SLACK`.
+
+    >>> live_state_radius(2)
+    4
+    """
+    return interaction + LIVE_SLACK
+
+
+def believed_near(
+    peers: Iterable[tuple[int, Cell, float]], here: Cell, radius: int, now: float, cell_seconds: float
+) -> list[int]:
+    """The peers to address with a radius broadcast: each ``(index, last known cell, heard at)`` whose cell is
+    within ``radius`` cells of ``here`` plus the cells it can have driven since it was heard.
+
+    A peer within ``radius`` now was, when last heard ``age`` seconds ago, at most
+    ``ceil(age / cell_seconds)`` cells further: so it is addressed, and a peer
+    known freshly is addressed only when it is near.
+
+    >>> believed_near([(1, (0, 6), 9.9), (2, (0, 6), 8.0), (3, (0, 20), 8.0)], (0, 0), 4, now=10.0, cell_seconds=0.5)
+    [2]
+    """
+    x, y = here
+    return [
+        index
+        for index, (cx, cy), heard_at in peers
+        if abs(cx - x) + abs(cy - y) <= radius + math.ceil(max(0.0, now - heard_at) / cell_seconds)
+    ]
 
 
 @dataclass
@@ -163,6 +208,8 @@ class LiveDriver:
         self._lock = threading.Lock()
         self._peers = len(scenario.robots) - 1
         self._client = ClientThread(transport, name=f"robot-{index}-client")
+        self.cell_seconds = scenario.timing.cell_time / getattr(body, "time_scale", 1.0)
+        """Seconds the body takes for a cell (a body without a time scale runs in real time)."""
 
     # -- what a policy's driver supplies ----------------------------------------------------
 
@@ -192,6 +239,10 @@ class LiveDriver:
 
     def _fleet_wait_messages(self) -> list[Outgoing]:
         """The state to send every heartbeat while waiting for the fleet."""
+        raise NotImplementedError
+
+    def _believed_within(self, radius: int) -> list[int]:
+        """The peers the brain believes within ``radius`` cells of itself (where a radius broadcast goes)."""
         raise NotImplementedError
 
     def _begin(self, started: float) -> None:
@@ -245,6 +296,9 @@ class LiveDriver:
         report, client = self.report, self._client
         for item in outgoing:
             data = self.sealer.seal(item.message)
+            if item.radius is not None:
+                near = self._believed_within(item.radius)
+                item = item._replace(recipients=(*near, *(peer for peer in item.recipients or () if peer not in near)))
             if item.recipients is None:
                 client.send(data, None)
                 report.messages_sent += self._peers
@@ -274,11 +328,12 @@ class LiveDriver:
         if on_progress is not None:  # the launcher learns at once when this robot's run began
             self._fill_report(started)
             on_progress(report)
-        self._send(self._state_messages(started))
-        last_state = started
+        self._send(fleet_wide(self._state_messages(started)))
+        last_state = last_fleet_state = started
         self._begin(started)
         everyone_done_since: float | None = None
         last_progress = started
+        linger = max(timing.linger, timing.fleet_heartbeat + timing.heartbeat)  # a far peer's news takes a fleet heartbeat
         try:
             while not self.stop_requested.is_set():
                 now = clock()
@@ -289,13 +344,17 @@ class LiveDriver:
                 if self._step(now, started):
                     last_state = now
                 self._send(self.robot.expire(now))
-                if now - last_state >= timing.heartbeat:
+                if now - last_fleet_state >= timing.fleet_heartbeat:
+                    self._send(fleet_wide(self._state_messages(now)))
+                    last_state = last_fleet_state = now
+                elif now - last_state >= timing.heartbeat:
                     self._send(self._state_messages(now))
                     last_state = now
                 if self._everyone_done(now):
                     everyone_done_since = everyone_done_since if everyone_done_since is not None else now
-                    if now - everyone_done_since >= timing.linger:
+                    if now - everyone_done_since >= linger:
                         report.stop_reason = "all arrived" if not report.silent_peers else "arrived; peers silent"
+                        self._send(fleet_wide(self._state_messages(now)))  # every peer's last news of it is fresh
                         break
                 else:
                     everyone_done_since = None
@@ -360,3 +419,13 @@ class LiveDriver:
         if isinstance(self.transport, FaultyTransport):
             report.faults = dict(self.transport.counts.__dict__)
         report.safety = self._safety_counts()
+
+
+def fleet_wide(outgoing: list[Outgoing]) -> list[Outgoing]:
+    """``outgoing`` addressed to every peer (the fleet heartbeat).
+
+    >>> from mrmp.protocol.messages import StateMessage
+    >>> fleet_wide([Outgoing(StateMessage(0, 1, (0, 0), (0, 1)), (2,), 3)])[0].fleet_wide
+    True
+    """
+    return [item._replace(recipients=None, radius=None) for item in outgoing]

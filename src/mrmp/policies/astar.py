@@ -26,11 +26,15 @@ from __future__ import annotations
 
 from mrmp.core.cell import Cell
 from mrmp.core.errors import NoPathError
+from mrmp.core.heading import Heading
 from mrmp.core.scenario import Timing
 from mrmp.policies.base import Decision, Situation
 from mrmp.policies.priority import claimed_cells, conflicting_peers, outranks_all
 from mrmp.search.graph import Planner
 from mrmp.search.planners import astar
+
+PLAN_CACHE = 64
+"""How many plans around the static obstacles alone a robot keeps (a robot refused a cell plans from it again)."""
 
 
 class AstarPolicy:
@@ -49,6 +53,9 @@ class AstarPolicy:
     """
 
     name = "astar"
+    interaction_radius = 2
+    """Conflicts are peers whose Present or Next is the robot's Next (within two cells, as for the thesis's
+    rule); the parked robots it plans around are those it knows of, within the same radius."""
     own_search = "astar"
     """The search :data:`~mrmp.core.options.POLICY_DEFAULT_SEARCH` stands for."""
 
@@ -64,17 +71,28 @@ class AstarPolicy:
         self.heading_aware = heading_aware
         self.timing = timing or Timing()
         self._path: list[Cell] = []
+        self._parked: dict[int, Cell] = {}
+        self._unblocked: dict[tuple[Cell, Cell, Heading | None], tuple[Cell, ...] | None] = {}
         self.replans = 0
 
     def _plan(self, situation: Situation, blocked: frozenset[Cell] = frozenset()) -> list[Cell] | None:
         heading = situation.heading if self.heading_aware else None
+        key = (situation.present, situation.goal, heading)
+        if not blocked and key in self._unblocked:  # the map is static and the search deterministic
+            cached = self._unblocked[key]
+            return None if cached is None else list(cached)
         try:
             result = self.search(
                 situation.grid, situation.present, situation.goal, blocked=blocked, heading=heading, timing=self.timing
             )
         except NoPathError:
-            return None
-        return list(result.path)
+            result = None
+        path = None if result is None else tuple(result.path)
+        if not blocked:
+            if len(self._unblocked) >= PLAN_CACHE:
+                self._unblocked.clear()
+            self._unblocked[key] = path
+        return None if path is None else list(path)
 
     def intend(self, situation: Situation) -> Cell:
         """The next cell of the current plan, planning afresh when off it."""
@@ -95,7 +113,7 @@ class AstarPolicy:
             self._advance(intended)
             return Decision(intended, "clear")
         conflict_ids = tuple(peer.index for peer in conflicts)
-        parked = [peer for peer in situation.peers.values() if peer.parked]
+        parked = self._remember_parked(situation)
         blocked_by_parked = any(peer.parked for peer in conflicts)
         if not blocked_by_parked:
             if outranks_all(present, situation.index, conflicts):
@@ -103,7 +121,7 @@ class AstarPolicy:
                 return Decision(intended, "priority", conflict_ids)
             if self.resolve == "wait":
                 return Decision(present, "wait", conflict_ids)
-        avoid = frozenset(cell for peer in [*conflicts, *parked] for cell in (peer.present, peer.next))
+        avoid = frozenset(cell for peer in conflicts for cell in (peer.present, peer.next)) | parked
         self.replans += 1
         path = self._plan(situation, blocked=avoid)
         if path is None or len(path) < 2 or path[1] in claimed_cells(situation.peers):
@@ -112,6 +130,17 @@ class AstarPolicy:
         self._path = path
         self._advance(step)
         return Decision(step, "divert", conflict_ids)
+
+    def _remember_parked(self, situation: Situation) -> frozenset[Cell]:
+        """The cells of the parked robots this robot knows of: those it sees now, and those it saw parked
+        and has not heard of since (a robot hearing only its neighbourhood keeps them when it moves on)."""
+        remembered = self._parked
+        for index, peer in situation.peers.items():
+            if peer.parked:
+                remembered[index] = peer.present
+            else:
+                remembered.pop(index, None)
+        return frozenset(remembered.values())
 
     def _advance(self, entered: Cell) -> None:
         if len(self._path) > 1 and self._path[1] == entered:

@@ -13,7 +13,7 @@ from the robot's own state and its :class:`~mrmp.robot.belief.Belief`.
 
 from __future__ import annotations
 
-from collections.abc import Mapping
+from collections.abc import Iterable, Mapping
 from dataclasses import dataclass
 from typing import Protocol
 
@@ -56,6 +56,22 @@ class Situation:
     goal: Cell
     grid: Grid
     peers: Mapping[int, PeerState]
+    progress: Mapping[int, int] | None = None
+
+    def progress_of(self, index: int) -> int:
+        """The most moves peer ``index`` is known to have completed (0 if never heard).
+
+        Progress only grows, so the robot's driver may keep it for peers its
+        view no longer holds (``progress``); without it, it is read from ``peers``.
+
+        >>> from mrmp.core.grid import Grid
+        >>> Situation(0, (0, 0), Heading.NORTH, (0, 1), Grid(1, 2), {}, {3: 7}).progress_of(3)
+        7
+        """
+        if self.progress is not None:
+            return self.progress.get(index, 0)
+        peer = self.peers.get(index)
+        return peer.progress if peer is not None else 0
 
 
 @dataclass(frozen=True, slots=True)
@@ -90,3 +106,32 @@ class Policy(Protocol):
     def decide(self, situation: Situation, intended: Cell) -> Decision:
         """The cell this robot enters (or keeps) after hearing its peers."""
         ...
+
+
+def interaction_radius(policy: object) -> int | None:
+    """How far (cells, Manhattan) from a robot a peer can stand whose state ``policy``'s decisions read.
+
+    A policy says so in its attribute ``interaction_radius``; a policy that
+    says nothing reads every peer (None: its robots' states go fleet-wide).
+
+    >>> class Local:
+    ...     interaction_radius = 2
+    >>> interaction_radius(Local()), interaction_radius(object())
+    (2, None)
+    """
+    radius = getattr(policy, "interaction_radius", None)
+    return radius if isinstance(radius, int) else None
+
+
+def listeners(policy: object, heard: Iterable[int] = (), progress: Mapping[int, int] | None = None) -> Iterable[int]:
+    """The peers beyond the interaction radius that must hear this robot's state now (policy method ``listeners``).
+
+    ``heard`` are the peers heard from since the robot's last state and
+    ``progress`` the most moves each peer is known to have completed, for a
+    policy that answers the peers that wait for it.
+
+    >>> list(listeners(object()))
+    []
+    """
+    method = getattr(policy, "listeners", None)
+    return method(heard, progress) if callable(method) else ()

@@ -14,6 +14,16 @@ planner of :mod:`mrmp.centralized` returns such plans, and
 :func:`~mrmp.centralized.dependencies.action_dependencies` refuses any other), whose
 dependency graph is then acyclic, never deadlocks.
 
+Its robot's states need to reach no robot near it (the policy reads no
+peer's cells: ``interaction_radius`` 0), only the robots whose moves wait for
+its moves, its *dependents* (:meth:`PlanFollowingPolicy.listeners`): the state
+that first reports a completed move goes to that move's dependents (*push*:
+on a perfect network a dependent hears it exactly when it would from states
+sent to everyone); a robot that waits for a peer's move sends its own state to
+that peer every step, and a peer that hears from a dependent still waiting for
+a move it has completed answers with its state (*pull*: a lost push is made up
+within a step of the next heard request).
+
 The dependencies themselves are computed from the plan by
 :func:`mrmp.centralized.dependencies.action_dependencies`; this policy only
 follows them, knowing its peers only through their messages.
@@ -36,7 +46,7 @@ Examples
 
 from __future__ import annotations
 
-from collections.abc import Mapping, Sequence
+from collections.abc import Iterable, Mapping, Sequence
 
 from mrmp.core.cell import Cell
 from mrmp.policies.base import Decision, Situation
@@ -52,13 +62,29 @@ class PlanFollowingPolicy:
     dependencies:
         For a move index, the ``(robot, progress)`` pairs it waits for: robot
         ``robot`` must have completed at least ``progress`` moves.
+    dependents:
+        For a number of completed moves ``k`` of this robot, the ``(robot, move)``
+        pairs whose move (an index into that robot's moves) waits for it to have
+        completed ``k`` moves (whom its states must reach); when omitted,
+        unknown, and its states go to every peer.
     """
 
     name = "plan"
 
-    def __init__(self, moves: Sequence[Cell], dependencies: Mapping[int, Sequence[tuple[int, int]]]) -> None:
+    def __init__(
+        self,
+        moves: Sequence[Cell],
+        dependencies: Mapping[int, Sequence[tuple[int, int]]],
+        dependents: Mapping[int, Sequence[tuple[int, int]]] | None = None,
+    ) -> None:
         self.moves = list(moves)
         self.dependencies = {move: list(needs) for move, needs in dependencies.items()}
+        self.dependents = None if dependents is None else {done: tuple(pairs) for done, pairs in dependents.items()}
+        self._waiting_on_me: dict[int, list[tuple[int, int]]] = {}
+        for done, pairs in (self.dependents or {}).items():
+            for robot, move in pairs:
+                self._waiting_on_me.setdefault(robot, []).append((done, move))
+        self._pushed = 0
         self.done = 0
         self.waits_for: list[int] = []
 
@@ -70,11 +96,41 @@ class PlanFollowingPolicy:
         """Whether every dependency of the next move is met, by what the peers have said."""
         waiting = []
         for robot, progress in self.dependencies.get(self.done, ()):
-            peer = situation.peers.get(robot)
-            if peer is None or peer.progress < progress:
+            if situation.progress_of(robot) < progress:
                 waiting.append(robot)
         self.waits_for = waiting
         return not waiting
+
+    @property
+    def interaction_radius(self) -> int | None:
+        """0 when the dependents are known (the policy reads no peer's cells), else None (states go fleet-wide)."""
+        return None if self.dependents is None else 0
+
+    def listeners(self, heard: Iterable[int] = (), progress: Mapping[int, int] | None = None) -> tuple[int, ...]:
+        """Whom this step's state must reach beyond the radius (module docstring): push, pull and the peers waited for.
+
+        ``heard`` are the peers heard from since the last state, ``progress``
+        the most moves each peer is known to have completed.
+
+        >>> policy = PlanFollowingPolicy([(0, 1), (0, 2)], {}, dependents={1: [(3, 0)], 2: [(4, 5), (3, 1)]})
+        >>> policy.done = 2
+        >>> policy.listeners()   # the first state after moves 1 and 2: their dependents
+        (3, 4)
+        >>> policy.listeners(heard=[3, 4], progress={3: 1, 4: 6})   # 3 still waits for move 2; 4 is past it
+        (3,)
+        """
+        if self.dependents is None:
+            return ()
+        robots: set[int] = set(self.waits_for)
+        done = self.done
+        for completed in range(self._pushed + 1, done + 1):
+            robots.update(robot for robot, _ in self.dependents.get(completed, ()))
+        self._pushed = max(self._pushed, done)
+        known = progress or {}
+        for robot in heard:
+            if any(needed <= done and known.get(robot, 0) <= move for needed, move in self._waiting_on_me.get(robot, ())):
+                robots.add(robot)
+        return tuple(sorted(robots))
 
     def intend(self, situation: Situation) -> Cell:
         """The next cell of the plan once its dependencies are met, else the present cell."""

@@ -104,6 +104,9 @@ class ThesisPolicy:
     """
 
     name = "thesis"
+    interaction_radius = 2
+    """The rule reads only peers whose Present or Next is its Next or its diversion cell, both next to its
+    Present: a peer's Next is next to the peer's Present, so such a peer stands within two cells."""
     own_search = "update-coordinate"
     """The search :data:`~mrmp.core.options.POLICY_DEFAULT_SEARCH` stands for."""
 

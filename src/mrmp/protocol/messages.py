@@ -33,8 +33,8 @@ Examples
 
 from __future__ import annotations
 
-from dataclasses import dataclass, replace
-from typing import Self
+from dataclasses import dataclass
+from typing import Any, Self
 
 from mrmp.core.cell import Cell
 from mrmp.core.heading import Heading
@@ -57,8 +57,15 @@ class Message:
     seq: int
 
     def with_seq(self, seq: int) -> Self:
-        """This message with sequence number ``seq``."""
-        return replace(self, seq=seq)  # type: ignore[type-var]
+        """This message with sequence number ``seq`` (its other fields as they are, in their declared order).
+
+        >>> ClaimMessage(2, 0, 5, (1, 1)).with_seq(9)
+        ClaimMessage(sender=2, seq=9, claim=5, cell=(1, 1))
+        """
+        cls: Any = type(self)
+        names: tuple[str, ...] = cls.__slots__  # a slotted dataclass: its fields, in order
+        copy: Self = cls(self.sender, seq, *[getattr(self, name) for name in names[2:]])
+        return copy
 
 
 class PibtMessage(Message):

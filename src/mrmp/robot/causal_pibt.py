@@ -128,6 +128,11 @@ class CausalRobot(MessageEndpoint):
         The map's flat form with its distance tables (shared by robots simulated in one process).
     heading:
         The body's initial heading.
+    state_radius:
+        Send states to the robots within this many cells of the tail (a radius
+        broadcast) rather than to every peer (None: every peer); at least
+        :data:`LOCK_RADIUS` plus the cells a robot can cover between two of a
+        peer's states (``docs/protocol.md``, "Neighbourhoods").
     """
 
     def __init__(
@@ -142,8 +147,12 @@ class CausalRobot(MessageEndpoint):
         claim_timeout: float = 4.0,
         flat: FlatMap | None = None,
         heading: Heading = Heading.NORTH,
+        state_radius: int | None = None,
     ) -> None:
+        if state_radius is not None and state_radius < LOCK_RADIUS:
+            raise ValueError(f"state radius {state_radius} is below the lock radius {LOCK_RADIUS}")
         self.index = index
+        self.state_radius = state_radius
         self.grid = grid
         self.retry_interval = retry_interval
         self.heading = heading
@@ -267,6 +276,10 @@ class CausalRobot(MessageEndpoint):
         state = self.state
         return self._state(state.tail, state.head if state.head is not None else state.tail, self.heading, self.at_goal)
 
+    def _state_outgoing(self) -> Outgoing:
+        """The state message, to the robots within the state radius (every peer without one)."""
+        return Outgoing(self.state_message(), None, self.state_radius)
+
     def _grant(self, locker: int, session: int) -> LockGrantMessage:
         """This robot's grant of its lock, carrying its current state."""
         return self.state.grant(locker, session)
@@ -320,7 +333,7 @@ class CausalRobot(MessageEndpoint):
         self.transitions.act(self.state, peers)
         write_backs = {index: view.write_back() for index, view in peers.items()}
         sent = self._numbered(self.locks.release(write_backs, now))
-        sent.append(Outgoing(self.state_message()))
+        sent.append(self._state_outgoing())
         if self.state.mode is Mode.EXTENDED:
             self.claim_failures = 0
             sent.extend(self._claim_head(now))
@@ -371,7 +384,7 @@ class CausalRobot(MessageEndpoint):
         self.transitions.act_extended(self.state)
         self.body_arrived = False
         self.safety.end_move(self.state.tail)
-        return [Outgoing(self.state_message()), *self._safety_sends(now)]
+        return [self._state_outgoing(), *self._safety_sends(now)]
 
     def _safety_sends(self, now: float) -> list[Outgoing]:
         """The safety layer's messages due now (releases of the cells left, claims to resend), stamped."""
@@ -382,7 +395,7 @@ class CausalRobot(MessageEndpoint):
         self.stats["heads_given_up"] += 1
         self.safety.cancel_claim()
         self.transitions.give_up_head(self.state)
-        return [Outgoing(self.state_message())]
+        return [self._state_outgoing()]
 
     # -- timers -------------------------------------------------------------------------------
 
@@ -409,7 +422,7 @@ class CausalRobot(MessageEndpoint):
 
     def heartbeat(self) -> list[Outgoing]:
         """The state message every peer gets regularly (it tells where this robot is)."""
-        return [Outgoing(self.state_message())]
+        return [self._state_outgoing()]
 
     # -- messages in ------------------------------------------------------------------------
 

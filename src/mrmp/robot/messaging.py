@@ -1,7 +1,10 @@
 """What every robot brain does with messages alike: numbering what it sends, answering claims, decoding.
 
 What every brain sends is a list of :class:`Outgoing`: a message, and to
-whom (named robots, every robot within a radio radius, or every peer).
+whom (named robots, every robot within a radio radius of the sender, both, or
+every peer). The driver interprets the address: the simulators deliver a radius
+broadcast to the robots whose bodies stand within the radius
+(:mod:`mrmp.sim.spatial`), a live driver to the peers it believes there.
 Every brain takes in what it receives through a :class:`Handlers` table, from
 message type to the method that takes messages of that type in. Every message a robot
 sends carries the next number of the robot's sequence (``seq``), so that
@@ -43,15 +46,25 @@ F = TypeVar("F", bound=Callable[..., Any])
 
 
 class Outgoing(NamedTuple):
-    """A message to send, to ``recipients``; when None, to every robot within ``radius`` cells (None: every peer).
+    """A message to send: to the robots named in ``recipients`` and to every robot within ``radius`` cells.
+
+    ``radius`` is Manhattan, around the sender's cell; with both None the
+    message goes to every peer (fleet-wide).
 
     >>> Outgoing(ClaimMessage(0, 1, 1, (0, 1)), (2,)).recipients
     (2,)
+    >>> Outgoing(ClaimMessage(0, 1, 1, (0, 1)), (2,), 3).fleet_wide, Outgoing(ClaimMessage(0, 1, 1, (0, 1))).fleet_wide
+    (False, True)
     """
 
     message: Message
     recipients: tuple[int, ...] | None = None
     radius: int | None = None
+
+    @property
+    def fleet_wide(self) -> bool:
+        """Whether the message goes to every peer (neither named recipients nor a radius)."""
+        return self.recipients is None and self.radius is None
 
 
 class Handlers:

@@ -51,7 +51,7 @@ from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
 from mrmp.core.heading import Heading
 from mrmp.core.scenario import RobotSpec
-from mrmp.policies.base import Decision, Policy, Situation
+from mrmp.policies.base import Decision, Policy, Situation, interaction_radius, listeners
 from mrmp.protocol.messages import ClaimMessage, Message, ReleaseAckMessage, ReleaseMessage, ReplyMessage, StateMessage
 from mrmp.protocol.safety import SafetyLayer
 from mrmp.robot.belief import Belief
@@ -82,6 +82,18 @@ class Robot(MessageEndpoint):
     silence_timeout:
         A peer not heard from for this long is *silent*: its policy treats it as
         standing still at its last known cells (None: never).
+    state_radius:
+        Send states to the robots within this many cells (a radius broadcast, plus
+        the policy's :func:`~mrmp.policies.base.listeners`) rather than to every
+        peer (None: every peer).
+    knowledge_lease:
+        Forget a peer not heard from for longer than this (it has gone out of
+        range), and show the policy only the peers within its
+        :func:`~mrmp.policies.base.interaction_radius` (None: keep every peer).
+        With a lease of ``L`` ticks, bodies moving a cell a tick, and
+        ``state_radius`` at least the interaction radius plus ``L``, the policy
+        sees on a perfect network exactly the peers within its radius, each as
+        it is now (``docs/protocol.md``, "Neighbourhoods").
     """
 
     def __init__(
@@ -95,9 +107,13 @@ class Robot(MessageEndpoint):
         claim_timeout: float = 4.0,
         retry_interval: float = 1.0,
         silence_timeout: float | None = None,
+        state_radius: int | None = None,
+        knowledge_lease: float | None = None,
     ) -> None:
         self.id = spec.id
         self.silence_timeout = silence_timeout
+        self.state_radius = state_radius
+        self.knowledge_lease = knowledge_lease
         self.now = 0.0
         self.index = index
         self.goal = spec.goal
@@ -110,6 +126,7 @@ class Robot(MessageEndpoint):
         self.wanted: Cell | None = None
         self.moving = False
         self.belief = Belief()
+        self._heard_since: set[int] = set()
         self.safety = SafetyLayer(
             index, starts, claim_timeout=claim_timeout, retry_interval=retry_interval, keep_releases=guarded
         )
@@ -126,6 +143,16 @@ class Robot(MessageEndpoint):
     def situation(self) -> Situation:
         """The robot's state and beliefs at the time of its last step, as its policy sees them."""
         peers = self.belief.peers
+        radius = interaction_radius(self.policy)
+        if self.knowledge_lease is not None:
+            self.belief.forget_before(self.now - self.knowledge_lease)
+            if radius is not None:
+                x, y = self.present
+                peers = {
+                    index: peer
+                    for index, peer in peers.items()
+                    if abs(peer.present[0] - x) + abs(peer.present[1] - y) <= radius
+                }
         if self.silence_timeout is not None:
             horizon = self.now - self.silence_timeout
             if any(peer.heard_at < horizon for peer in peers.values()):
@@ -133,7 +160,7 @@ class Robot(MessageEndpoint):
                     index: replace(peer, silent=True, next=peer.present) if peer.heard_at < horizon else peer
                     for index, peer in peers.items()
                 }
-        return Situation(self.index, self.present, self.heading, self.goal, self.grid, peers)
+        return Situation(self.index, self.present, self.heading, self.goal, self.grid, peers, self.belief.progress)
 
     def state_message(self) -> StateMessage:
         """A fresh state message: Present, Next, heading, arrival and safety state."""
@@ -150,7 +177,11 @@ class Robot(MessageEndpoint):
         self.now = now
         if not self.moving and self.wanted is None and self.safety.pending is None:
             self.intended = self.policy.intend(self.situation())
-        return [Outgoing(self.state_message())]
+        if self.state_radius is None:
+            return [Outgoing(self.state_message())]
+        heard, self._heard_since = self._heard_since, set()
+        extra = tuple(listeners(self.policy, heard, self.belief.progress))
+        return [Outgoing(self.state_message(), extra, self.state_radius)]
 
     def decide(self, now: float) -> list[Outgoing]:
         """Apply the policy; when guarded, return the claim for the chosen cell."""
@@ -214,6 +245,8 @@ class Robot(MessageEndpoint):
     @handlers.on(StateMessage)
     def _take_state(self, message: StateMessage, now: float) -> list[Outgoing]:
         self.belief.update(message, now)
+        if self.state_radius is not None:
+            self._heard_since.add(message.sender)
         return []
 
     @handlers.on(ClaimMessage)

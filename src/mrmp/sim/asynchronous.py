@@ -13,7 +13,11 @@ is event-driven and seeded:
   loses, delays, duplicates and reorders it as the scenario's network (and its
   per-link faults) say, through :func:`mrmp.core.faults.message_fates`;
 * a body is on its tail until its move ends, then on its head; the referee
-  (:class:`~mrmp.sim.referee.Referee`) judges the fleet at the end of every tick.
+  (:class:`~mrmp.sim.referee.Referee`) judges the fleet at the end of every tick;
+* a robot's state goes to the robots whose bodies stand within its state radius
+  (the lock radius plus the heartbeat period and the longest delay, in cells:
+  the farthest a robot can have come since a peer's last state), found
+  through a spatial index (:mod:`mrmp.sim.spatial`).
 
 Each tick: deliver what is due (and the answers sent meanwhile), activate the
 robots whose time has come, start the moves the safety layer allows, end the
@@ -44,12 +48,13 @@ from mrmp.core.limits import MAX_TICKS
 from mrmp.core.result import RobotResult, RunResult
 from mrmp.core.scenario import Scenario
 from mrmp.core.seeds import Stream, stream_random
-from mrmp.robot.causal_pibt import CausalRobot
+from mrmp.robot.causal_pibt import LOCK_RADIUS, CausalRobot
 from mrmp.robot.robot import Outgoing
 from mrmp.search.flat_map import FlatMap
 from mrmp.sim.goals import GoalBook
 from mrmp.sim.metrics import shortest_steps
 from mrmp.sim.referee import Referee
+from mrmp.sim.spatial import SpatialIndex
 from mrmp.sim.ticking import TickObserver, run_result, run_ticks, scenario_network, send_counted
 
 __all__ = ["SLOWEST_PACE", "AsynchronousSimulator", "causal_timers"]
@@ -102,6 +107,7 @@ class AsynchronousSimulator:
                 claim_timeout=claim_timeout,
                 flat=flat,
                 heading=spec.heading,
+                state_radius=LOCK_RADIUS + self.heartbeat_period + worst.delay_max,
             )
             for index, spec in enumerate(scenario.robots)
         ]
@@ -111,6 +117,8 @@ class AsynchronousSimulator:
         self.max_ticks = scenario.max_ticks or self.default_max_ticks()
         self.tick = 0
         self.bodies: list[Cell] = list(starts)
+        self.radio = SpatialIndex(starts)
+        """Where every body stands: the simulated radio delivers radius broadcasts through it."""
         self._next_activation = [self._random.randint(0, 2 * pace) for pace in self.paces]
         self._arrival_at: list[int | None] = [None] * len(self.robots)
         self._heartbeat_at = [self._random.randint(1, self.heartbeat_period) for _ in self.robots]
@@ -189,12 +197,17 @@ class AsynchronousSimulator:
         heading = Heading.between(source, target)
         self._results[index].turns += right_turns(robot.heading, heading)
         self.bodies[index] = target
+        self.radio.move(index, source, target)
         self._send(robot, robot.arrived_at(target, self.tick, heading))
 
     def _send(self, robot: CausalRobot, outgoing: list[Outgoing]) -> None:
         result = self._results[robot.index]
         for item in outgoing:
-            send_counted(self.network, robot.index, item, self._everyone, self.tick, result)
+            send_counted(self.network, robot.index, item, self._everyone, self.tick, result, self._near)
+
+    def _near(self, sender: int, radius: int) -> list[int]:
+        """The robots whose bodies stand within ``radius`` cells of ``sender``'s body."""
+        return self.radio.within(self.bodies[sender], radius)
 
     def _drain(self) -> None:
         """Deliver everything due by this tick, including answers sent meanwhile."""

@@ -14,6 +14,12 @@ Per tick, as in the thesis (sections 3.5-3.6), with the safety layer:
 6. robots on their goals count a goal reached; in a lifelong run each then
    receives a new goal (drawn with the run's seed).
 
+A robot whose policy has an interaction radius sends its state to the robots
+within that radius plus its knowledge lease (:func:`neighbourhood`), and the
+network delivers such a radius broadcast to the robots whose bodies stand
+there, found through a spatial index (:mod:`mrmp.sim.spatial`): no step of a
+tick scans the fleet per message.
+
 Time for the safety layer's timers is counted in ticks. The run ends when every
 robot stands on its goal (never, in a lifelong run: it ends with "time up" at
 the tick limit), at the tick limit, or when the same configuration of
@@ -39,8 +45,8 @@ from collections.abc import Sequence
 from mrmp.core.cell import Cell
 from mrmp.core.heading import Heading, right_turns
 from mrmp.core.result import RobotResult, RunResult
-from mrmp.core.scenario import Scenario
-from mrmp.policies.base import Decision, Policy
+from mrmp.core.scenario import NetworkFaults, Scenario
+from mrmp.policies.base import Decision, Policy, interaction_radius
 from mrmp.protocol.codec import DecodeError, decode
 from mrmp.protocol.messages import Message
 from mrmp.robot.robot import Outgoing, Robot
@@ -48,6 +54,7 @@ from mrmp.sim.goals import GoalBook
 from mrmp.sim.metrics import default_max_ticks, network_slowdown, shortest_steps
 from mrmp.sim.policy_table import POLICY_TABLE, make_policy, policy_entry
 from mrmp.sim.referee import Referee
+from mrmp.sim.spatial import SpatialIndex
 from mrmp.sim.ticking import TickObserver, run_result, run_ticks, scenario_network, send_counted
 
 RECURRENCE_LIMIT = 10
@@ -67,6 +74,33 @@ def safety_timers(delay_max: int) -> tuple[int, int]:
     """
     retry = 2 * delay_max + 1
     return retry, 3 * retry + 1
+
+
+LOSS_LEASE = 2
+"""Extra ticks a robot keeps a peer's state on a lossy network: it forgets a peer only after that many more
+heartbeats in a row were lost."""
+
+
+def neighbourhood(policy: Policy, faults: NetworkFaults) -> tuple[int | None, int | None]:
+    """The state radius and knowledge lease (ticks) of a robot running ``policy`` over a network with ``faults``.
+
+    The lease covers the network's longest delay (and :data:`LOSS_LEASE` more
+    heartbeats when it loses messages). The radius is the policy's interaction
+    radius plus twice the lease: two robots approaching each other close two
+    cells a tick, so every state either sent in the last ``lease`` ticks by a
+    robot now within the interaction radius reached this robot
+    (``docs/protocol.md``, "Neighbourhoods"). A policy without an interaction
+    radius: (None, None), states to every peer, kept for ever.
+
+    >>> from mrmp.policies.thesis import ThesisPolicy
+    >>> neighbourhood(ThesisPolicy(), NetworkFaults()), neighbourhood(ThesisPolicy(), NetworkFaults(loss=0.1, delay_max=2))
+    ((2, 0), (10, 4))
+    """
+    radius = interaction_radius(policy)
+    if radius is None:
+        return None, None
+    lease = faults.delay_max + (LOSS_LEASE if faults.loss > 0 else 0)
+    return radius + 2 * lease, lease
 
 
 class LockstepSimulator:
@@ -103,19 +137,26 @@ class LockstepSimulator:
         grid = scenario.grid
         starts = [spec.start for spec in scenario.robots]
         retry, timeout = safety_timers(scenario.worst_faults().delay_max)
-        self.robots = [
-            Robot(
-                spec,
-                index,
-                grid,
-                policies[index] if policies is not None else make_policy(scenario.policy, scenario.timing),
-                starts,
-                guarded=scenario.safety,
-                claim_timeout=timeout,
-                retry_interval=retry,
+        self.robots = []
+        for index, spec in enumerate(scenario.robots):
+            policy = policies[index] if policies is not None else make_policy(scenario.policy, scenario.timing)
+            state_radius, lease = neighbourhood(policy, scenario.worst_faults())
+            self.robots.append(
+                Robot(
+                    spec,
+                    index,
+                    grid,
+                    policy,
+                    starts,
+                    guarded=scenario.safety,
+                    claim_timeout=timeout,
+                    retry_interval=retry,
+                    state_radius=state_radius,
+                    knowledge_lease=lease,
+                )
             )
-            for index, spec in enumerate(scenario.robots)
-        ]
+        self.bodies = SpatialIndex(starts)
+        """Where every body stands: the simulated radio delivers radius broadcasts through it."""
         slowdown = network_slowdown(scenario) if scenario.safety else 1.0
         per_round_trip = slowdown / (2 * scenario.worst_faults().delay_max + 1)
         self.recurrence_limit = int((RECURRENCE_LIMIT + 2 * timeout) * max(1.0, per_round_trip))
@@ -182,6 +223,8 @@ class LockstepSimulator:
                 duration = turns * timing.turn_time + timing.cell_time * cost
                 heading = new_heading
             if target is not None:
+                if target != robot.present:
+                    self.bodies.move(robot.index, robot.present, target)
                 robot.arrived_at(target, heading)
             result.path.append(robot.present)
             result.headings.append(robot.heading)
@@ -198,9 +241,14 @@ class LockstepSimulator:
         result = self._results[robot.index]
         log = self._message_log
         for item in outgoing:
-            recipients = send_counted(self.network, robot.index, item, self._everyone, self.tick, result)
+            recipients = send_counted(self.network, robot.index, item, self._everyone, self.tick, result, self._near)
             if log is not None:
                 self._log_message(log[-1], robot.index, item.message, recipients)
+
+    def _near(self, sender: int, radius: int) -> list[int]:
+        """The robots whose bodies stand within ``radius`` cells of ``sender``'s body."""
+        bodies = self.bodies
+        return bodies.within(bodies.cell_of(sender), radius)
 
     def _log_message(
         self, entries: list[tuple[str, str, str]], sender: int, message: Message, recipients: Sequence[int] | range

@@ -96,21 +96,44 @@ def run_ticks(
     return stop_reason
 
 
-def send_counted(
-    network: SimulatedNetwork, sender: int, item: Outgoing, everyone: range, tick: int, result: RobotResult
-) -> Sequence[int] | range:
-    """Send ``item`` over ``network`` to its recipients (``everyone`` but the sender when it has none).
+Near = Callable[[int, int], Sequence[int]]
+"""The robots whose bodies stand within ``radius`` cells of robot ``sender``'s body: ``near(sender, radius)``."""
 
-    Counts the messages and bytes sent in ``result``; returns the recipients
-    (the sender among them if it was listed or broadcast to).
+
+def send_counted(
+    network: SimulatedNetwork,
+    sender: int,
+    item: Outgoing,
+    everyone: range,
+    tick: int,
+    result: RobotResult,
+    near: Near | None = None,
+) -> Sequence[int] | range:
+    """Send ``item`` over ``network`` to its recipients; count the messages and bytes sent in ``result``.
+
+    The recipients are the robots ``item`` names plus, when it has a radius,
+    every robot ``near`` gives within that radius of the sender (the simulated
+    radio; without ``near``, the whole fleet); a message with neither goes to
+    ``everyone``. The sender never sends to itself. Returns the recipients (the
+    sender among them if it was listed or broadcast to).
     """
     payload = encode(item.message)
-    recipients = item.recipients if item.recipients is not None else everyone
+    named = item.recipients
+    if item.radius is not None:
+        around = near(sender, item.radius) if near is not None else everyone
+        recipients: Sequence[int] | range = (
+            around if not named else [*around, *(index for index in named if index not in around)]
+        )
+    else:
+        recipients = named if named is not None else everyone
+    size = len(payload)
+    sent = 0
     for recipient in recipients:
         if recipient != sender:
             network.send(sender, recipient, payload, tick)
-            result.messages_sent += 1
-            result.bytes_sent += len(payload)
+            sent += 1
+    result.messages_sent += sent
+    result.bytes_sent += sent * size
     return recipients
 
 

@@ -126,8 +126,8 @@ def test_interrupted_bench_stops_at_once_keeps_finished_records_and_resumes(tmp_
 
 
 def test_a_run_over_its_time_limit_is_killed_and_recorded_as_timeout():
-    # reactive A* with the safety layer on den520d takes several seconds for 40 robots
-    run = den520d_run("astar", 40, time_limit_s=0.05)
+    # reactive A* with the safety layer on den520d takes over 10 seconds for 200 robots (1 s for 40)
+    run = den520d_run("astar", 200, time_limit_s=0.05)
     started = time.monotonic()
     record = run_isolated(run)
     assert record["status"] == "timeout" and record["error"].startswith("killed after")
@@ -218,7 +218,7 @@ def _children(pid):
 def test_a_worker_that_dies_stops_the_bench_with_a_note_and_no_false_record(tmp_path):
     import threading
 
-    slow = den520d_run("astar", 40, time_limit_s=20)
+    slow = den520d_run("astar", 200, time_limit_s=20)  # over 10 s: still running when its worker is killed
     notes, outcomes = [], []
     thread = threading.Thread(
         target=lambda: outcomes.append(run_bench([slow], tmp_path, workers=1, progress=False, say=notes.append))
