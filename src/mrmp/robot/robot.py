@@ -52,7 +52,15 @@ from mrmp.core.grid import Grid
 from mrmp.core.heading import Heading
 from mrmp.core.scenario import RobotSpec
 from mrmp.policies.base import Decision, Policy, Situation
-from mrmp.protocol.messages import ClaimMessage, Message, ReleaseAckMessage, ReleaseMessage, ReplyMessage, StateMessage
+from mrmp.protocol.messages import (
+    ClaimMessage,
+    HandoffMessage,
+    Message,
+    ReleaseAckMessage,
+    ReleaseMessage,
+    ReplyMessage,
+    StateMessage,
+)
 from mrmp.protocol.safety import SafetyLayer
 from mrmp.robot.belief import Belief
 from mrmp.robot.messaging import Handlers, MessageEndpoint, Outgoing
@@ -82,6 +90,11 @@ class Robot(MessageEndpoint):
     silence_timeout:
         A peer not heard from for this long is *silent*: its policy treats it as
         standing still at its last known cells (None: never).
+    following:
+        The safety layer's lockstep rule (a robot may enter a cell its occupant
+        leaves in the same tick; :class:`~mrmp.protocol.safety.SafetyLayer`),
+        for drivers that move every allowed robot at once, at the end of the
+        tick (the lockstep simulator). Live bodies keep the default.
     """
 
     def __init__(
@@ -95,6 +108,7 @@ class Robot(MessageEndpoint):
         claim_timeout: float = 4.0,
         retry_interval: float = 1.0,
         silence_timeout: float | None = None,
+        following: bool = False,
     ) -> None:
         self.id = spec.id
         self.silence_timeout = silence_timeout
@@ -111,7 +125,12 @@ class Robot(MessageEndpoint):
         self.moving = False
         self.belief = Belief()
         self.safety = SafetyLayer(
-            index, starts, claim_timeout=claim_timeout, retry_interval=retry_interval, keep_releases=guarded
+            index,
+            starts,
+            claim_timeout=claim_timeout,
+            retry_interval=retry_interval,
+            keep_releases=guarded,
+            following=following and guarded,
         )
         self.seq = 0
         self.progress = 0
@@ -223,8 +242,13 @@ class Robot(MessageEndpoint):
 
     @handlers.on(ReplyMessage)
     def _take_reply(self, message: ReplyMessage, now: float) -> list[Outgoing]:
-        self.safety.handle_reply(message, now)
-        return []
+        sends = self.safety.handle_reply(message, now)
+        return [Outgoing(self._stamp(sent), recipients) for sent, recipients in sends]
+
+    @handlers.on(HandoffMessage)
+    def _take_handoff(self, message: HandoffMessage, now: float) -> list[Outgoing]:
+        sends = self.safety.handle_handoff(message)
+        return [Outgoing(self._stamp(sent), recipients) for sent, recipients in sends]
 
     @handlers.on(ReleaseMessage)
     def _take_release(self, message: ReleaseMessage, now: float) -> list[Outgoing]:

@@ -88,6 +88,11 @@ class LockstepSimulator:
     on_tick:
         Called at the end of every tick with the tick and the robots' cells
         (for watching a run as it goes).
+    following:
+        Run the safety layer under the lockstep model's rule (the default): a
+        robot may enter a cell its occupant leaves in the same tick, once that
+        one has handed it off (``docs/protocol.md``). False keeps the rule of
+        live bodies, under which a cell is entered only after its release.
     """
 
     def __init__(
@@ -98,6 +103,7 @@ class LockstepSimulator:
         *,
         record_messages: bool = False,
         on_tick: TickObserver | None = None,
+        following: bool = True,
     ) -> None:
         self.scenario = scenario
         grid = scenario.grid
@@ -113,6 +119,7 @@ class LockstepSimulator:
                 guarded=scenario.safety,
                 claim_timeout=timeout,
                 retry_interval=retry,
+                following=following,
             )
             for index, spec in enumerate(scenario.robots)
         ]
