@@ -3,7 +3,7 @@
 Runs reactive A* and the thesis policy, guarded, on random-32-32-20 (MovingAI,
 the first N agents of scenario 1) for several fleet sizes, on a perfect network,
 and prints for each run the moves made and the datagrams sent per robot-move,
-split into states and the safety layer's claims, replies, releases and their
+split into states and the safety layer's claims, replies, handoffs, releases and their
 acknowledgements. Counts are deterministic.
 
 Usage: python bench/messages_per_move.py [--sizes 10,25,50] [--max-ticks 200]
@@ -20,7 +20,7 @@ from mrmp.io.scenario_file import load_movingai_scenario
 from mrmp.sim.simulator import simulate
 
 MAPS = Path(__file__).resolve().parent.parent / "maps"
-SAFETY_KINDS = ("claim", "reply", "release", "releaseack")
+SAFETY_KINDS = ("claim", "reply", "handoff", "release", "releaseack")
 
 
 def main() -> int:

@@ -56,6 +56,8 @@ class Situation:
     goal: Cell
     grid: Grid
     peers: Mapping[int, PeerState]
+    now: float = 0.0
+    """The driver's time of the decision (ticks in the lockstep simulator)."""
 
 
 @dataclass(frozen=True, slots=True)

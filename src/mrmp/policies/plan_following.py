@@ -52,13 +52,30 @@ class PlanFollowingPolicy:
     dependencies:
         For a move index, the ``(robot, progress)`` pairs it waits for: robot
         ``robot`` must have completed at least ``progress`` moves.
+    not_before:
+        Optionally, for each move, the plan's tick of it: the move is not made
+        before that time (the situation's ``now``, ticks in the lockstep
+        simulator), so that on a perfect network the robot keeps the plan's
+        waits too and its path is the planned one; late robots go as soon as
+        their dependencies allow.
+
+    >>> from mrmp.core import Grid, Heading
+    >>> policy = PlanFollowingPolicy([(0, 1)], {}, not_before=[3])
+    >>> [policy.intend(Situation(0, (0, 0), Heading.EAST, (0, 1), Grid(1, 2), {}, now)) for now in (2, 3)]
+    [(0, 0), (0, 1)]
     """
 
     name = "plan"
 
-    def __init__(self, moves: Sequence[Cell], dependencies: Mapping[int, Sequence[tuple[int, int]]]) -> None:
+    def __init__(
+        self,
+        moves: Sequence[Cell],
+        dependencies: Mapping[int, Sequence[tuple[int, int]]],
+        not_before: Sequence[int] | None = None,
+    ) -> None:
         self.moves = list(moves)
         self.dependencies = {move: list(needs) for move, needs in dependencies.items()}
+        self.not_before = list(not_before) if not_before is not None else None
         self.done = 0
         self.waits_for: list[int] = []
 
@@ -80,6 +97,8 @@ class PlanFollowingPolicy:
         """The next cell of the plan once its dependencies are met, else the present cell."""
         self._catch_up(situation.present)
         if self.done >= len(self.moves) or not self.ready(situation):
+            return situation.present
+        if self.not_before is not None and situation.now < self.not_before[self.done]:
             return situation.present
         return self.moves[self.done]
 

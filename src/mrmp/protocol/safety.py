@@ -19,6 +19,16 @@ up a claim, and repeats it until each replica acknowledges it
 (:class:`~mrmp.protocol.messages.ReleaseAckMessage`) or a bounded number of
 tries passes.
 
+**Following, in the lockstep model** (``following=True``, for a driver that
+moves every allowed robot at once at the end of the tick in which its claim won
+its majority): such a robot is *committed* to its move, and hands its Present
+off (:class:`~mrmp.protocol.messages.HandoffMessage` to the Present's
+replicas). A replica may register a handed-off cell to another robot, and grants
+at once the claim it refused for that cell in the meantime; so a robot may
+enter, in the same tick, the cell its occupant leaves. A robot hands off only
+once its own claim has a majority, so the robots waiting on each other's
+handoffs form chains, never cycles: no swap, no rotation.
+
 Safety (no two robots ever cover one cell, whatever is lost, delayed,
 duplicated or reordered): two majorities of one replica set share at least one
 robot, and that robot registers a cell to at most one owner at a time; a
@@ -43,6 +53,7 @@ Examples
 >>> claim.cell, layer.replicas_of((0, 1)), layer.may_enter((0, 1))
 ((0, 1), (0, 1, 2), False)
 >>> layer.handle_reply(ReplyMessage(sender=2, seq=1, claimant=0, claim=claim.claim, cell=(0, 1), granted=True), now=0.1)
+[]
 >>> layer.may_enter((0, 1))
 True
 >>> layer.begin_move((0, 1)); layer.end_move((0, 1))

@@ -152,7 +152,7 @@ class Robot(MessageEndpoint):
                     index: replace(peer, silent=True, next=peer.present) if peer.heard_at < horizon else peer
                     for index, peer in peers.items()
                 }
-        return Situation(self.index, self.present, self.heading, self.goal, self.grid, peers)
+        return Situation(self.index, self.present, self.heading, self.goal, self.grid, peers, self.now)
 
     def state_message(self) -> StateMessage:
         """A fresh state message: Present, Next, heading, arrival and safety state."""

@@ -346,7 +346,7 @@ def simulate(
     >>> seen
     [(1, [(0, 1), (0, 2)])]
     >>> sorted(set(result.message_log[1]))
-    [('A', 'B', 'claim'), ('A', 'B', 'release'), ('A', 'B', 'state'), ('B', 'A', 'reply'), ('B', 'A', 'state')]
+    [('A', 'B', 'claim'), ('A', 'B', 'handoff'), ('A', 'B', 'release'), ('A', 'B', 'state'), ('B', 'A', 'reply'), ('B', 'A', 'state')]
     """
     entry = policy_entry(scenario.policy.name) if policies is None else None
     if entry is not None and not entry.per_robot:
