@@ -73,4 +73,11 @@ def execute_in_simulator(
     if scenario.max_ticks is None:
         scenario = scenario.with_changes(max_ticks=execution_max_ticks(scenario, plan))
     result = simulate(scenario, policies=policies, record_messages=record_messages, on_tick=on_tick)
-    return replace(result, planning_time_s=plan.planning_time_s, plan_bytes=size, policy=plan.planner)
+    return replace(
+        result,
+        planning_time_s=plan.planning_time_s,
+        plan_bytes=size,
+        policy=plan.planner,
+        plan_sum_of_costs=plan.sum_of_costs(),
+        plan_makespan=plan.makespan(),
+    )

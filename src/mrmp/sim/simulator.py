@@ -345,8 +345,9 @@ def simulate(
     >>> result = simulate(swap, record_messages=True, on_tick=lambda tick, cells: seen.append((tick, cells)))
     >>> seen
     [(1, [(0, 1), (0, 2)])]
-    >>> sorted(set(result.message_log[1]))
-    [('A', 'B', 'claim'), ('A', 'B', 'handoff'), ('A', 'B', 'release'), ('A', 'B', 'state'), ('B', 'A', 'reply'), ('B', 'A', 'state')]
+    >>> sorted(set(result.message_log[1]))  # doctest: +NORMALIZE_WHITESPACE
+    [('A', 'B', 'claim'), ('A', 'B', 'handoff'), ('A', 'B', 'release'), ('A', 'B', 'state'),
+     ('B', 'A', 'reply'), ('B', 'A', 'state')]
     """
     entry = policy_entry(scenario.policy.name) if policies is None else None
     if entry is not None and not entry.per_robot:
