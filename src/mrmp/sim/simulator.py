@@ -59,14 +59,17 @@ times the expected tries of a claim under loss)."""
 def safety_timers(delay_max: int) -> tuple[int, int]:
     """Retry interval and claim timeout, in ticks, for a network delaying up to ``delay_max`` ticks.
 
-    A claim and its answer take up to ``2 * delay_max`` ticks; a claim is sent
-    again after one such round trip and abandoned after three.
+    A claim and its answer take up to ``2 * delay_max`` ticks (within the tick
+    on a network without delay); a claim still short of its majority after one
+    such round trip is sent again when the robot's timers run at the end of
+    that tick, and abandoned after about three (``3 * (2 * delay_max + 1) + 1``
+    ticks).
 
     >>> safety_timers(0), safety_timers(3)
-    ((1, 4), (7, 22))
+    ((0, 4), (6, 22))
     """
-    retry = 2 * delay_max + 1
-    return retry, 3 * retry + 1
+    retry = 2 * delay_max
+    return retry, 3 * (retry + 1) + 1
 
 
 class LockstepSimulator:
