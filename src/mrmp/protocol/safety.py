@@ -324,6 +324,25 @@ class SafetyLayer:
         sends.extend(self._releases_due(now))
         return sends
 
+    def resend_claim(self, now: float) -> list[Send]:
+        """Send the pending claim again to the replicas that have not granted it, if it is due for a resend.
+
+        For a driver that gives the exchange of a tick a second round (the
+        lockstep simulator): a claim short of its majority, not refused, whose
+        retry interval has passed (at once on a network without delay, where
+        every answer is in by then) goes again to the replicas missing.
+        """
+        pending = self.pending
+        if pending is None or pending.committed or pending.refused or len(pending.votes) >= self.quorum:
+            return []
+        if now - pending.sent_at < self.retry_interval:
+            return []
+        missing = tuple(replica for replica in self.claim_recipients(pending.cell) if replica not in pending.votes)
+        if not missing:
+            return []
+        pending.sent_at = now
+        return [(ClaimMessage(self.index, 0, pending.number, pending.cell), missing)]
+
     def state_fields(self) -> dict[str, object]:
         """The safety part of this robot's state message: ``target``, ``claim``, ``claim_cell``."""
         claim = self.granted_claim or self.pending

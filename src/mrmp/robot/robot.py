@@ -187,6 +187,13 @@ class Robot(MessageEndpoint):
             return []
         return [Outgoing(self._stamp(claim), self.safety.claim_recipients(claim.cell))]
 
+    def retry(self, now: float) -> list[Outgoing]:
+        """A second round of the tick's exchange: the claim still short of its majority, sent again if due."""
+        self.now = now
+        if not self.guarded:
+            return []
+        return [Outgoing(self._stamp(message), recipients) for message, recipients in self.safety.resend_claim(now)]
+
     def motion(self, now: float) -> Cell | None:
         """The cell the body may start entering now, if any; the robot then counts as moving."""
         wanted = self.wanted

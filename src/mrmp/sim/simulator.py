@@ -6,7 +6,9 @@ Per tick, as in the thesis (sections 3.5-3.6), with the safety layer:
 2. the network delivers what is due (at once with zero delay; later with delay,
    so decisions rest on stale knowledge), and robots answer claims;
 3. every robot checks for obstacles and decides; a guarded robot claims the
-   cell it chose, and the claims and their answers are delivered;
+   cell it chose, and the claims and their answers are delivered; a claim
+   still short of its majority and due for a resend (at once on a network
+   without delay: an answer was lost) is sent again, and delivered;
 4. every robot whose move is allowed (guarded: a majority registered the cell
    to it; unguarded: always) moves, turning right first when the heading
    changes, and observes its new cell;
@@ -168,6 +170,9 @@ class LockstepSimulator:
         self._drain()
         for robot in robots:
             self._send(robot, robot.decide(tick))
+        self._drain()
+        for robot in robots:
+            self._send(robot, robot.retry(tick))
         self._drain()
         if self.record_decisions:
             self.decisions.append([robot.last_decision for robot in robots])  # type: ignore[misc]

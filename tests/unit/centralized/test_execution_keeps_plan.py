@@ -69,14 +69,14 @@ def test_without_following_the_execution_loses_its_plan():
 @pytest.mark.parametrize(
     ("faults", "bound"),
     [
-        (NetworkFaults(loss=0.1), 1.5),
+        (NetworkFaults(loss=0.1), 1.2),
         (NetworkFaults(loss=0.1, delay_min=0, delay_max=1, duplicate=0.05, reorder=0.1), 3.5),
     ],
     ids=["loss", "loss-delay"],
 )
 @pytest.mark.parametrize("seed", range(2))
 def test_under_loss_and_delay_the_execution_stays_safe_and_degrades_gracefully(faults, bound, seed):
-    """Measured: about 1.3 times the plan's sum of costs with 10% loss, 2.5 to 2.7 with a tick of delay too."""
+    """Measured: about 1.05 times the plan's sum of costs with 10% loss, about 2.5 with a tick of delay too."""
     scenario = instance("random-32-32-20", 30)
     plan = plan_with("lacam", scenario, time_limit_s=60)
     result = execute_in_simulator(scenario.with_changes(network=faults, seed=seed), plan)
