@@ -275,3 +275,24 @@ def test_a_swap_is_refused_a_chain_follows_in_one_tick():
     assert a.handle_handoff(message) == []  # A's own vote for (0, 1): now its own
     a.handle_reply(grant, 1)
     assert a.may_enter((0, 1))
+
+
+def test_a_claim_short_of_its_majority_is_resent_to_the_missing_replicas_only():
+    """The lockstep tick's second round: a lost answer is asked for again at once (retry interval 0)."""
+    starts = [(0, 0), (1, 1), (2, 2), (0, 2)]
+    layer = SafetyLayer(3, starts, retry_interval=0, following=True)
+    cell = next((x, y) for x in range(3, 20) for y in range(3, 20) if 3 not in layer.replicas_of((x, y)))
+    claim = layer.start_claim(cell, 5)
+    first, second, third = layer.replicas_of(cell)
+    layer.handle_reply(ReplyMessage(first, 1, 3, claim.claim, cell, True), 5)
+    [(again, recipients)] = layer.resend_claim(5)
+    assert again.claim == claim.claim and recipients == (second, third)
+    layer.handle_reply(ReplyMessage(second, 1, 3, claim.claim, cell, True), 5)
+    assert layer.resend_claim(5) == [] and layer.may_enter(cell)  # committed: nothing to resend
+    late = SafetyLayer(3, starts, retry_interval=2, following=True)
+    late.start_claim(cell, 5)
+    assert late.resend_claim(5) == [] and len(late.resend_claim(7)) == 1  # not before its answers are due
+    refused = SafetyLayer(3, starts, retry_interval=0, following=True)
+    number = refused.start_claim(cell, 5).claim
+    refused.handle_reply(ReplyMessage(first, 1, 3, number, cell, False), 5)
+    assert refused.resend_claim(5) == []  # refused: given up at the tick's end instead
