@@ -328,12 +328,17 @@ class SafetyLayer:
         """Send the pending claim again to the replicas that have not granted it, if it is due for a resend.
 
         For a driver that gives the exchange of a tick a second round (the
-        lockstep simulator): a claim short of its majority, not refused, whose
-        retry interval has passed (at once on a network without delay, where
-        every answer is in by then) goes again to the replicas missing.
+        lockstep simulator): a claim short of its majority whose retry interval
+        has passed (at once on a network without delay, where every answer is in
+        by then) goes again to the replicas that have not granted it. A refused
+        claim is sent again only under the lockstep rule, where a refusing
+        replica may have granted it since (its owner handed the cell off) and
+        that grant may have been lost; otherwise it is given up.
         """
         pending = self.pending
-        if pending is None or pending.committed or pending.refused or len(pending.votes) >= self.quorum:
+        if pending is None or pending.committed or len(pending.votes) >= self.quorum:
+            return []
+        if pending.refused and not self.following:
             return []
         if now - pending.sent_at < self.retry_interval:
             return []
