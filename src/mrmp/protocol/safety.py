@@ -59,6 +59,20 @@ True
 >>> layer.begin_move((0, 1)); layer.end_move((0, 1))
 >>> [(type(message).__name__, message.cell, recipients) for message, recipients in layer.expire(now=1.0)]
 [('ReleaseMessage', (0, 0), (1, 2))]
+
+The lockstep rule: robot 1 leaves (0, 1) for (0, 2), and robot 0 follows it in, in the same tick:
+
+>>> a, b = SafetyLayer(0, [(0, 0), (0, 1)], following=True), SafetyLayer(1, [(0, 0), (0, 1)], following=True)
+>>> follow = a.start_claim((0, 1), now=1)
+>>> b.handle_claim(follow, claimant_outranks=False).granted   # robot 1 stands there, not yet leaving
+False
+>>> lead = b.start_claim((0, 2), now=1)
+>>> sends = b.handle_reply(a.handle_claim(lead, claimant_outranks=False), now=1)   # its majority: it commits
+>>> [(type(message).__name__, message.cell) for message, _ in sends]   # hands (0, 1) off, grants the claim refused
+[('HandoffMessage', (0, 1)), ('ReplyMessage', (0, 1))]
+>>> _ = a.handle_handoff(sends[0][0]); _ = a.handle_reply(sends[1][0], now=1)
+>>> a.may_enter((0, 1)), b.may_enter((0, 2))
+(True, True)
 """
 
 from __future__ import annotations
