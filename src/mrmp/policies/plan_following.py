@@ -26,11 +26,13 @@ Examples
 >>> def at(cell, peer_progress):
 ...     peer = PeerState(1, (1, 1), (1, 1), Heading.NORTH, False, 1, 0.0, progress=peer_progress)
 ...     return Situation(0, cell, Heading.EAST, (0, 2), Grid(2, 3), {1: peer})
->>> policy.intend(at((0, 0), 0))
+>>> policy.decide(at((0, 0), 0), (0, 1)).next
 (0, 1)
->>> policy.intend(at((0, 1), 0))   # move 1 waits until robot 1 has completed its first move
-(0, 1)
->>> policy.intend(at((0, 1), 1))
+>>> policy.decide(at((0, 1), 0), (0, 2))   # move 1 waits until robot 1 has completed its first move
+Decision(next=(0, 1), reason='wait', conflicts=(1,))
+>>> policy.intend(at((0, 1), 0))   # its Next, announced to its peers, is the plan's next cell all the same
+(0, 2)
+>>> policy.decide(at((0, 1), 1), (0, 2)).next
 (0, 2)
 """
 
@@ -61,7 +63,7 @@ class PlanFollowingPolicy:
 
     >>> from mrmp.core import Grid, Heading
     >>> policy = PlanFollowingPolicy([(0, 1)], {}, not_before=[3])
-    >>> [policy.intend(Situation(0, (0, 0), Heading.EAST, (0, 1), Grid(1, 2), {}, now)) for now in (2, 3)]
+    >>> [policy.decide(Situation(0, (0, 0), Heading.EAST, (0, 1), Grid(1, 2), {}, now), (0, 1)).next for now in (2, 3)]
     [(0, 0), (0, 1)]
     """
 
@@ -94,7 +96,15 @@ class PlanFollowingPolicy:
         return not waiting
 
     def intend(self, situation: Situation) -> Cell:
-        """The next cell of the plan once its dependencies are met, else the present cell."""
+        """The next cell of the plan (the present cell once the plan is done), whether or not it may go yet.
+
+        Announced as the robot's Next, it tells the robot it waits for which cell it wants.
+        """
+        self._catch_up(situation.present)
+        return self.moves[self.done] if self.done < len(self.moves) else situation.present
+
+    def _allowed(self, situation: Situation) -> Cell:
+        """The next cell of the plan once its dependencies are met and its tick has come, else the present cell."""
         self._catch_up(situation.present)
         if self.done >= len(self.moves) or not self.ready(situation):
             return situation.present
@@ -105,10 +115,9 @@ class PlanFollowingPolicy:
     def decide(self, situation: Situation, intended: Cell) -> Decision:
         """Follow the plan: the dependencies already ruled out every conflict.
 
-        Readiness is checked again with what the peers said since :meth:`intend`
-        (a dependency met meanwhile lets the robot go now rather than a step later).
+        Readiness is checked with what the peers have said by now.
         """
-        intended = self.intend(situation)
+        intended = self._allowed(situation)
         if intended == situation.present:
             reason = "arrived" if situation.present == situation.goal and self.done >= len(self.moves) else "wait"
             return Decision(situation.present, reason, tuple(self.waits_for))

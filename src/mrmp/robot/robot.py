@@ -136,6 +136,7 @@ class Robot(MessageEndpoint):
         self.progress = 0
         self.dropped: Counter[str] = Counter()
         self.last_decision: Decision | None = None
+        self._repeat_state: Cell | None = None  # the cell just left, until the state is repeated
 
     @property
     def arrived(self) -> bool:
@@ -188,11 +189,26 @@ class Robot(MessageEndpoint):
         return [Outgoing(self._stamp(claim), self.safety.claim_recipients(claim.cell))]
 
     def retry(self, now: float) -> list[Outgoing]:
-        """A second round of the tick's exchange: the claim still short of its majority, sent again if due."""
+        """A second round of the tick's exchange: the claim still short of its majority, sent again if due.
+
+        A guarded robot that has just moved also repeats its state to the peers that
+        announced the cell it left or the cell it entered as their Next (those
+        that wait for it to be gone, or there), so that one lost state does not
+        hold them back.
+        """
         self.now = now
+        sends: list[Outgoing] = []
         if not self.guarded:
-            return []
-        return [Outgoing(self._stamp(message), recipients) for message, recipients in self.safety.resend_claim(now)]
+            return sends  # the thesis's robots as written send their state once a step
+        if self._repeat_state is not None:
+            cells = (self._repeat_state, self.present)
+            self._repeat_state = None
+            waiting = tuple(index for index, peer in self.belief.peers.items() if peer.next in cells)
+            if waiting:
+                sends.append(Outgoing(self.state_message(), waiting))
+        if self.guarded:
+            sends.extend(Outgoing(self._stamp(message), recipients) for message, recipients in self.safety.resend_claim(now))
+        return sends
 
     def motion(self, now: float) -> Cell | None:
         """The cell the body may start entering now, if any; the robot then counts as moving."""
@@ -210,6 +226,7 @@ class Robot(MessageEndpoint):
         """The body reports the cell it now stands on and its heading (from its own sensors)."""
         if cell != self.present:
             self.progress += 1
+            self._repeat_state = self.present
         self.present = cell
         self.heading = heading
         self.moving = False
