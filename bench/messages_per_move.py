@@ -4,7 +4,7 @@ Runs reactive A*, the thesis policy and the execution of a LaCAM plan, guarded,
 on MovingAI instances (the first N agents of scenario 1; random-32-32-20 holds
 at most 409, so N=1000 runs on random-64-64-20), on a perfect network, and
 prints for each run the moves made, the datagrams sent per robot-move, split
-into states and the safety layer's claims, replies, releases and their
+into states and the safety layer's claims, replies, handoffs, releases and their
 acknowledgements, and the datagrams per robot-tick (whether the robot moves or
 not). Counts are deterministic. States go to the robots within the policy's
 interaction radius (``docs/protocol.md``, "Neighbourhoods"), so these figures
@@ -34,7 +34,7 @@ from mrmp.io.scenario_file import load_movingai_scenario
 from mrmp.sim.simulator import simulate
 
 MAPS = Path(__file__).resolve().parent.parent / "maps"
-SAFETY_KINDS = ("claim", "reply", "release", "releaseack")
+SAFETY_KINDS = ("claim", "reply", "handoff", "release", "releaseack")
 PLANNERS = ("lacam", "pp", "cbs")
 
 

@@ -443,6 +443,8 @@ def print_result(result: RunResult, console: Console) -> None:
             f"({result.time_makespan_s:.1f} s), sum of costs {result.sum_of_costs}, lower bound {result.lower_bound}, "
             f"collisions: {len(result.collisions)}, messages {result.messages}, wall time {result.wall_time_s:.3f} s"
         )
+    if result.plan_sum_of_costs is not None:
+        console.print(f"  the plan executed: sum of costs {result.plan_sum_of_costs}, makespan {result.plan_makespan}")
     for collision in result.collisions[:10]:
         console.print(f"  [red]{collision.describe()}[/red]")
     if len(result.collisions) > 10:

@@ -34,9 +34,10 @@ TOO_LONG = (
     "out/standard --out",
     "bench/chapter5.py",
     "bench/messages_per_move.py",
+    "bench/plan_execution.py",
 )
 """Commands left out of the run for their length (the standard matrix takes 12 minutes, chapter 5 more, the messages
-per move up to 1000 robots several), by a fragment."""
+per move up to 1000 robots several, the executions of plans for 200 robots minutes), by a fragment."""
 
 
 @dataclass(frozen=True)

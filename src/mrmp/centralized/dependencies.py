@@ -210,10 +210,25 @@ def plan_moves(path: Sequence[Cell]) -> tuple[list[Cell], list[int]]:
     return cells, ticks
 
 
-def action_dependencies(paths: Sequence[Sequence[Cell]]) -> tuple[list[list[Cell]], list[dict[int, list[tuple[int, int]]]]]:
+def action_dependencies(
+    paths: Sequence[Sequence[Cell]], *, following: bool = False
+) -> tuple[list[list[Cell]], list[dict[int, list[tuple[int, int]]]]]:
     """Every robot's moves and, per move, the ``(robot, progress)`` pairs it must wait for.
 
     The graph is checked before it is returned (:func:`check_executable`).
+
+    With ``following``, a move that *follows* another robot's (that robot
+    leaves the cell at the very tick this one enters it) waits only until that
+    robot stands on the cell, ready to leave (its progress one less): the two
+    moves may then happen in one tick, and what keeps the follower out until
+    the leader leaves is the safety layer's lockstep rule
+    (:class:`~mrmp.protocol.safety.SafetyLayer`, ``following``), not the
+    graph. So these dependencies are for guarded robots of the lockstep
+    simulator only; the check is made on the strict graph, which a rotation
+    makes cyclic (the safety layer refuses rotations too).
+
+    >>> action_dependencies([[(0, 0), (0, 1), (0, 2)], [(0, 1), (0, 2), (0, 3)]], following=True)[1]
+    [{0: [(1, 0)], 1: [(1, 1)]}, {}]
 
     Raises
     ------
@@ -232,6 +247,7 @@ def action_dependencies(paths: Sequence[Sequence[Cell]]) -> tuple[list[list[Cell
     for cell_visits in visits.values():
         cell_visits.sort()
     dependencies: list[dict[int, list[tuple[int, int]]]] = []
+    follows: list[tuple[int, int, int]] = []  # (robot, move, position in its needs): same-tick dependencies
     for robot, (cells, ticks) in enumerate(moves_and_ticks):
         needs: dict[int, list[tuple[int, int]]] = {}
         for move, (cell, tick) in enumerate(zip(cells, ticks)):
@@ -247,9 +263,15 @@ def action_dependencies(paths: Sequence[Sequence[Cell]]) -> tuple[list[list[Cell
                 if leaving is None:
                     raise ValueError(f"robot {robot} enters {cell} at tick {tick} but robot {other} never leaves it")
                 needs.setdefault(move, []).append((other, leaving + 1))
+                if other_ticks[leaving] == tick:
+                    follows.append((robot, move, len(needs[move]) - 1))
         dependencies.append(needs)
     moves = [cells for cells, _ in moves_and_ticks]
     check_executable(moves, dependencies, [ticks for _, ticks in moves_and_ticks])
+    if following:
+        for robot, move, position in follows:
+            other, progress = dependencies[robot][move][position]
+            dependencies[robot][move][position] = (other, progress - 1)
     return moves, dependencies
 
 

@@ -19,14 +19,20 @@ from __future__ import annotations
 
 from collections.abc import Sequence
 
-from mrmp.centralized.dependencies import action_dependencies, action_dependents
+from mrmp.centralized.dependencies import action_dependencies, action_dependents, plan_moves
 from mrmp.centralized.plan import PlanningResult
 from mrmp.core.errors import MrmpError
 from mrmp.policies.plan_following import PlanFollowingPolicy
 
 
-def plan_policies(plan: PlanningResult) -> list[PlanFollowingPolicy]:
+def plan_policies(plan: PlanningResult, *, following: bool = False, scheduled: bool = False) -> list[PlanFollowingPolicy]:
     """One plan-following policy per robot, in scenario order.
+
+    ``following``: robots guarded by the safety layer's lockstep rule may make
+    a move that follows another robot's in the same tick as that one
+    (:func:`~mrmp.centralized.dependencies.action_dependencies`).
+    ``scheduled``: each move waits for its planned tick too (drivers whose
+    time is counted in the plan's ticks: the lockstep simulator).
 
     Raises
     ------
@@ -35,10 +41,11 @@ def plan_policies(plan: PlanningResult) -> list[PlanFollowingPolicy]:
     """
     if plan.paths is None:
         raise MrmpError(f"{plan.planner}: no plan to execute ({plan.status}: {plan.message})")
-    moves, dependencies = action_dependencies(plan.paths)
+    moves, dependencies = action_dependencies(plan.paths, following=following)
+    schedules = [plan_moves(path)[1] if scheduled else None for path in plan.paths]
     return [
-        PlanFollowingPolicy(robot_moves, needs, waiting)
-        for robot_moves, needs, waiting in zip(moves, dependencies, action_dependents(dependencies))
+        PlanFollowingPolicy(robot_moves, needs, waiting, not_before=schedule)
+        for robot_moves, needs, waiting, schedule in zip(moves, dependencies, action_dependents(dependencies), schedules)
     ]
 
 

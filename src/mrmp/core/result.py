@@ -107,7 +107,9 @@ class RunResult:
     ``ideal_makespan_s`` is the longest single-robot path time at the run's
     speed. Runs executing a central plan carry the wall time spent planning,
     ``planning_time_s``, and the size of the shares of the plan handed to the
-    robots (their moves and dependencies), ``plan_bytes``. In a ``lifelong``
+    robots (their moves and dependencies), ``plan_bytes``, and the plan's own
+    figures, ``plan_sum_of_costs`` and ``plan_makespan`` (what the execution is
+    measured against). In a ``lifelong``
     run robots receive new goals as they reach theirs; its figure is the
     ``throughput``, goals reached per tick. A run simulated with
     ``record_messages`` carries its ``message_log``: for each tick (index 0,
@@ -130,6 +132,8 @@ class RunResult:
     ideal_makespan_s: float | None = None
     planning_time_s: float | None = None
     plan_bytes: int | None = None
+    plan_sum_of_costs: int | None = None
+    plan_makespan: int | None = None
     lifelong: bool = False
     message_log: list[list[tuple[str, str, str]]] | None = None
 

@@ -3,7 +3,10 @@
 Each robot follows its share of the plan (:func:`mrmp.centralized.execution.plan_policies`:
 its own moves and the progress of others each move waits for, from the plan's
 Action Dependency Graph, Hönig et al., RA-L 2019), learning its peers' progress
-only from their messages, under the scenario's network faults.
+only from their messages, under the scenario's network faults. Guarded robots
+make a move that follows another's in the same tick as that one (the safety
+layer's lockstep rule), and no move before its planned tick: on a perfect
+network the executed paths are the planned paths; late messages only delay.
 
 Examples
 --------
@@ -12,8 +15,8 @@ Examples
 >>> scenario = Scenario(Grid(1, 3), (RobotSpec("A", (0, 0), (0, 1)), RobotSpec("B", (0, 1), (0, 2))))
 >>> plan = PlanningResult("solved", pad_paths([[(0, 0), (0, 1)], [(0, 1), (0, 2)]]), 0.0, "hand")
 >>> result = execute_in_simulator(scenario, plan)
->>> result.success, [robot.path for robot in result.robots]
-(True, [[(0, 0), (0, 0), (0, 1)], [(0, 1), (0, 2), (0, 2)]])
+>>> result.success, [robot.path for robot in result.robots]   # A follows B in the same tick, as planned
+(True, [[(0, 0), (0, 1)], [(0, 1), (0, 2)]])
 """
 
 from __future__ import annotations
@@ -65,9 +68,16 @@ def execute_in_simulator(
 
     ``record_messages`` and ``on_tick`` are passed to :func:`~mrmp.sim.simulator.simulate`.
     """
-    policies = plan_policies(plan)
+    policies = plan_policies(plan, following=scenario.safety, scheduled=True)
     size = distributed_bytes(policies)
     if scenario.max_ticks is None:
         scenario = scenario.with_changes(max_ticks=execution_max_ticks(scenario, plan))
     result = simulate(scenario, policies=policies, record_messages=record_messages, on_tick=on_tick)
-    return replace(result, planning_time_s=plan.planning_time_s, plan_bytes=size, policy=plan.planner)
+    return replace(
+        result,
+        planning_time_s=plan.planning_time_s,
+        plan_bytes=size,
+        policy=plan.planner,
+        plan_sum_of_costs=plan.sum_of_costs(),
+        plan_makespan=plan.makespan(),
+    )

@@ -114,6 +114,8 @@ def result_to_dict(result: RunResult, grid: Grid | None = None) -> dict[str, Any
         "ideal_makespan_s": result.ideal_makespan_s,
         "planning_time_s": result.planning_time_s,
         "plan_bytes": result.plan_bytes,
+        "plan_sum_of_costs": result.plan_sum_of_costs,
+        "plan_makespan": result.plan_makespan,
         "lifelong": result.lifelong,
         "throughput": result.throughput,
         "collisions": [_collision_to_dict(collision) for collision in result.collisions],
@@ -301,6 +303,8 @@ def result_from_dict(data: Mapping[str, Any], source: str = "result") -> RunResu
             fields.get("planning_time_s", (int, float, type(None)), "a number or null", None)
         ),
         plan_bytes=fields.get("plan_bytes", (int, type(None)), "an integer or null", None),
+        plan_sum_of_costs=fields.get("plan_sum_of_costs", (int, type(None)), "an integer or null", None),
+        plan_makespan=fields.get("plan_makespan", (int, type(None)), "an integer or null", None),
         lifelong=fields.get("lifelong", bool, "true or false", False),
         message_log=_message_log(fields.get("message_log", (list, type(None)), "a list of ticks or null", None), source),
     )

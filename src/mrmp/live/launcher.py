@@ -352,5 +352,7 @@ def _judge(
             policy=options.plan.planner,
             planning_time_s=options.plan.planning_time_s,
             plan_bytes=distributed_bytes(plan_policies(options.plan)),
+            plan_sum_of_costs=options.plan.sum_of_costs(),
+            plan_makespan=options.plan.makespan(),
         )
     return result

@@ -57,6 +57,8 @@ class Situation:
     grid: Grid
     peers: Mapping[int, PeerState]
     progress: Mapping[int, int] | None = None
+    now: float = 0.0
+    """The driver's time of the decision (ticks in the lockstep simulator)."""
 
     def progress_of(self, index: int) -> int:
         """The most moves peer ``index`` is known to have completed (0 if never heard).

@@ -36,11 +36,13 @@ Examples
 >>> def at(cell, peer_progress):
 ...     peer = PeerState(1, (1, 1), (1, 1), Heading.NORTH, False, 1, 0.0, progress=peer_progress)
 ...     return Situation(0, cell, Heading.EAST, (0, 2), Grid(2, 3), {1: peer})
->>> policy.intend(at((0, 0), 0))
+>>> policy.decide(at((0, 0), 0), (0, 1)).next
 (0, 1)
->>> policy.intend(at((0, 1), 0))   # move 1 waits until robot 1 has completed its first move
-(0, 1)
->>> policy.intend(at((0, 1), 1))
+>>> policy.decide(at((0, 1), 0), (0, 2))   # move 1 waits until robot 1 has completed its first move
+Decision(next=(0, 1), reason='wait', conflicts=(1,))
+>>> policy.intend(at((0, 1), 0))   # its Next, announced to its peers, is the plan's next cell all the same
+(0, 2)
+>>> policy.decide(at((0, 1), 1), (0, 2)).next
 (0, 2)
 """
 
@@ -67,6 +69,17 @@ class PlanFollowingPolicy:
         pairs whose move (an index into that robot's moves) waits for it to have
         completed ``k`` moves (whom its states must reach); when omitted,
         unknown, and its states go to every peer.
+    not_before:
+        Optionally, for each move, the plan's tick of it: the move is not made
+        before that time (the situation's ``now``, ticks in the lockstep
+        simulator), so that on a perfect network the robot keeps the plan's
+        waits too and its path is the planned one; late robots go as soon as
+        their dependencies allow.
+
+    >>> from mrmp.core import Grid, Heading
+    >>> policy = PlanFollowingPolicy([(0, 1)], {}, not_before=[3])
+    >>> [policy.decide(Situation(0, (0, 0), Heading.EAST, (0, 1), Grid(1, 2), {}, now=now), (0, 1)).next for now in (2, 3)]
+    [(0, 0), (0, 1)]
     """
 
     name = "plan"
@@ -76,9 +89,12 @@ class PlanFollowingPolicy:
         moves: Sequence[Cell],
         dependencies: Mapping[int, Sequence[tuple[int, int]]],
         dependents: Mapping[int, Sequence[tuple[int, int]]] | None = None,
+        *,
+        not_before: Sequence[int] | None = None,
     ) -> None:
         self.moves = list(moves)
         self.dependencies = {move: list(needs) for move, needs in dependencies.items()}
+        self.not_before = list(not_before) if not_before is not None else None
         self.dependents = None if dependents is None else {done: tuple(pairs) for done, pairs in dependents.items()}
         self._waiting_on_me: dict[int, list[tuple[int, int]]] = {}
         for done, pairs in (self.dependents or {}).items():
@@ -133,19 +149,28 @@ class PlanFollowingPolicy:
         return tuple(sorted(robots))
 
     def intend(self, situation: Situation) -> Cell:
-        """The next cell of the plan once its dependencies are met, else the present cell."""
+        """The next cell of the plan (the present cell once the plan is done), whether or not it may go yet.
+
+        Announced as the robot's Next, it tells the robot it waits for which cell it wants.
+        """
+        self._catch_up(situation.present)
+        return self.moves[self.done] if self.done < len(self.moves) else situation.present
+
+    def _allowed(self, situation: Situation) -> Cell:
+        """The next cell of the plan once its dependencies are met and its tick has come, else the present cell."""
         self._catch_up(situation.present)
         if self.done >= len(self.moves) or not self.ready(situation):
+            return situation.present
+        if self.not_before is not None and situation.now < self.not_before[self.done]:
             return situation.present
         return self.moves[self.done]
 
     def decide(self, situation: Situation, intended: Cell) -> Decision:
         """Follow the plan: the dependencies already ruled out every conflict.
 
-        Readiness is checked again with what the peers said since :meth:`intend`
-        (a dependency met meanwhile lets the robot go now rather than a step later).
+        Readiness is checked with what the peers have said by now.
         """
-        intended = self.intend(situation)
+        intended = self._allowed(situation)
         if intended == situation.present:
             reason = "arrived" if situation.present == situation.goal and self.done >= len(self.moves) else "wait"
             return Decision(situation.present, reason, tuple(self.waits_for))

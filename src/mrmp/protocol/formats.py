@@ -21,6 +21,7 @@ Bodies follow the 10-byte header; cells are two signed 32-bit integers::
    12 lock ack       locker (u32), session (u32)                                        18 bytes in all
    13 release        claim (u32), cell                                                  22 bytes in all
    14 release ack    owner (u32), claim (u32), cell                                     26 bytes in all
+   15 handoff        claim (u32), cell                                                  22 bytes in all
 
 A cell a message does not have (a state's target or claim cell, a grant's
 head) is :data:`~mrmp.protocol.messages.NO_CELL` on the wire, and a flag says
@@ -28,8 +29,8 @@ whether it is there, so that every accepted datagram is exactly one encoding.
 
 Examples
 --------
->>> STATE.size, CLAIM.size, LOCK_GRANT.size, RELEASE.size, RELEASE_ACK.size
-(52, 22, 45, 22, 26)
+>>> STATE.size, CLAIM.size, LOCK_GRANT.size, RELEASE.size, RELEASE_ACK.size, HANDOFF.size
+(52, 22, 45, 22, 26, 22)
 """
 
 from __future__ import annotations
@@ -44,6 +45,7 @@ from mrmp.protocol.messages import (
     AnswerMessage,
     BeaconMessage,
     ClaimMessage,
+    HandoffMessage,
     InheritMessage,
     LockAckMessage,
     LockGrantMessage,
@@ -239,3 +241,11 @@ RELEASE = register(WireFormat(13, ReleaseMessage, "!Iii", lambda m: (m.claim, *m
 RELEASE_ACK = register(
     WireFormat(14, ReleaseAckMessage, "!IIii", lambda m: (m.owner, m.claim, *m.cell), _unpack_release_ack)
 )
+
+
+def _unpack_handoff(sender: int, seq: int, fields: Fields, _: tuple[Cell, ...]) -> HandoffMessage:
+    claim, cx, cy = fields
+    return HandoffMessage(sender, seq, claim, (cx, cy))
+
+
+HANDOFF = register(WireFormat(15, HandoffMessage, "!Iii", lambda m: (m.claim, *m.cell), _unpack_handoff))

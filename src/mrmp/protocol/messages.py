@@ -11,7 +11,8 @@ current claim; see ``docs/protocol.md``).
 
 :class:`ClaimMessage` and :class:`ReplyMessage` are the safety protocol's
 request for a cell and its answer, :class:`ReleaseMessage` and
-:class:`ReleaseAckMessage` its release of a cell and the acknowledgement. :class:`BeaconMessage`,
+:class:`ReleaseAckMessage` its release of a cell and the acknowledgement, :class:`HandoffMessage`
+a robot's commitment to leave its cell in the current tick (the lockstep model's following). :class:`BeaconMessage`,
 :class:`InheritMessage`, :class:`AnswerMessage`, :class:`ReserveMessage` and
 :class:`PullMessage` carry decentralized PIBT (:mod:`mrmp.robot.pibt_robot`).
 :class:`LockRequestMessage`, :class:`LockGrantMessage`,
@@ -152,6 +153,17 @@ class ReleaseMessage(Message):
 
     Claim 0 is the registration every robot holds on its start cell.
     """
+
+    sender: int
+    seq: int
+    claim: int
+    cell: Cell
+
+
+@dataclass(frozen=True, slots=True)
+class HandoffMessage(Message):
+    """To the replicas of ``cell`` (lockstep model only): the sender leaves ``cell``, registered to it for claim
+    ``claim``, in this tick; a replica may register the cell to a robot that follows it in."""
 
     sender: int
     seq: int

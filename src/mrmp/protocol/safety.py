@@ -19,6 +19,16 @@ up a claim, and repeats it until each replica acknowledges it
 (:class:`~mrmp.protocol.messages.ReleaseAckMessage`) or a bounded number of
 tries passes.
 
+**Following, in the lockstep model** (``following=True``, for a driver that
+moves every allowed robot at once at the end of the tick in which its claim won
+its majority): such a robot is *committed* to its move, and hands its Present
+off (:class:`~mrmp.protocol.messages.HandoffMessage` to the Present's
+replicas). A replica may register a handed-off cell to another robot, and grants
+at once the claim it refused for that cell in the meantime; so a robot may
+enter, in the same tick, the cell its occupant leaves. A robot hands off only
+once its own claim has a majority, so the robots waiting on each other's
+handoffs form chains, never cycles: no swap, no rotation.
+
 Safety (no two robots ever cover one cell, whatever is lost, delayed,
 duplicated or reordered): two majorities of one replica set share at least one
 robot, and that robot registers a cell to at most one owner at a time; a
@@ -43,11 +53,26 @@ Examples
 >>> claim.cell, layer.replicas_of((0, 1)), layer.may_enter((0, 1))
 ((0, 1), (0, 1, 2), False)
 >>> layer.handle_reply(ReplyMessage(sender=2, seq=1, claimant=0, claim=claim.claim, cell=(0, 1), granted=True), now=0.1)
+[]
 >>> layer.may_enter((0, 1))
 True
 >>> layer.begin_move((0, 1)); layer.end_move((0, 1))
 >>> [(type(message).__name__, message.cell, recipients) for message, recipients in layer.expire(now=1.0)]
 [('ReleaseMessage', (0, 0), (1, 2))]
+
+The lockstep rule: robot 1 leaves (0, 1) for (0, 2), and robot 0 follows it in, in the same tick:
+
+>>> a, b = SafetyLayer(0, [(0, 0), (0, 1)], following=True), SafetyLayer(1, [(0, 0), (0, 1)], following=True)
+>>> follow = a.start_claim((0, 1), now=1)
+>>> b.handle_claim(follow, claimant_outranks=False).granted   # robot 1 stands there, not yet leaving
+False
+>>> lead = b.start_claim((0, 2), now=1)
+>>> sends = b.handle_reply(a.handle_claim(lead, claimant_outranks=False), now=1)   # its majority: it commits
+>>> [(type(message).__name__, message.cell) for message, _ in sends]   # hands (0, 1) off, grants the claim refused
+[('HandoffMessage', (0, 1)), ('ReplyMessage', (0, 1))]
+>>> _ = a.handle_handoff(sends[0][0]); _ = a.handle_reply(sends[1][0], now=1)
+>>> a.may_enter((0, 1)), b.may_enter((0, 2))
+(True, True)
 """
 
 from __future__ import annotations
@@ -56,7 +81,14 @@ from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 from mrmp.core.cell import Cell
-from mrmp.protocol.messages import ClaimMessage, Message, ReleaseAckMessage, ReleaseMessage, ReplyMessage
+from mrmp.protocol.messages import (
+    ClaimMessage,
+    HandoffMessage,
+    Message,
+    ReleaseAckMessage,
+    ReleaseMessage,
+    ReplyMessage,
+)
 from mrmp.protocol.replicas import REPLICAS, majority, replica_set
 
 RELEASE_TRIES = 32
@@ -76,18 +108,32 @@ class _Registration:
 
     owner: int
     claim: int
+    handed_off: bool = False
+    """The owner has committed to leave the cell in the current tick (lockstep model): it may be registered anew."""
 
 
 @dataclass
 class PendingClaim:
-    """This robot's own claim in progress; ``votes`` are the replicas that granted it (itself included)."""
+    """This robot's own claim in progress.
+
+    ``votes`` are the replicas that granted it (itself included), ``refusers``
+    those whose last answer was a refusal. ``committed`` (lockstep model only):
+    a majority granted it and the robot has handed its Present off, so it moves
+    in this tick whatever comes later.
+    """
 
     number: int
     cell: Cell
     started_at: float
     sent_at: float
     votes: set[int] = field(default_factory=set)
-    refused: bool = False
+    refusers: set[int] = field(default_factory=set)
+    committed: bool = False
+
+    @property
+    def refused(self) -> bool:
+        """Whether some replica's last answer to this claim was a refusal."""
+        return bool(self.refusers)
 
 
 @dataclass
@@ -134,6 +180,16 @@ class SafetyLayer:
     keep_releases:
         Whether releases are sent (False for a robot that moves unguarded, which
         claims nothing and so has nothing to release).
+    following:
+        The lockstep model's rule (``docs/protocol.md``, "Following in the
+        lockstep model"): a robot whose claim has a majority hands its Present
+        off to that cell's replicas (:class:`~mrmp.protocol.messages.HandoffMessage`)
+        and moves in the same tick, and a replica may then register that cell
+        to a robot following it in, granting the claims it refused for it
+        meanwhile. Only for drivers that move every allowed robot at once, at the
+        end of the tick in which its claim won its majority (the lockstep
+        simulator); bodies that cover both cells while they move keep the
+        default, under which a cell is registered anew only once released.
     """
 
     def __init__(
@@ -144,6 +200,7 @@ class SafetyLayer:
         retry_interval: float = 1.0,
         replicas: int = REPLICAS,
         keep_releases: bool = True,
+        following: bool = False,
     ) -> None:
         self.index = index
         self.fleet_size = len(starts)
@@ -152,6 +209,8 @@ class SafetyLayer:
         self.claim_timeout = claim_timeout
         self.retry_interval = retry_interval
         self.keep_releases = keep_releases
+        self.following = following
+        self.present_handed_off = False
         self.present: Cell = starts[index]
         self.present_claim = 0
         self.target: Cell | None = None
@@ -164,6 +223,7 @@ class SafetyLayer:
         self._highest_claim: dict[int, int] = {}
         self._highest_release: dict[int, int] = {}
         self._releases: dict[tuple[Cell, int], _Release] = {}
+        self._deferred: dict[Cell, dict[int, int]] = {}
         for owner, cell in enumerate(starts):
             if owner != index and index in self.replicas_of(cell):
                 self._registry[cell] = _Registration(owner, 0)
@@ -176,7 +236,7 @@ class SafetyLayer:
 
     def owner_of(self, cell: Cell) -> int | None:
         """The robot this robot's registry names for ``cell`` (itself for its own cells), or None."""
-        if cell == self.present or cell == self.target:
+        if (cell == self.present and not self.present_handed_off) or cell == self.target:
             return self.index
         if self.pending is not None and cell == self.pending.cell:
             return self.index
@@ -186,9 +246,13 @@ class SafetyLayer:
         return registration.owner if registration is not None else None
 
     def can_claim(self, cell: Cell) -> bool:
-        """Whether no peer owns ``cell`` in this robot's own registry."""
+        """Whether this robot may ask for ``cell``: no peer owns it in its own registry.
+
+        Under the lockstep model's rule any cell may be asked for (its owner may
+        hand it off in this tick), but this robot's own Present.
+        """
         owner = self.owner_of(cell)
-        return owner is None or owner == self.index
+        return owner is None or owner == self.index or self.following
 
     # -- this robot's claims ----------------------------------------------------------
 
@@ -202,9 +266,18 @@ class SafetyLayer:
             return None
         self.cancel_claim()
         self._claim_numbers += 1
-        votes = {self.index} if self.index in self.replicas_of(cell) else set()
+        replica = self.index in self.replicas_of(cell)
+        registration = self._registry.get(cell)
+        if replica and registration is not None and not registration.handed_off:
+            votes: set[int] = set()  # its own vote goes to the peer registered here, until that one hands it off
+        elif replica:
+            self._registry.pop(cell, None)
+            votes = {self.index}
+        else:
+            votes = set()
         self.pending = PendingClaim(self._claim_numbers, cell, now, now, votes)
         self.stats.claims += 1
+        self._commit_if_granted()  # a fleet of one is its own majority (nobody to hand off to)
         return ClaimMessage(self.index, 0, self.pending.number, cell)
 
     def claim_recipients(self, cell: Cell) -> tuple[int, ...]:
@@ -214,7 +287,9 @@ class SafetyLayer:
     def may_enter(self, cell: Cell) -> bool:
         """Whether a majority of ``cell``'s replicas registered it to this robot for its pending claim."""
         pending = self.pending
-        return pending is not None and pending.cell == cell and not pending.refused and len(pending.votes) >= self.quorum
+        if pending is None or pending.cell != cell:
+            return False
+        return pending.committed or (not pending.refused and len(pending.votes) >= self.quorum)
 
     def begin_move(self, cell: Cell) -> None:
         """The body starts entering ``cell`` (which :meth:`may_enter` allowed, or any cell when unguarded)."""
@@ -233,6 +308,7 @@ class SafetyLayer:
         if granted is not None and granted.cell != cell:
             self._release(granted.cell, granted.number)  # the body stopped short of the cell it was allowed
         self.present = cell
+        self.present_handed_off = False
         self.target = None
         self.granted_claim = None
 
@@ -240,6 +316,8 @@ class SafetyLayer:
         """Give up the pending claim, releasing it at the replicas that may have granted it."""
         pending = self.pending
         if pending is not None:
+            if pending.committed:
+                raise RuntimeError("a committed claim is not given up: its robot moves in this tick")
             self.pending = None
             self._release(pending.cell, pending.number)
 
@@ -247,7 +325,7 @@ class SafetyLayer:
         """Time out or resend the pending claim, and send the releases due: the messages to send."""
         sends: list[Send] = []
         pending = self.pending
-        if pending is not None:
+        if pending is not None and not pending.committed:
             if pending.refused:
                 self.stats.refused += 1
                 self.cancel_claim()
@@ -259,6 +337,30 @@ class SafetyLayer:
                 sends.append((ClaimMessage(self.index, 0, pending.number, pending.cell), self.claim_recipients(pending.cell)))
         sends.extend(self._releases_due(now))
         return sends
+
+    def resend_claim(self, now: float) -> list[Send]:
+        """Send the pending claim again to the replicas that have not granted it, if it is due for a resend.
+
+        For a driver that gives the exchange of a tick a second round (the
+        lockstep simulator): a claim short of its majority whose retry interval
+        has passed (at once on a network without delay, where every answer is in
+        by then) goes again to the replicas that have not granted it. A refused
+        claim is sent again only under the lockstep rule, where a refusing
+        replica may have granted it since (its owner handed the cell off) and
+        that grant may have been lost; otherwise it is given up.
+        """
+        pending = self.pending
+        if pending is None or pending.committed or len(pending.votes) >= self.quorum:
+            return []
+        if pending.refused and not self.following:
+            return []
+        if now - pending.sent_at < self.retry_interval:
+            return []
+        missing = tuple(replica for replica in self.claim_recipients(pending.cell) if replica not in pending.votes)
+        if not missing:
+            return []
+        pending.sent_at = now
+        return [(ClaimMessage(self.index, 0, pending.number, pending.cell), missing)]
 
     def state_fields(self) -> dict[str, object]:
         """The safety part of this robot's state message: ``target``, ``claim``, ``claim_cell``."""
@@ -317,27 +419,99 @@ class SafetyLayer:
         owner = self.owner_of(cell)
         pending = self.pending
         contested = pending is not None and pending.cell == cell and self.granted_claim is None
+        if contested and pending is not None and pending.committed:
+            contested = False  # it moves in this tick: nobody outranks that
         if owner == self.index and contested and claimant_outranks and cell not in (self.present, self.target):
             self.cancel_claim()
             owner = self.owner_of(cell)
-        if owner is None or owner == sender:
+        registration = self._registry.get(cell)
+        handed_off = owner != self.index and registration is not None and registration.handed_off
+        if owner is None or owner == sender or handed_off:
             self._registry[cell] = _Registration(sender, message.claim)  # only newer claims get here
             self.stats.grants_given += 1
             return ReplyMessage(self.index, 0, sender, message.claim, cell, True)
+        if self.following:
+            self._deferred.setdefault(cell, {})[sender] = message.claim  # granted if the owner hands the cell off
         self.stats.refusals_given += 1
         return ReplyMessage(self.index, 0, sender, message.claim, cell, False)
 
-    def handle_reply(self, message: ReplyMessage, now: float) -> None:
-        """Count a replica's answer to this robot's pending claim (others are ignored)."""
+    def handle_reply(self, message: ReplyMessage, now: float) -> list[Send]:
+        """Count a replica's answer to this robot's pending claim (others are ignored).
+
+        Under the lockstep model's rule a grant may come after a refusal from
+        the same replica (its owner handed the cell off meanwhile) and replaces
+        it; the grant that completes a majority commits the claim, and the
+        handoff of the Present is returned to be sent.
+        """
         pending = self.pending
         if pending is None or message.claimant != self.index or message.claim != pending.number:
-            return
+            return []
         if message.cell != pending.cell or message.sender not in self.replicas_of(pending.cell):
-            return
+            return []
         if message.granted:
             pending.votes.add(message.sender)
+            if self.following:
+                pending.refusers.discard(message.sender)
         else:
-            pending.refused = True
+            pending.refusers.add(message.sender)
+        return self._commit_if_granted()
+
+    # -- the lockstep model's handoffs ---------------------------------------------------
+
+    def _commit_if_granted(self) -> list[Send]:
+        """Lockstep model: once the pending claim has a majority, commit to it and hand the Present off.
+
+        The handoff goes to the Present's other replicas; as a replica of its
+        own Present, this robot grants at once a claim it deferred for it.
+        """
+        pending = self.pending
+        if not self.following or pending is None or pending.committed or len(pending.votes) < self.quorum:
+            return []
+        pending.committed = True
+        self.present_handed_off = True
+        sends: list[Send] = []
+        recipients = self.claim_recipients(self.present)
+        if recipients:
+            sends.append((HandoffMessage(self.index, 0, self.present_claim, self.present), recipients))
+        if self.index in self.replicas_of(self.present):
+            sends.extend(self._grant_deferred(self.present))
+        return sends
+
+    def handle_handoff(self, message: HandoffMessage) -> list[Send]:
+        """A peer leaves a cell this robot keeps in this tick: mark its registration, grant a deferred claim.
+
+        Only a handoff that names the registration this replica holds for the
+        sender counts (a late one, after a release or a newer claim, is ignored).
+        """
+        cell = message.cell
+        registration = self._registry.get(cell)
+        if not self.following or registration is None:
+            return []
+        if registration.owner != message.sender or registration.claim != message.claim:
+            return []
+        registration.handed_off = True
+        return self._grant_deferred(cell)
+
+    def _grant_deferred(self, cell: Cell) -> list[Send]:
+        """Register ``cell``, just handed off, to the first claim still current that was refused for it here.
+
+        This robot's own pending claim for the cell comes first (its vote);
+        then peers' claims in the order they came. Returns the grant to send.
+        """
+        waiting = self._deferred.pop(cell, {})
+        pending = self.pending
+        if pending is not None and pending.cell == cell and self.index not in pending.votes:
+            self._registry.pop(cell, None)
+            pending.votes.add(self.index)
+            pending.refusers.discard(self.index)
+            return self._commit_if_granted()
+        for claimant, claim in waiting.items():
+            if claim != self._highest_claim.get(claimant) or claim <= self._highest_release.get(claimant, -1):
+                continue  # given up, released, or superseded since
+            self._registry[cell] = _Registration(claimant, claim)
+            self.stats.grants_given += 1
+            return [(ReplyMessage(self.index, 0, claimant, claim, cell, True), (claimant,))]
+        return []
 
     def handle_release(self, message: ReleaseMessage) -> ReleaseAckMessage:
         """Drop the sender's registration of the cell if it is not newer than the release; acknowledge it.
@@ -349,6 +523,7 @@ class SafetyLayer:
         registration = self._registry.get(cell)
         if registration is not None and registration.owner == sender and registration.claim <= message.claim:
             del self._registry[cell]
+            self._deferred.pop(cell, None)
         return ReleaseAckMessage(self.index, 0, sender, message.claim, cell)
 
     def handle_release_ack(self, message: ReleaseAckMessage) -> None:

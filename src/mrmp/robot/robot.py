@@ -52,7 +52,15 @@ from mrmp.core.grid import Grid
 from mrmp.core.heading import Heading
 from mrmp.core.scenario import RobotSpec
 from mrmp.policies.base import Decision, Policy, Situation, interaction_radius, listeners
-from mrmp.protocol.messages import ClaimMessage, Message, ReleaseAckMessage, ReleaseMessage, ReplyMessage, StateMessage
+from mrmp.protocol.messages import (
+    ClaimMessage,
+    HandoffMessage,
+    Message,
+    ReleaseAckMessage,
+    ReleaseMessage,
+    ReplyMessage,
+    StateMessage,
+)
 from mrmp.protocol.safety import SafetyLayer
 from mrmp.robot.belief import Belief
 from mrmp.robot.messaging import Handlers, MessageEndpoint, Outgoing
@@ -94,6 +102,11 @@ class Robot(MessageEndpoint):
         ``state_radius`` at least the interaction radius plus ``L``, the policy
         sees on a perfect network exactly the peers within its radius, each as
         it is now (``docs/protocol.md``, "Neighbourhoods").
+    following:
+        The safety layer's lockstep rule (a robot may enter a cell its occupant
+        leaves in the same tick; :class:`~mrmp.protocol.safety.SafetyLayer`),
+        for drivers that move every allowed robot at once, at the end of the
+        tick (the lockstep simulator). Live bodies keep the default.
     """
 
     def __init__(
@@ -109,6 +122,7 @@ class Robot(MessageEndpoint):
         silence_timeout: float | None = None,
         state_radius: int | None = None,
         knowledge_lease: float | None = None,
+        following: bool = False,
     ) -> None:
         self.id = spec.id
         self.silence_timeout = silence_timeout
@@ -128,12 +142,18 @@ class Robot(MessageEndpoint):
         self.belief = Belief()
         self._heard_since: set[int] = set()
         self.safety = SafetyLayer(
-            index, starts, claim_timeout=claim_timeout, retry_interval=retry_interval, keep_releases=guarded
+            index,
+            starts,
+            claim_timeout=claim_timeout,
+            retry_interval=retry_interval,
+            keep_releases=guarded,
+            following=following and guarded,
         )
         self.seq = 0
         self.progress = 0
         self.dropped: Counter[str] = Counter()
         self.last_decision: Decision | None = None
+        self._repeat_state: Cell | None = None  # the cell just left, until the state is repeated
 
     @property
     def arrived(self) -> bool:
@@ -160,7 +180,9 @@ class Robot(MessageEndpoint):
                     index: replace(peer, silent=True, next=peer.present) if peer.heard_at < horizon else peer
                     for index, peer in peers.items()
                 }
-        return Situation(self.index, self.present, self.heading, self.goal, self.grid, peers, self.belief.progress)
+        return Situation(
+            self.index, self.present, self.heading, self.goal, self.grid, peers, self.belief.progress, now=self.now
+        )
 
     def state_message(self) -> StateMessage:
         """A fresh state message: Present, Next, heading, arrival and safety state."""
@@ -199,6 +221,27 @@ class Robot(MessageEndpoint):
             return []
         return [Outgoing(self._stamp(claim), self.safety.claim_recipients(claim.cell))]
 
+    def retry(self, now: float) -> list[Outgoing]:
+        """A second round of the tick's exchange: the claim still short of its majority, sent again if due.
+
+        A guarded robot that has just moved also repeats its state to the peers that
+        announced the cell it left or the cell it entered as their Next (those
+        that wait for it to be gone, or there), so that one lost state does not
+        hold them back.
+        """
+        self.now = now
+        sends: list[Outgoing] = []
+        if not self.guarded:
+            return sends  # the thesis's robots as written send their state once a step
+        if self._repeat_state is not None:
+            cells = (self._repeat_state, self.present)
+            self._repeat_state = None
+            waiting = tuple(index for index, peer in self.belief.peers.items() if peer.next in cells)
+            if waiting:
+                sends.append(Outgoing(self.state_message(), waiting))
+        sends.extend(Outgoing(self._stamp(message), recipients) for message, recipients in self.safety.resend_claim(now))
+        return sends
+
     def motion(self, now: float) -> Cell | None:
         """The cell the body may start entering now, if any; the robot then counts as moving."""
         wanted = self.wanted
@@ -215,6 +258,7 @@ class Robot(MessageEndpoint):
         """The body reports the cell it now stands on and its heading (from its own sensors)."""
         if cell != self.present:
             self.progress += 1
+            self._repeat_state = self.present
         self.present = cell
         self.heading = heading
         self.moving = False
@@ -256,8 +300,13 @@ class Robot(MessageEndpoint):
 
     @handlers.on(ReplyMessage)
     def _take_reply(self, message: ReplyMessage, now: float) -> list[Outgoing]:
-        self.safety.handle_reply(message, now)
-        return []
+        sends = self.safety.handle_reply(message, now)
+        return [Outgoing(self._stamp(sent), recipients) for sent, recipients in sends]
+
+    @handlers.on(HandoffMessage)
+    def _take_handoff(self, message: HandoffMessage, now: float) -> list[Outgoing]:
+        sends = self.safety.handle_handoff(message)
+        return [Outgoing(self._stamp(sent), recipients) for sent, recipients in sends]
 
     @handlers.on(ReleaseMessage)
     def _take_release(self, message: ReleaseMessage, now: float) -> list[Outgoing]:

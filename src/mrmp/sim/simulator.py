@@ -6,7 +6,9 @@ Per tick, as in the thesis (sections 3.5-3.6), with the safety layer:
 2. the network delivers what is due (at once with zero delay; later with delay,
    so decisions rest on stale knowledge), and robots answer claims;
 3. every robot checks for obstacles and decides; a guarded robot claims the
-   cell it chose, and the claims and their answers are delivered;
+   cell it chose, and the claims and their answers are delivered; a claim
+   still short of its majority and due for a resend (at once on a network
+   without delay: an answer was lost) is sent again, and delivered;
 4. every robot whose move is allowed (guarded: a majority registered the cell
    to it; unguarded: always) moves, turning right first when the heading
    changes, and observes its new cell;
@@ -66,14 +68,17 @@ times the expected tries of a claim under loss)."""
 def safety_timers(delay_max: int) -> tuple[int, int]:
     """Retry interval and claim timeout, in ticks, for a network delaying up to ``delay_max`` ticks.
 
-    A claim and its answer take up to ``2 * delay_max`` ticks; a claim is sent
-    again after one such round trip and abandoned after three.
+    A claim and its answer take up to ``2 * delay_max`` ticks (within the tick
+    on a network without delay); a claim still short of its majority after one
+    such round trip is sent again when the robot's timers run at the end of
+    that tick, and abandoned after about three (``3 * (2 * delay_max + 1) + 1``
+    ticks).
 
     >>> safety_timers(0), safety_timers(3)
-    ((1, 4), (7, 22))
+    ((0, 4), (6, 22))
     """
-    retry = 2 * delay_max + 1
-    return retry, 3 * retry + 1
+    retry = 2 * delay_max
+    return retry, 3 * (retry + 1) + 1
 
 
 LOSS_LEASE = 2
@@ -122,6 +127,11 @@ class LockstepSimulator:
     on_tick:
         Called at the end of every tick with the tick and the robots' cells
         (for watching a run as it goes).
+    following:
+        Run the safety layer under the lockstep model's rule (the default): a
+        robot may enter a cell its occupant leaves in the same tick, once that
+        one has handed it off (``docs/protocol.md``). False keeps the rule of
+        live bodies, under which a cell is entered only after its release.
     """
 
     def __init__(
@@ -132,6 +142,7 @@ class LockstepSimulator:
         *,
         record_messages: bool = False,
         on_tick: TickObserver | None = None,
+        following: bool = True,
     ) -> None:
         self.scenario = scenario
         grid = scenario.grid
@@ -153,6 +164,7 @@ class LockstepSimulator:
                     retry_interval=retry,
                     state_radius=state_radius,
                     knowledge_lease=lease,
+                    following=following,
                 )
             )
         self.bodies = SpatialIndex(starts)
@@ -199,6 +211,9 @@ class LockstepSimulator:
         self._drain()
         for robot in robots:
             self._send(robot, robot.decide(tick))
+        self._drain()
+        for robot in robots:
+            self._send(robot, robot.retry(tick))
         self._drain()
         if self.record_decisions:
             self.decisions.append([robot.last_decision for robot in robots])  # type: ignore[misc]
@@ -386,8 +401,9 @@ def simulate(
     >>> result = simulate(swap, record_messages=True, on_tick=lambda tick, cells: seen.append((tick, cells)))
     >>> seen
     [(1, [(0, 1), (0, 2)])]
-    >>> sorted(set(result.message_log[1]))
-    [('A', 'B', 'claim'), ('A', 'B', 'release'), ('A', 'B', 'state'), ('B', 'A', 'reply'), ('B', 'A', 'state')]
+    >>> sorted(set(result.message_log[1]))  # doctest: +NORMALIZE_WHITESPACE
+    [('A', 'B', 'claim'), ('A', 'B', 'handoff'), ('A', 'B', 'release'), ('A', 'B', 'state'),
+     ('B', 'A', 'reply'), ('B', 'A', 'state')]
     """
     entry = policy_entry(scenario.policy.name) if policies is None else None
     if entry is not None and not entry.per_robot:

@@ -91,12 +91,14 @@ def test_messages_are_counted_per_datagram():
     assert result.messages == 2 * near  # each robot, each such tick, one datagram to its one peer
     assert result.network["sent"] == result.messages
     assert all(robot.bytes_sent == 52 * robot.messages_sent for robot in result.robots)
-    guarded = simulate(SWAP, record_messages=True)  # each move adds a claim, its answer, a release and its answer
+    guarded = simulate(SWAP, record_messages=True)  # each move adds a claim, its answer, a handoff, a release, its answer
     moves = sum(robot.steps for robot in guarded.robots)
     kinds = Counter(kind for tick in guarded.message_log for _, _, kind in tick)
-    assert kinds["claim"] == kinds["reply"] == kinds["release"] == moves
+    assert kinds["claim"] == kinds["reply"] == kinds["handoff"] == kinds["release"] == moves
     assert kinds["releaseack"] == moves - 1  # the last release is still on its way when the run ends
-    assert guarded.messages == result.messages + 4 * moves - 1
+    repeated = kinds["state"] - result.messages  # states repeated to a peer that wants the cell just left or entered
+    assert repeated == 1  # once: A, which has just left (1, 2), to B, whose Next (1, 2) is
+    assert guarded.messages == result.messages + repeated + 5 * moves - 1
     assert guarded.network["claims"] == guarded.network["claims_granted"] == guarded.network["releases"] == moves
 
 
