@@ -70,7 +70,7 @@ import random
 from collections import Counter
 
 from mrmp.core.heading import Heading
-from mrmp.protocol.messages import AnswerMessage, BeaconMessage, Message, PibtMessage, PullMessage
+from mrmp.protocol.messages import AnswerMessage, BeaconMessage, Message, PullMessage
 from mrmp.protocol.pibt_local import CallInheritMessage, CallReserveMessage
 from mrmp.robot.messaging import Handlers, Outgoing
 from mrmp.robot.pibt_robot import MIN_RADIUS, RESERVE_RADIUS, PibtRobot
@@ -350,4 +350,3 @@ class LocalPibtRobot(PibtRobot):
         assert self.target is not None
         self._reserve(self.target, out, final=True)
         super()._finish(moved, out)
-

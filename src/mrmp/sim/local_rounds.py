@@ -45,12 +45,12 @@ from collections import Counter
 from mrmp.core.errors import InputError
 from mrmp.core.result import RunResult
 from mrmp.core.scenario import Scenario
-from mrmp.protocol.codec import decode
-from mrmp.protocol.messages import Message, PibtMessage
+from mrmp.protocol.codec import decode, encode
+from mrmp.protocol.messages import Message
 from mrmp.robot.messaging import Outgoing
 from mrmp.robot.pibt_local import LocalPibtRobot
 from mrmp.sim.rounds import NO_ROBOT, RoundsSimulator
-from mrmp.sim.ticking import TickObserver, link_faults, run_result, scenario_network, send_counted
+from mrmp.sim.ticking import TickObserver, link_faults, run_result, scenario_network
 
 __all__ = ["LocalRoundsSimulator"]
 
@@ -100,6 +100,7 @@ class LocalRoundsSimulator(RoundsSimulator):
                 send(robot.index, item, now)
         woken = [robot.index for robot in robots if robot.wake]
         network = self.network
+        receivers = self._receivers  # a perfect network: every datagram once, in its step
         rounds = 0
         while True:
             batch = network.deliver(now)
@@ -112,8 +113,7 @@ class LocalRoundsSimulator(RoundsSimulator):
                 message = decoded.get(id(payload))
                 if message is None:
                     message = decoded[id(payload)] = decode(payload)
-                assert isinstance(message, PibtMessage), "a PIBT robot sends PIBT messages"
-                if robots[recipient].receive(message):
+                if receivers[recipient](message):
                     acting[recipient] = None
             woken = []
             for index in acting:
@@ -133,7 +133,13 @@ class LocalRoundsSimulator(RoundsSimulator):
             occupant = self._occupant
             cells = self._within(self.robots[sender].present, item.radius)
             recipients = tuple(other for cell in cells if (other := occupant[cell]) != NO_ROBOT)
-        send_counted(self.network, sender, Outgoing(item.message, recipients), self._everyone, now, self._results[sender])
+        payload = encode(item.message)
+        network_send = self.network.send
+        for recipient in recipients:
+            network_send(sender, recipient, payload, now)
+        result = self._results[sender]
+        result.messages_sent += len(recipients)
+        result.bytes_sent += len(payload) * len(recipients)
 
     def _result(self, stop_reason: str, wall_time: float) -> RunResult:
         for index, result in enumerate(self._results):
@@ -148,8 +154,4 @@ class LocalRoundsSimulator(RoundsSimulator):
         network["messages"] = sum(result.messages_sent for result in self._results)
         network["dropped_by_robots"] = sum(sum(robot.dropped.values()) for robot in self.robots)
         network["distance_tables"] = self.flat.tables_computed
-        return run_result(
-            self, self._results, "pibt", stop_reason, wall_time, network, planning_time_s=self.flat.table_seconds
-        )
-
-
+        return run_result(self, self._results, "pibt", stop_reason, wall_time, network, planning_time_s=self.flat.table_seconds)
