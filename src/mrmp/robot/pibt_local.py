@@ -160,7 +160,7 @@ class LocalPibtRobot(PibtRobot):
         for message in beacons:
             self._ranks[message.sender] = (message.elapsed, message.tie, -message.sender)
             px, py = message.present
-            if abs(px - x) + abs(py - y) <= RESERVE_RADIUS:
+            if abs(px - x) + abs(py - y) <= self.radius:
                 self._near.append(message.sender)
 
     informing = Handlers()
@@ -298,7 +298,7 @@ class LocalPibtRobot(PibtRobot):
         self.seq += 1
         root, (elapsed, tie, _) = self._root, self._rank
         message = CallReserveMessage(self.index, self.seq, self.step, self.flat.cells[cell], root, elapsed, tie, final)
-        out.append(Outgoing(message, None, RESERVE_RADIUS))
+        out.append(Outgoing(message, None, self.radius if final else RESERVE_RADIUS))
 
     def _continue(self, out: list[Outgoing]) -> None:
         here = self.present
