@@ -174,3 +174,15 @@ def test_without_waiting_for_higher_priorities_decisions_drift_from_central_pibt
         return count
 
     assert differing(Eager) > 3 * differing(LocalPibtRobot)
+
+
+@pytest.mark.parametrize("swap", [False, True])
+@pytest.mark.parametrize("seed", range(40))
+def test_a_radius_that_covers_the_map_gives_central_pibt_exactly(seed, swap):
+    # every robot waits for every robot of higher priority: the calls run one at a time, in priority order
+    simulator = LocalRoundsSimulator(random_scenario(seed, swap, radius=32), random_ties=False)
+    for _ in range(30):
+        expected = central_next(simulator, swap)
+        simulator.step()
+        assert [robot.present for robot in simulator.robots] == expected
+    assert simulator.referee.collisions == []
