@@ -163,6 +163,9 @@ class LocalPibtRobot(PibtRobot):
             if abs(px - x) + abs(py - y) <= self.radius:
                 self._near.append(message.sender)
 
+    rotations = True
+    """Take the cell of a robot busy in the robot's own call (PIBT's rotations): safe when every call ends in its step."""
+
     informing = Handlers()
 
     @informing.on(BeaconMessage)
@@ -186,7 +189,7 @@ class LocalPibtRobot(PibtRobot):
         else:
             self._calls[sender] = message.root
         if cell == self.target and not self._confirmed and sender != self.index:
-            if cell != self.present and message.rank > self._rank:
+            if cell != self.present and (message.final or message.rank > self._rank):
                 self._lost = True  # a call of higher priority reserved it in the same round: withdraw
                 reserved[cell] = sender
             else:
@@ -218,7 +221,7 @@ class LocalPibtRobot(PibtRobot):
             self.target = None
             self._next += 1
             self._continue(out)
-        elif not self._confirmed:
+        elif not self._confirmed and self._may_confirm():
             self._confirmed = True
             if self._finishing is not None:
                 moved, self._finishing = self._finishing, None
@@ -244,6 +247,10 @@ class LocalPibtRobot(PibtRobot):
             else:
                 self.stats["waits"] += 1
         return out
+
+    def _may_confirm(self) -> bool:
+        """Whether the provisional reservation has survived: in synchronous rounds, one round has passed."""
+        return True
 
     def _may_start(self) -> bool:
         """Every robot within 2 cells of higher priority has decided, and none is in the middle of a call."""
@@ -322,7 +329,7 @@ class LocalPibtRobot(PibtRobot):
                 self._next += 1  # the occupant moves into our cell: taking its cell would swap
                 continue
             if target is not None:
-                if self._calls.get(occupant) == self._root:
+                if self.rotations and self._calls.get(occupant) == self._root:
                     self._reserve(cell, out)  # a robot of our own call leaves it (a rotation, as in PIBT)
                     self._finish(True, out)
                     return

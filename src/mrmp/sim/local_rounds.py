@@ -46,15 +46,21 @@ from mrmp.core.errors import InputError
 from mrmp.core.result import RunResult
 from mrmp.core.scenario import Scenario
 from mrmp.protocol.codec import decode, encode
-from mrmp.protocol.messages import Message
+from mrmp.protocol.messages import Message, PibtMessage
 from mrmp.robot.messaging import Outgoing
 from mrmp.robot.pibt_local import LocalPibtRobot
+from mrmp.robot.pibt_reliable import ReliablePibtRobot
+from mrmp.robot.pibt_robot import RESERVE_RADIUS
+from mrmp.sim.metrics import default_max_ticks
 from mrmp.sim.rounds import NO_ROBOT, RoundsSimulator
 from mrmp.sim.ticking import TickObserver, link_faults, run_result, scenario_network
 
-__all__ = ["LocalRoundsSimulator"]
+__all__ = ["STEP_RETRIES", "LocalRoundsSimulator"]
 
-ROBOT_COUNTS = ("waits", "withdrawn", "refused", "passed_busy", "abandoned")
+STEP_RETRIES = 4
+"""Over a faulty network a step lasts this many retry intervals (``2 * delay_max + 1`` ticks each) by default."""
+
+ROBOT_COUNTS = ("waits", "withdrawn", "refused", "passed_busy", "abandoned", "acks", "retransmissions")
 """What the robots count themselves, reported in the result's ``network``."""
 
 
@@ -78,15 +84,35 @@ class LocalRoundsSimulator(RoundsSimulator):
         random_ties: bool = True,
         on_tick: TickObserver | None = None,
         tie_penalties: bool | None = None,
+        step_ticks: int | None = None,
     ) -> None:
-        if not scenario.network.is_perfect or link_faults(scenario):
-            raise InputError("network: local sequencing of pibt runs over a perfect network only")
+        self.perfect = scenario.network.is_perfect and not link_faults(scenario)
+        worst = scenario.worst_faults()
+        self.retry = 2 * worst.delay_max + 1
+        if step_ticks is None:
+            step_ticks = 1 if self.perfect else STEP_RETRIES * self.retry
+        if step_ticks < 1:
+            raise InputError(f"step_ticks: must be at least 1, got {step_ticks}")
+        self.step_ticks = step_ticks
+        if not self.perfect:
+            self.robot_type = ReliablePibtRobot
         super().__init__(scenario, random_ties, on_tick, tie_penalties)
+        for robot in self.robots:
+            if isinstance(robot, ReliablePibtRobot):
+                robot.retry = self.retry
         self.network = scenario_network(scenario)
         self._everyone = range(len(self.robots))
 
+    def _default_max_ticks(self) -> int:
+        """Room for PIBT's steps (:func:`~mrmp.sim.metrics.default_max_ticks`) of ``step_ticks`` each; twice that when faulty."""
+        ticks = default_max_ticks(self.scenario.with_changes(safety=False), self.lengths) * self.step_ticks
+        return ticks if self.perfect else 2 * ticks
+
     def step(self) -> None:
         """One PIBT step: beacons, rounds until nothing is due and no timer is set, then the moves."""
+        if not self.perfect:
+            self._timed_step()
+            return
         self.step_count += 1
         step = self.step_count
         robots = self.robots
@@ -124,6 +150,58 @@ class LocalRoundsSimulator(RoundsSimulator):
                     woken.append(index)
         self.stats["rounds"] += rounds
         self._advance(moves=True)
+
+    def _timed_step(self) -> None:
+        """One step over a faulty network: ``step_ticks`` ticks of deliveries, timers and rounds, then the moves."""
+        self.step_count += 1
+        step = self.step_count
+        robots = self.robots
+        occupant = self._occupant = [NO_ROBOT] * len(self.flat.neighbours)
+        for robot in robots:
+            occupant[robot.present] = robot.index
+        send = self._send
+        within = self._within
+        for robot in robots:
+            assert isinstance(robot, ReliablePibtRobot)
+            sensed = [cell for cell in within(robot.present, RESERVE_RADIUS) if occupant[cell] != NO_ROBOT]
+            for item in robot.begin_step(step, sensed, self.tick):
+                send(robot.index, item, self.tick)
+        for tick_of_step in range(self.step_ticks):
+            now = self.tick
+            if tick_of_step:
+                for robot in robots:
+                    for item in robot.on_tick(now):
+                        send(robot.index, item, now)
+            for robot in robots:
+                for item in robot.act():
+                    send(robot.index, item, now)
+            self._deliver_rounds(now)
+            if self.tick >= self.max_ticks:
+                return
+            self._advance(moves=tick_of_step == self.step_ticks - 1)
+
+    def _deliver_rounds(self, now: int) -> None:
+        """Deliver what is due at ``now`` and let the recipients act, until nothing more is due this tick."""
+        robots = self.robots
+        network = self.network
+        send = self._send
+        while True:
+            batch = network.deliver(now)
+            if not batch:
+                return
+            self.stats["rounds"] += 1
+            acting: dict[int, None] = {}
+            decoded: dict[int, Message] = {}
+            for _, recipient, payload in batch:
+                message = decoded.get(id(payload))
+                if message is None:
+                    message = decoded[id(payload)] = decode(payload)
+                assert isinstance(message, PibtMessage), "a PIBT robot sends PIBT messages"
+                if robots[recipient].receive(message):
+                    acting[recipient] = None
+            for index in acting:
+                for item in robots[index].act():
+                    send(index, item, now)
 
     def _send(self, sender: int, item: Outgoing, now: int) -> None:
         """Hand ``item`` to the network: to its named recipients, or by radio to the bodies within its radius."""

@@ -111,10 +111,48 @@ def test_robots_count_their_waits_and_the_network_carries_everything():
     assert all(key in result.network for key in ("withdrawn", "refused", "passed_busy", "abandoned", "lost"))
 
 
-def test_a_lossy_network_is_refused_in_one_line():
-    scenario = random_scenario(1, swap=True, faults=NetworkFaults(loss=0.1))
-    with pytest.raises(InputError, match=r"^network: local sequencing of pibt runs over a perfect network only$"):
-        LocalRoundsSimulator(scenario)
+FAULTS = {
+    "lossy": NetworkFaults(loss=0.3, duplicate=0.1),
+    "slow": NetworkFaults(loss=0.1, delay_min=0, delay_max=2, duplicate=0.1, reorder=0.2),
+}
+
+
+@pytest.mark.parametrize("faults", FAULTS)
+@pytest.mark.parametrize("seed", range(12))
+def test_over_a_faulty_network_crowds_never_collide(seed, faults):
+    scenario = crowd(seed, density=0.5, max_ticks=120).with_changes(network=FAULTS[faults])
+    simulator = LocalRoundsSimulator(scenario)
+    result = simulator.run()
+    assert result.collisions == []
+    assert simulator.step_ticks == 4 * (2 * FAULTS[faults].delay_max + 1)
+    if len(scenario.robots) > 1:
+        assert result.network["lost"] > 0 and result.network["retransmissions"] > 0 and result.network["acks"] > 0
+
+
+def test_over_a_lossy_network_robots_arrive():
+    scenario = crowd(4, density=0.3, max_ticks=4000).with_changes(network=FAULTS["lossy"])
+    result = LocalRoundsSimulator(scenario).run()
+    assert result.success and result.collisions == []
+    assert 0 < result.network["abandoned"] < result.network["steps"] * len(scenario.robots) / 2
+
+
+def test_a_cut_network_abandons_every_step_and_only_robots_alone_move():
+    scenario = crowd(5, density=0.5, max_ticks=12).with_changes(network=NetworkFaults(loss=1.0))
+    result = LocalRoundsSimulator(scenario, step_ticks=3).run()
+    starts = [spec.start for spec in scenario.robots]
+
+    def alone(cell):  # nobody within 2 cells: nothing to ask, nobody to tell
+        return all(other == cell or abs(other[0] - cell[0]) + abs(other[1] - cell[1]) > 2 for other in starts)
+
+    crowded = [robot for robot in result.robots if not alone(robot.start)]
+    assert crowded and all(set(robot.path) == {robot.start} for robot in crowded)
+    assert result.network["abandoned"] >= 4 * len(crowded)
+    assert result.collisions == []
+
+
+def test_a_step_of_no_ticks_is_refused_in_one_line():
+    with pytest.raises(InputError, match=r"^step_ticks: must be at least 1, got 0$"):
+        LocalRoundsSimulator(crowd(1), step_ticks=0)
 
 
 # -- every rule is needed: broken variants that the tests above would catch ----------------------------
