@@ -76,6 +76,9 @@ class LocalRoundsSimulator(RoundsSimulator):
     """
 
     robot_type = LocalPibtRobot
+    """The brain over a perfect network."""
+    reliable_type: type[ReliablePibtRobot] = ReliablePibtRobot
+    """The brain over a faulty network."""
     robots: list[LocalPibtRobot]  # type: ignore[assignment]
 
     def __init__(
@@ -95,7 +98,7 @@ class LocalRoundsSimulator(RoundsSimulator):
             raise InputError(f"step_ticks: must be at least 1, got {step_ticks}")
         self.step_ticks = step_ticks
         if not self.perfect:
-            self.robot_type = ReliablePibtRobot
+            self.robot_type = self.reliable_type
         super().__init__(scenario, random_ties, on_tick, tie_penalties)
         for robot in self.robots:
             if isinstance(robot, ReliablePibtRobot):

@@ -9,6 +9,7 @@ from mrmp.core import Grid, NetworkFaults, PolicyOptions, RobotSpec, Scenario
 from mrmp.core.errors import InputError
 from mrmp.core.grid import connected_regions
 from mrmp.robot.pibt_local import LocalPibtRobot
+from mrmp.robot.pibt_reliable import ReliablePibtRobot
 from mrmp.sim.local_rounds import LocalRoundsSimulator
 
 
@@ -224,3 +225,34 @@ def test_a_radius_that_covers_the_map_gives_central_pibt_exactly(seed, swap):
         simulator.step()
         assert [robot.present for robot in simulator.robots] == expected
     assert simulator.referee.collisions == []
+
+
+class Impatient(ReliablePibtRobot):
+    """Broken: over a faulty network, a reservation is confirmed without waiting for the acknowledgements."""
+
+    def _may_confirm(self):
+        return True
+
+
+class Secretive(ReliablePibtRobot):
+    """Broken: an acknowledgement does not carry its sender's claim, so claims of one cell go unnoticed."""
+
+    def receive(self, message):
+        target, self.target = self.target, None
+        try:
+            return super().receive(message)
+        finally:
+            self.target = target
+
+
+@pytest.mark.parametrize("variant", [Impatient, Secretive])
+def test_each_broken_variant_collides_over_a_faulty_network(variant):
+    class Simulator(LocalRoundsSimulator):
+        reliable_type = variant
+
+    collided = 0
+    for seed in range(30):
+        scenario = crowd(seed, density=0.5, max_ticks=60).with_changes(network=FAULTS["slow"])
+        assert LocalRoundsSimulator(scenario).run().collisions == []
+        collided += len(Simulator(scenario).run().collisions)
+    assert collided > 0
