@@ -66,7 +66,7 @@ from collections.abc import Iterable
 
 from mrmp.core.heading import Heading
 from mrmp.protocol.messages import BeaconMessage, PibtMessage, PullMessage
-from mrmp.protocol.pibt_local import NO_CLAIM, CallAckMessage, CallReserveMessage
+from mrmp.protocol.pibt_local import NO_CLAIM, CallAckMessage, CallInheritMessage, CallReserveMessage
 from mrmp.robot.messaging import Outgoing
 from mrmp.robot.pibt_local import LocalPibtRobot
 from mrmp.robot.pibt_robot import MIN_RADIUS, RESERVE_RADIUS
@@ -203,7 +203,7 @@ class ReliablePibtRobot(LocalPibtRobot):
             self.dropped["duplicate"] += 1
             return True  # the acknowledgement goes out in act
         self._seen.add(key)
-        if isinstance(message, CallReserveMessage):
+        if isinstance(message, CallReserveMessage | CallInheritMessage):  # both say what the sender reserved
             if message.seq < self._latest.get(message.sender, 0):
                 self.dropped["overtaken"] += 1  # a later reservation of the sender arrived first
                 return True

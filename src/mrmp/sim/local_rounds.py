@@ -57,7 +57,7 @@ from mrmp.sim.ticking import TickObserver, link_faults, run_result, scenario_net
 
 __all__ = ["STEP_RETRIES", "LocalRoundsSimulator"]
 
-STEP_RETRIES = 4
+STEP_RETRIES = 8
 """Over a faulty network a step lasts this many retry intervals (``2 * delay_max + 1`` ticks each) by default."""
 
 ROBOT_COUNTS = ("waits", "withdrawn", "refused", "passed_busy", "abandoned", "acks", "retransmissions")

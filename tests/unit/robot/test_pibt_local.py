@@ -125,7 +125,7 @@ def test_over_a_faulty_network_crowds_never_collide(seed, faults):
     simulator = LocalRoundsSimulator(scenario)
     result = simulator.run()
     assert result.collisions == []
-    assert simulator.step_ticks == 4 * (2 * FAULTS[faults].delay_max + 1)
+    assert simulator.step_ticks == 8 * (2 * FAULTS[faults].delay_max + 1)
     if len(scenario.robots) > 1:
         assert result.network["lost"] > 0 and result.network["retransmissions"] > 0 and result.network["acks"] > 0
 
