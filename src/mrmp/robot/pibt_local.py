@@ -233,8 +233,8 @@ class LocalPibtRobot(PibtRobot):
                 key=lambda message: message.rank,
                 reverse=True,
             )
-            for message in inherits:
-                self._take_inherit_local(message, out)
+            for inherit in inherits:
+                self._take_inherit_local(inherit, out)
             for message in control:
                 if isinstance(message, AnswerMessage):
                     self._take_answer(message, out)

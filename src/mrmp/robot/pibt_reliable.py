@@ -135,7 +135,7 @@ class ReliablePibtRobot(LocalPibtRobot):
 
     # -- the step ------------------------------------------------------------------
 
-    def begin_step(self, step: int, sensed: Iterable[int] = (), now: int = 0) -> list[Outgoing]:  # type: ignore[override]
+    def begin_step(self, step: int, sensed: Iterable[int] = (), now: int = 0) -> list[Outgoing]:
         """Start step ``step`` at tick ``now``; ``sensed``: the cells within 2 that hold a body (the robot's sensor)."""
         out = super().begin_step(step)
         self._now = now

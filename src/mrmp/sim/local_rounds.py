@@ -164,15 +164,15 @@ class LocalRoundsSimulator(RoundsSimulator):
             occupant[robot.present] = robot.index
         send = self._send
         within = self._within
-        for robot in robots:
-            assert isinstance(robot, ReliablePibtRobot)
+        reliable = [robot for robot in robots if isinstance(robot, ReliablePibtRobot)]
+        for robot in reliable:
             sensed = [cell for cell in within(robot.present, RESERVE_RADIUS) if occupant[cell] != NO_ROBOT]
             for item in robot.begin_step(step, sensed, self.tick):
                 send(robot.index, item, self.tick)
         for tick_of_step in range(self.step_ticks):
             now = self.tick
             if tick_of_step:
-                for robot in robots:
+                for robot in reliable:
                     for item in robot.on_tick(now):
                         send(robot.index, item, now)
             for robot in robots:
