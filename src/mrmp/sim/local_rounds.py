@@ -105,6 +105,7 @@ class LocalRoundsSimulator(RoundsSimulator):
                 robot.retry = self.retry
         self.network = scenario_network(scenario)
         self._everyone = range(len(self.robots))
+        self._hearers: dict[tuple[int, int], tuple[int, ...]] = {}
 
     def _default_max_ticks(self) -> int:
         """Room for PIBT's steps (:func:`~mrmp.sim.metrics.default_max_ticks`) of ``step_ticks`` each; twice that when faulty."""
@@ -120,6 +121,7 @@ class LocalRoundsSimulator(RoundsSimulator):
         step = self.step_count
         robots = self.robots
         occupant = self._occupant = [NO_ROBOT] * len(self.flat.neighbours)
+        self._hearers = {}
         for robot in robots:
             occupant[robot.present] = robot.index
         now = self.tick
@@ -160,6 +162,7 @@ class LocalRoundsSimulator(RoundsSimulator):
         step = self.step_count
         robots = self.robots
         occupant = self._occupant = [NO_ROBOT] * len(self.flat.neighbours)
+        self._hearers = {}
         for robot in robots:
             occupant[robot.present] = robot.index
         send = self._send
@@ -211,9 +214,12 @@ class LocalRoundsSimulator(RoundsSimulator):
         recipients = item.recipients
         if recipients is None:
             assert item.radius is not None, "a PIBT robot broadcasts within a radius"
-            occupant = self._occupant
-            cells = self._within(self.robots[sender].present, item.radius)
-            recipients = tuple(other for cell in cells if (other := occupant[cell]) != NO_ROBOT)
+            key = (sender, item.radius)
+            recipients = self._hearers.get(key)
+            if recipients is None:  # the bodies stand still during a step: who hears whom is found once
+                occupant = self._occupant
+                cells = self._within(self.robots[sender].present, item.radius)
+                recipients = self._hearers[key] = tuple(other for cell in cells if (other := occupant[cell]) != NO_ROBOT)
         payload = encode(item.message)
         network_send = self.network.send
         for recipient in recipients:
