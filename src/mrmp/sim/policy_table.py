@@ -187,7 +187,7 @@ POLICY_TABLE: dict[str, PolicyEntry] = {
         PibtOptions,
         PibtRobot,
         simulator=pibt_simulator,
-        runs="runs in synchronous rounds (mrmp.sim.rounds; with sequencing local, mrmp.sim.local_rounds)",
+        runs="runs in synchronous rounds (mrmp.sim.rounds)",
         not_live="runs in the simulator's synchronous rounds only; its live, asynchronous form is --policy causal",
     ),
     "causal": PolicyEntry(
