@@ -13,11 +13,13 @@ then acts):
    within its radio radius (at least 2 cells);
 2. a robot that has not decided and was not asked to decide *starts its own
    call* (it becomes a *root*) in the first round in which every robot within
-   2 cells that has a higher priority has decided, and no robot within 2 cells
-   is in the middle of a call (it holds a provisional reservation). Everything
-   a call reads lies within 2 cells of the robots it reaches, and a call
-   reaches robots only through their neighbours, so this is the local form of
-   "the highest-priority robot that has not decided starts";
+   its radio radius that has a higher priority has decided for good (its final
+   reservation reaches that far), and no robot within 2 cells is in the middle
+   of a call (it holds a provisional reservation). Everything a call reads
+   lies within 2 cells of the robots it reaches, and a call reaches robots
+   only through their neighbours, so this is the local form of "the
+   highest-priority robot that has not decided starts" (exactly that when the
+   radius covers the map);
 3. an asked robot (priority inheritance, :class:`CallInheritMessage`) decides
    at once, within the call of the robot that asked (its *root*), as in PIBT;
 4. a reservation (:class:`CallReserveMessage`, to every robot within 2
