@@ -1,4 +1,9 @@
-"""Doctests run from the repository's root, so that their examples can name ``examples/`` and ``maps/``."""
+"""Doctests run from the repository's root, so that their examples can name ``examples/`` and ``maps/``.
+
+Property tests (hypothesis) have no per-example deadline: a wall-clock limit
+would make them fail on a loaded machine, and the project asserts counts, never
+durations.
+"""
 
 from __future__ import annotations
 
@@ -6,8 +11,12 @@ from pathlib import Path
 
 import pytest
 from _pytest.doctest import DoctestItem
+from hypothesis import settings
 
 ROOT = Path(__file__).resolve().parent
+
+settings.register_profile("mrmp", deadline=None)
+settings.load_profile("mrmp")
 
 
 @pytest.fixture(autouse=True)

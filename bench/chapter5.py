@@ -35,7 +35,13 @@ deterministic; times are this machine's, the least of ``--repeats`` runs.
 ``astar`` runs up to ``--astar-up-to`` robots: its robots broadcast their state
 to the whole fleet every tick, so beyond that a run takes minutes.
 
-Usage: python bench/chapter5.py [--map empty-32-32] [--sizes 2,10,50,100,200] [--max-ticks 300] [--repeats 3]
+With ``--plots DIR`` it also draws one figure per claim, against N: the busiest
+robot's computation (complexity), datagrams per robot-move (speed) and the share
+of robot-ticks spent waiting (synchronization), as ``DIR/complexity.png``,
+``DIR/speed.png`` and ``DIR/synchronization.png`` (``docs/chapter5/`` holds the
+published ones).
+
+Usage: python bench/chapter5.py [--map empty-32-32] [--sizes 2,10,50,100,200] [--max-ticks 300] [--repeats 3] [--plots DIR]
 """
 
 from __future__ import annotations
@@ -56,6 +62,7 @@ from mrmp.io import load_movingai_scenario
 from mrmp.policies.base import Decision, Policy, Situation
 from mrmp.sim.policy_table import make_policy
 from mrmp.sim.simulator import simulate
+from mrmp.viz.series_plot import write_series_plot
 
 MAPS = Path(__file__).resolve().parents[1] / "maps"
 
@@ -109,6 +116,20 @@ class Row:
             first_move_s=min(self.first_move_s, other.first_move_s),
         )
 
+    def waiting_share(self) -> float | None:
+        """The share of robot-ticks before arrival spent standing still (None for a run that did not happen)."""
+        result = self.result
+        if result is None:
+            return None
+        return sum(robot.waits for robot in result.robots) / max(1, sum(robot.cost for robot in result.robots))
+
+    def messages_per_move(self) -> float | None:
+        """Datagrams sent per robot-move (None for a run that did not happen)."""
+        result = self.result
+        if result is None:
+            return None
+        return result.messages / max(1, sum(robot.steps for robot in result.robots))
+
     def cells(self) -> list[str]:
         result = self.result
         step = "-" if self.step_s is None else _seconds(self.step_s)
@@ -117,14 +138,12 @@ class Row:
                     _seconds(self.first_move_s), "-", "-", "-", "-", "-", "-"]  # fmt: skip
         moves = max(1, sum(robot.steps for robot in result.robots))
         sent_bytes = sum(robot.bytes_sent for robot in result.robots)
-        before_arrival = max(1, sum(robot.cost for robot in result.robots))
-        waiting = sum(robot.waits for robot in result.robots) / before_arrival
         ok = "yes" if result.success else f"no ({result.stop_reason})"
         states = "-" if self.state_messages is None else f"{self.state_messages / moves:.1f}"
         return [
             self.method, self.kind, str(self.robots), ok, step, _seconds(self.busiest_s), _seconds(self.first_move_s),
-            f"{result.messages / moves:.1f}", states, f"{sent_bytes / moves:.0f}",
-            "-" if self.plan_bytes is None else str(self.plan_bytes), f"{waiting:.0%}", str(result.ticks),
+            f"{self.messages_per_move():.1f}", states, f"{sent_bytes / moves:.0f}",
+            "-" if self.plan_bytes is None else str(self.plan_bytes), f"{self.waiting_share():.0%}", str(result.ticks),
         ]  # fmt: skip
 
 
@@ -186,6 +205,27 @@ def measured(method: Callable[[Scenario], Row], scenario: Scenario, repeats: int
     return row
 
 
+def write_claim_plots(rows: list[Row], folder: Path) -> None:
+    """One PNG per claim of chapter 5, each method a line against N (runs that did not happen left out)."""
+
+    def series(value: Callable[[Row], float | None]) -> dict[str, list[tuple[int, float]]]:
+        by_method: dict[str, list[tuple[int, float]]] = {}
+        for row in rows:
+            measured_value = value(row)
+            if measured_value is not None:
+                by_method.setdefault(f"{row.method} ({row.kind})", []).append((row.robots, measured_value))
+        return by_method
+
+    folder.mkdir(parents=True, exist_ok=True)
+    write_series_plot(folder / "complexity.png", "Complexity: the busiest robot's computation", "ms over the run (log)",
+                      series(lambda row: 1000 * row.busiest_s or None), log_y=True)  # fmt: skip
+    write_series_plot(folder / "speed.png", "Speed: datagrams per robot-move", "datagrams / move (log)",
+                      series(lambda row: row.messages_per_move() or None), log_y=True)  # fmt: skip
+    waiting = series(lambda row: None if row.waiting_share() is None else 100 * (row.waiting_share() or 0.0))
+    write_series_plot(folder / "synchronization.png", "Synchronization: time spent waiting",
+                      "robot-ticks standing still (%)", waiting, percent=True)  # fmt: skip
+
+
 def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--map", default="empty-32-32")
@@ -195,6 +235,7 @@ def main() -> int:
     parser.add_argument("--repeats", type=int, default=3, help="runs of each method; wall times are the least")
     parser.add_argument("--astar-up-to", type=int, default=100,
                         help="largest fleet for astar (it broadcasts to every robot every tick)")  # fmt: skip
+    parser.add_argument("--plots", type=Path, default=None, help="write one PNG per claim into this folder")
     arguments = parser.parse_args()
     warm_up = load_movingai_scenario(MAPS / f"{arguments.map}.map", MAPS / f"{arguments.map}-random-1.scen", 2)
     for warm in (decentralized_astar, decentralized_pibt):  # one-time set-ups (imports, grid tables) not counted
@@ -203,6 +244,7 @@ def main() -> int:
     centralized(warm_up, "pp", arguments.time_limit)
     print("| " + " | ".join(HEADER) + " |")
     print("|" + "---|" * len(HEADER))
+    rows: list[Row] = []
     for size in [int(text) for text in arguments.sizes.split(",")]:
         scenario = load_movingai_scenario(
             MAPS / f"{arguments.map}.map", MAPS / f"{arguments.map}-random-1.scen", size
@@ -215,7 +257,10 @@ def main() -> int:
         if size <= arguments.astar_up_to:
             methods.insert(0, decentralized_astar)
         for method in methods:
-            print("| " + " | ".join(measured(method, scenario, arguments.repeats).cells()) + " |", flush=True)
+            rows.append(measured(method, scenario, arguments.repeats))
+            print("| " + " | ".join(rows[-1].cells()) + " |", flush=True)
+    if arguments.plots is not None:
+        write_claim_plots(rows, arguments.plots)
     return 0
 
 

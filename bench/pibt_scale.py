@@ -16,8 +16,7 @@ measured:
   ``-random-1`` where the issue quotes it (for comparison; not measured here).
 
 Every line is also appended to ``--out`` (JSON lines) as it is measured.
-``--seeds K`` runs every instance with its seed (0 for ``.scen`` instances)
-and the K-1 following ones (the seed drives the robots' random tie-breaks;
+``--seeds K`` runs every instance with seeds 0 to K-1 (the seed drives the robots' random tie-breaks;
 default 1), so "inst" counts instances times seeds.
 
 Usage: python bench/pibt_scale.py [--maps DIR] [--only random-32-32-20,empty-32-32] [--seeds K] [--out FILE]
@@ -64,9 +63,16 @@ LACAM_CPP = {
 RANDOM_INSTANCES = 2
 
 
-def random_instance(map_path: Path, agents: int, seed: int) -> Scenario:
-    """``agents`` seeded random starts and goals in the map's largest connected region."""
-    return seeded_instance(read_map(map_path), agents, seed, name=f"{map_path.stem}-seed-{seed}")
+def random_instance(map_path: Path, agents: int, instance: int) -> Scenario:
+    """``agents`` random starts and goals in the map's largest connected region, drawn with seed ``instance``.
+
+    The run's own seed (the robots' tie-breaks) is 0, as for ``.scen`` instances:
+    the instance a bench configuration's ``instances: K`` entry draws
+    (:func:`mrmp.experiments.records.build_scenario`), so that ``bench/pibt.yaml``
+    reproduces these rows exactly.
+    """
+    scenario = seeded_instance(read_map(map_path), agents, instance, name=f"{map_path.stem}-i{instance}")
+    return scenario.with_changes(seed=0)
 
 
 def instances(maps: Path, name: str, agents: int) -> list[Scenario]:
@@ -74,7 +80,7 @@ def instances(maps: Path, name: str, agents: int) -> list[Scenario]:
     scens = sorted(maps.glob(f"{name}-random-*.scen"))
     if scens:
         return [load_movingai_scenario(map_path, scen, agents) for scen in scens]
-    return [random_instance(map_path, agents, seed) for seed in range(RANDOM_INSTANCES)]
+    return [random_instance(map_path, agents, instance) for instance in range(RANDOM_INSTANCES)]
 
 
 def measure(label: str, agents: int, scenarios: list[Scenario], out: Path | None, seeds: int = 1) -> None:
@@ -126,7 +132,7 @@ def main() -> int:
     parser.add_argument("--maps", type=Path, default=ROOT / "maps", help="folder of .map and .scen files")
     parser.add_argument("--only", default="", help="comma-separated map names (default: all)")
     parser.add_argument("--out", type=Path, default=None, help="append one JSON line per row to this file")
-    parser.add_argument("--seeds", type=int, default=1, help="run every instance with its seed and the SEEDS-1 following")
+    parser.add_argument("--seeds", type=int, default=1, help="run every instance with seeds 0 to SEEDS-1")
     arguments = parser.parse_args()
     if arguments.seeds < 1:
         parser.error(f"--seeds must be at least 1, not {arguments.seeds}")

@@ -19,7 +19,7 @@ from __future__ import annotations
 
 import html
 import os
-from dataclasses import dataclass, fields, replace
+from dataclasses import dataclass
 from pathlib import Path
 from typing import Any
 
@@ -27,8 +27,9 @@ from mrmp.centralized.plan import PlanningResult
 from mrmp.centralized.registry import PLANNER_NAMES, plan_with
 from mrmp.core.errors import InputError, Problem
 from mrmp.core.result import RunResult
-from mrmp.core.scenario import PolicyOptions, Scenario, scenario_problems
+from mrmp.core.scenario import Scenario
 from mrmp.experiments.execution import execute_in_simulator
+from mrmp.experiments.run_options import FIELD_NAMES, NETWORK_OPTIONS, POLICY_SETTINGS, SCENARIO_OPTIONS, apply_run_options
 from mrmp.io import load_movingai_scenario, load_scenario, write_result_json
 from mrmp.io.results import result_to_dict
 from mrmp.sim.policy_table import policy_names
@@ -39,9 +40,6 @@ from mrmp.viz.svg import svg_text
 ScenarioSource = Scenario | str | os.PathLike[str]
 """A scenario, or the path of a YAML scenario file."""
 
-_NETWORK_FIELDS = ("loss", "duplicate", "reorder")
-_SCENARIO_FIELDS = ("seed", "max_ticks", "safety", "lifelong")
-_POLICY_SETTINGS = tuple(field.name for field in fields(PolicyOptions) if field.name != "name")
 
 
 def load(path: str | os.PathLike[str], scen: str | os.PathLike[str] | None = None, agents: int | None = None) -> Scenario:
@@ -84,39 +82,12 @@ def with_options(scenario: Scenario, policy: str | None = None, **options: Any) 
     mrmp.core.errors.InputError: speed: unknown option; known: resolve, heading_aware, ...
     """
     given = {key: value for key, value in options.items() if value is not None}
-    unknown = sorted(set(given) - set(_POLICY_SETTINGS) - set(_NETWORK_FIELDS) - set(_SCENARIO_FIELDS) - {"delay"})
+    unknown = sorted(set(given) - set(POLICY_SETTINGS) - set(NETWORK_OPTIONS) - set(SCENARIO_OPTIONS) - {"delay"})
     if unknown:
-        known = ", ".join((*_POLICY_SETTINGS, *_NETWORK_FIELDS, "delay", *_SCENARIO_FIELDS))
+        known = ", ".join((*POLICY_SETTINGS, *NETWORK_OPTIONS, "delay", *SCENARIO_OPTIONS))
         raise InputError([Problem(key, f"unknown option; known: {known}") for key in unknown])
-    problems: list[Problem] = []
-    if policy is not None and policy not in policy_names():
-        problems.append(Problem("policy", f"unknown policy {policy!r}; known: {', '.join(policy_names())}"))
-    policy_changes = {key: given[key] for key in _POLICY_SETTINGS if key in given}
-    if policy is not None and not problems:
-        policy_changes["name"] = policy
-    policy_options = scenario.policy
-    try:
-        policy_options = replace(scenario.policy, **policy_changes)
-    except InputError as error:
-        problems.extend(error.problems)
-    network_changes = {key: given[key] for key in _NETWORK_FIELDS if key in given}
-    if "delay" in given:
-        network_changes["delay_min"], network_changes["delay_max"] = _delay_range(given["delay"])
-    network = replace(scenario.network, **network_changes) if network_changes else scenario.network
-    changes = {key: given[key] for key in _SCENARIO_FIELDS if key in given}
-    updated = scenario.with_changes(policy=policy_options, network=network, **changes)
-    problems = scenario_problems(updated) + problems
-    if problems:
-        raise InputError(problems)
-    return updated
-
-
-def _delay_range(delay: Any) -> tuple[int, int]:
-    """``delay`` (ticks, a number or a pair) as a ``(low, high)`` pair."""
-    low, high = delay if isinstance(delay, tuple | list) else (delay, delay)
-    if not (isinstance(low, int) and isinstance(high, int) and 0 <= low <= high):
-        raise InputError(Problem("delay", f"expected ticks N or (A, B) with 0 <= A <= B, got {delay!r}"))
-    return low, high
+    settings = {key: given.pop(key) for key in POLICY_SETTINGS if key in given}
+    return apply_run_options(scenario, policy, settings, names=FIELD_NAMES, **given)
 
 
 def run(
@@ -167,15 +138,40 @@ def run(
     return Result(execute_in_simulator(configured, plan, record_messages=record_messages), configured, plan)
 
 
-def animate(result: Result, path: str | os.PathLike[str], show_messages: bool = False) -> Path:
+def animate(
+    result: Result,
+    path: str | os.PathLike[str],
+    show_messages: bool = False,
+    goal_lines: bool = False,
+    colour_by: str | None = None,
+    speed: float = 1.0,
+) -> Path:
     """Write ``result`` as an animation, GIF, SVG or MP4 by ``path``'s suffix; returns the path written.
 
+    The options are those of ``mrmp run --animate``: ``show_messages``
+    draws each tick's messages (a run made with ``record_messages=True``),
+    ``goal_lines`` a line from each robot to its goal, ``colour_by`` colours
+    the robots by ``"robot"``, ``"progress"`` or ``"heading"`` (by default
+    ``"robot"`` for a few robots, ``"progress"`` for a crowd), and ``speed``
+    plays a live run that many times faster than real time.
+
     >>> import tempfile
-    >>> folder = tempfile.mkdtemp()
-    >>> animate(run("examples/thesis-swap.yaml"), Path(folder) / "swap.svg").suffix
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> animate(run("examples/thesis-swap.yaml"), folder / "swap.svg").suffix
     '.svg'
+    >>> drawn = animate(run("examples/thesis-swap.yaml"), folder / "lines.svg", goal_lines=True, colour_by="heading")
+    >>> text = drawn.read_text()
+    >>> 'id="goal-lines"' in text, 'facing north' in text
+    (True, True)
+    >>> animate(run("examples/thesis-swap.yaml"), folder / "x.svg", colour_by="rainbow")
+    Traceback (most recent call last):
+    ...
+    ValueError: colour_by must be one of robot, progress, heading, got 'rainbow'
     """
-    return write_animation(result.scenario.grid, result.run, path, show_messages=show_messages)
+    return write_animation(
+        result.scenario.grid, result.run, path,
+        show_messages=show_messages, goal_lines=goal_lines, colour_by=colour_by, speed=speed,
+    )  # fmt: skip
 
 
 @dataclass(frozen=True)

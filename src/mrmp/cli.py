@@ -10,12 +10,13 @@ from __future__ import annotations
 import functools
 import inspect
 import sys
-from collections.abc import Callable
-from dataclasses import dataclass, replace
+from collections.abc import Callable, Iterable
+from dataclasses import dataclass
 from pathlib import Path
 from typing import TYPE_CHECKING, Annotated, Any
 
 import typer
+import typer.core
 from rich.console import Console
 from rich.table import Table
 
@@ -29,9 +30,10 @@ from mrmp.core.limits import (
     MIN_TIME_SCALE,
     shown,
 )
-from mrmp.core.options import setting_types, settings
+from mrmp.core.options import Setting, setting_types, settings
 from mrmp.core.result import RunResult
-from mrmp.core.scenario import NetworkFaults, PolicyOptions, Scenario, scenario_problems
+from mrmp.core.scenario import PolicyOptions, Scenario
+from mrmp.experiments.run_options import FLAG_NAMES, apply_run_options, parse_range
 from mrmp.io import load_movingai_scenario, load_scenario, validate_file, write_result_json
 from mrmp.live.transport_table import TRANSPORTS
 from mrmp.sim.policy_table import policy_entry, policy_names
@@ -41,11 +43,134 @@ if TYPE_CHECKING:
     from mrmp.centralized.plan import PlanningResult
     from mrmp.live.transport import LiveFaults
 
+FLAG = ""
+"""The metavar of an option that takes no value (an on/off flag): none is shown."""
+
+
+def _flags_without_value_type(params: list[Any]) -> list[Any]:
+    """``params`` with their on/off flags (``--help`` too) given an empty metavar, so that help shows no ``<bool>``.
+
+    Options whose choices come from a table of a heavy module (the colourings
+    of :mod:`mrmp.viz`) get their metavar and default here, on first use, so
+    that commands without them (``mrmp agent``, ``mrmp referee``) start
+    without importing it.
+    """
+    for param in params:
+        if getattr(param, "is_flag", False) and param.metavar is None:
+            param.metavar = FLAG
+        elif param.name in _LATE_DETAILS and param.metavar is None:
+            param.metavar, param.show_default = _LATE_DETAILS[param.name]()
+    return params
+
+
+class _Command(typer.core.TyperCommand):
+    """A command whose help shows no value type for its flags (they take none)."""
+
+    def get_params(self, ctx: Any) -> list[Any]:
+        """The command's parameters, flags without value types."""
+        return _flags_without_value_type(super().get_params(ctx))
+
+
+class _Group(typer.core.TyperGroup):
+    """The ``mrmp`` group: its own flags (``--version``, completion, help) show no value type either."""
+
+    def get_params(self, ctx: Any) -> list[Any]:
+        """The group's parameters, flags without value types."""
+        return _flags_without_value_type(super().get_params(ctx))
+
+
 app = typer.Typer(
-    add_completion=False,
+    cls=_Group,
     no_args_is_help=True,
+    context_settings={"help_option_names": ["-h", "--help"], "show_default": True},
     help="Multi-robot motion planning with communication: decentralized robots on a grid.",
 )
+command = functools.partial(app.command, cls=_Command)
+"""``app.command`` for mrmp's commands (help without value types for flags)."""
+
+SCENARIOS = "Scenario"
+POLICIES = "Policy"
+FAULTS = "Network faults (simulated; live runs inject them too)"
+OUTPUT = "Output"
+PLANNING = "Central planner"
+LIVE = "Live run (--live)"
+"""The panels ``mrmp run --help`` groups its options in."""
+SCENARIO_DEFAULT = "the scenario's"
+"""The default shown for an option that replaces a value of the scenario file."""
+
+
+def choices(names: Iterable[str]) -> str:
+    """An option's metavar listing the values it takes, e.g. ``[udp|multicast|zenoh]``.
+
+    >>> choices(["divert", "wait"])
+    '[divert|wait]'
+    """
+    return "[" + "|".join(names) + "]"
+
+
+def _colourings() -> tuple[str, ...]:
+    from mrmp.viz.colouring import COLOURINGS
+
+    return COLOURINGS
+
+
+def _colour_by_option(panel: str | None = None) -> Any:
+    """The ``--colour-by`` option of ``mrmp run --animate`` and ``mrmp animate``, its choices from the viz's table."""
+    return typer.Option(
+        help="Colour the robots by their id, the share of their path done, or their heading.",
+        autocompletion=_colourings,
+        rich_help_panel=panel,
+    )
+
+
+def _colour_by_details() -> tuple[str, str]:
+    """``--colour-by``'s metavar and default, from :mod:`mrmp.viz.colouring`."""
+    from mrmp.viz.colouring import COLOURINGS, CROWD
+
+    return choices(COLOURINGS), f"robot up to {CROWD} robots, else progress"
+
+
+_LATE_DETAILS: dict[str, Callable[[], tuple[str, str]]] = {"colour_by": _colour_by_details}
+"""Options whose metavar and shown default are looked up when the command's parameters are first listed."""
+
+
+def _check_drawing(colour_by: str | None, speed: float) -> None:
+    """Refuse, before the run, a colouring or speed the animation cannot use."""
+    if colour_by is not None and colour_by not in _colourings():
+        raise InputError(Problem("--colour-by", f"unknown colouring {colour_by!r}; known: {', '.join(_colourings())}"))
+    _positive(speed, "--speed")
+
+
+def _planner_names() -> tuple[str, ...]:
+    from mrmp.centralized.registry import PLANNER_NAMES
+
+    return tuple(PLANNER_NAMES)
+
+
+def _version(value: bool) -> None:
+    if value:
+        print(f"mrmp {_installed_version()}")
+        raise typer.Exit(0)
+
+
+def _installed_version() -> str:
+    """The installed distribution's version."""
+    from importlib.metadata import PackageNotFoundError, version
+
+    try:
+        return version("mrmp")
+    except PackageNotFoundError:
+        return "(not installed: pip install -e . in the checkout)"
+
+
+@app.callback()
+def _main(
+    version: Annotated[
+        bool, typer.Option("--version", "-V", is_eager=True, callback=_version, help="Print mrmp's version and exit.")
+    ] = False,
+) -> None:
+    """Multi-robot motion planning with communication: decentralized robots on a grid."""
+
 
 TABLE_ROWS = 40
 """Robots listed in the terminal table; the JSON result always has every robot."""
@@ -56,25 +181,6 @@ def _fail(problems: list[Problem] | tuple[Problem, ...]) -> typer.Exit:
     for problem in problems:
         err.print(f"error: {problem}", markup=False)
     return typer.Exit(2)
-
-
-def parse_range(text: str, option: str, unit: str = "ticks", whole: bool = True) -> tuple[float, float]:
-    """Read ``N`` or ``A..B`` (whole numbers when ``whole``), with ``0 <= A <= B``.
-
-    >>> parse_range("0..3", "--delay"), parse_range("2", "--delay")
-    ((0, 3), (2, 2))
-    >>> parse_range("20..80", "--delay-ms", "milliseconds", whole=False)
-    (20.0, 80.0)
-    """
-    low, separator, high = text.partition("..")
-    number = int if whole else float
-    try:
-        bounds = (number(low), number(high)) if separator else (number(low), number(low))
-    except ValueError:
-        raise InputError(Problem(option, f"expected N or A..B {unit}, got {text!r}")) from None
-    if not 0 <= bounds[0] <= bounds[1]:
-        raise InputError(Problem(option, f"expected 0 <= A <= B {unit}, got {text!r}"))
-    return bounds
 
 
 def _load(
@@ -93,44 +199,6 @@ def _load(
     if agents is not None and agents <= 0:
         raise InputError(Problem("--agents", f"must be positive, got {agents}"))
     return load_movingai_scenario(map_path, scen_path, agents)
-
-
-def _with_policy(scenario: Scenario, name: str | None, policy_settings: dict[str, Any]) -> tuple[PolicyOptions, list[Problem]]:
-    """The scenario's policy with ``--policy`` and the setting flags given applied, and the problems found."""
-    changes = {key: value for key, value in policy_settings.items() if value is not None}
-    if name is not None:
-        changes["name"] = name
-    if not changes:
-        return scenario.policy, []
-    try:
-        return replace(scenario.policy, **changes), []
-    except InputError as error:
-        return scenario.policy, list(error.problems)
-
-
-def _apply_options(
-    scenario: Scenario, policy_name: str | None = None, policy_settings: dict[str, Any] | None = None, **options: object
-) -> Scenario:
-    policy, policy_problems = _with_policy(scenario, policy_name, policy_settings or {})
-    network = scenario.network
-    network_changes: dict[str, object] = {
-        key: options[key] for key in ("loss", "duplicate", "reorder") if options.get(key) is not None
-    }
-    if options.get("delay") is not None:
-        network_changes["delay_min"], network_changes["delay_max"] = parse_range(str(options["delay"]), "--delay")
-    if network_changes:
-        network = NetworkFaults(**{**network.__dict__, **network_changes})
-    changes: dict[str, object] = {"policy": policy, "network": network}
-    for key in ("seed", "max_ticks", "safety", "lifelong"):
-        if options.get(key) is not None:
-            changes[key] = options[key]
-    updated = scenario.with_changes(**changes)
-    problems = scenario_problems(updated) + policy_problems
-    if policy_name is not None and policy_name not in policy_names():
-        problems.append(Problem("--policy", f"unknown policy {policy_name!r}; known: {', '.join(policy_names())}"))
-    if problems:
-        raise InputError(problems)
-    return updated
 
 
 def with_policy_flags(command: Callable[..., None]) -> Callable[..., None]:
@@ -154,7 +222,7 @@ def with_policy_flags(command: Callable[..., None]) -> Callable[..., None]:
             field.name,
             inspect.Parameter.POSITIONAL_OR_KEYWORD,
             default=None,
-            annotation=Annotated[types[field.name] | None, typer.Option(setting.flag, help=setting.help)],
+            annotation=Annotated[types[field.name] | None, _setting_option(setting, types[field.name], field.default)],
         )
         for field, setting in settings(PolicyOptions)
     ]
@@ -171,6 +239,31 @@ def with_policy_flags(command: Callable[..., None]) -> Callable[..., None]:
     with_flags.__signature__ = signature.replace(parameters=parameters)  # type: ignore[attr-defined]
     with_flags.__annotations__ = {parameter.name: parameter.annotation for parameter in parameters} | {"return": None}
     return with_flags
+
+
+def _setting_option(setting: Setting, kind: type, default: object) -> Any:
+    """The ``mrmp run`` option of a policy setting: its choices, or no metavar for a switch; the scenario's value by default."""
+    metavar = choices(setting.choices) if setting.choices else None
+    return typer.Option(
+        setting.flag,
+        help=setting.help,
+        metavar=metavar,
+        show_default=f"the scenario's, else {_shown_default(setting, default)}",
+        rich_help_panel=POLICIES,
+        autocompletion=(lambda: list(setting.choices)) if setting.choices else None,
+    )
+
+
+def _shown_default(setting: Setting, default: object) -> str:
+    """A setting's default as its option spells it: ``divert``, ``2``, ``--swap``.
+
+    >>> _shown_default(Setting("", "swap", "--swap/--no-swap"), True), _shown_default(Setting("", "radius", "--radius"), 2)
+    ('--swap', '2')
+    """
+    if isinstance(default, bool):
+        on, _, off = setting.flag.partition("/")
+        return on if default else off
+    return str(default)
 
 
 def _positive(value: float, option: str, largest: float | None = None, unit: str = "") -> float:
@@ -407,53 +500,55 @@ def _watched(
         return start(view.on_tick)
 
 
-@app.command()
+@command()
 @with_policy_flags
 def run(
-    scenario_path: Annotated[Path | None, typer.Argument(metavar="SCENARIO", help="A YAML scenario.")] = None,
-    map_path: Annotated[Path | None, typer.Option("--map", help="A MovingAI .map file.")] = None,
-    scen_path: Annotated[Path | None, typer.Option("--scen", help="A MovingAI .scen file.")] = None,
-    agents: Annotated[int | None, typer.Option(help="Robots taken from the .scen (default: all).")] = None,
-    policy: Annotated[str | None, typer.Option(help=f"Decision rule: {', '.join(policy_names())}.")] = None,
+    scenario_path: Annotated[Path | None, typer.Argument(metavar="SCENARIO", help="A YAML scenario (or --map and --scen).", show_default=False)] = None,
+    map_path: Annotated[Path | None, typer.Option("--map", help="A MovingAI .map file (with --scen).", rich_help_panel=SCENARIOS)] = None,
+    scen_path: Annotated[Path | None, typer.Option("--scen", help="A MovingAI .scen file (with --map).", rich_help_panel=SCENARIOS)] = None,
+    agents: Annotated[int | None, typer.Option(help="Robots taken from the .scen.", show_default="all", rich_help_panel=SCENARIOS)] = None,
+    max_ticks: Annotated[int | None, typer.Option(help="Stop after this many ticks.", show_default=SCENARIO_DEFAULT, rich_help_panel=SCENARIOS)] = None,
+    lifelong: Annotated[bool, typer.Option("--lifelong", help="A robot that reaches its goal gets a new one (seeded); report throughput.", rich_help_panel=SCENARIOS)] = False,
+    seed: Annotated[int | None, typer.Option(help="Seed of the run's random draws (network faults, tie-breaks, new goals, paces).", show_default=SCENARIO_DEFAULT, rich_help_panel=SCENARIOS)] = None,
+    policy: Annotated[str | None, typer.Option(help="The decision rule every robot runs.", metavar=choices(policy_names()), show_default=SCENARIO_DEFAULT, autocompletion=policy_names, rich_help_panel=POLICIES)] = None,
     policy_settings: dict[str, Any] | None = None,
-    unsafe: Annotated[bool, typer.Option("--unsafe", help="Turn the safety layer off: the policy as written.")] = False,
-    lifelong: Annotated[bool, typer.Option("--lifelong", help="A robot that reaches its goal gets a new one (seeded); report throughput.")] = False,
-    max_ticks: Annotated[int | None, typer.Option(help="Stop after this many ticks.")] = None,
-    seed: Annotated[int | None, typer.Option(help="Seed of the simulated network.")] = None,
-    loss: Annotated[float | None, typer.Option(help="Probability that a message is lost.")] = None,
-    delay: Annotated[str | None, typer.Option(help="Message delay in ticks: N or A..B.")] = None,
-    duplicate: Annotated[float | None, typer.Option(help="Probability that a message is duplicated.")] = None,
-    reorder: Annotated[float | None, typer.Option(help="Probability that a message overtakes earlier ones.")] = None,
-    json_path: Annotated[str | None, typer.Option("--json", help="Write the whole result as JSON (- for stdout).")] = None,
-    animate: Annotated[Path | None, typer.Option(help="Write an animation: .gif, .svg or .mp4 (needs ffmpeg).")] = None,
-    show_messages: Annotated[bool, typer.Option("--show-messages", help="Record each tick's messages and draw them in the --animate animation (and the --json result).")] = False,
-    goal_lines: Annotated[bool, typer.Option("--goal-lines", help="Draw a line from each robot to its goal in the --animate animation.")] = False,
-    watch: Annotated[bool, typer.Option("--watch", help="Draw the grid in the terminal as the robots move.")] = False,
-    watch_fps: Annotated[float, typer.Option(help="--watch: ticks drawn per second.")] = 10.0,
-    planner: Annotated[str | None, typer.Option(help="Plan centrally first (cbs, pp, lacam), then execute the plan.")] = None,
-    time_limit: Annotated[float, typer.Option(help="Seconds a central planner may spend.")] = 30.0,
-    live: Annotated[bool, typer.Option("--live", help="One OS process per robot, in real time, over a loopback network.")] = False,
-    transport: Annotated[str, typer.Option(help=f"Live transport: {TRANSPORTS.listed()}.")] = "udp",
-    time_scale: Annotated[float, typer.Option(help="Live: run this many times faster than the robots' real speed.")] = 1.0,
-    delay_ms: Annotated[str | None, typer.Option(help="Live: message delay in milliseconds, N or A..B.")] = None,
-    jitter: Annotated[float, typer.Option(help="Live: each move takes its time times 1 +- jitter.")] = 0.0,
-    miss_line: Annotated[float, typer.Option(help="Live: probability that a body misses a grid line.")] = 0.0,
-    results: Annotated[Path | None, typer.Option(help="Live: folder for traces and reports (default: a new temporary one).")] = None,
-    kill: Annotated[list[str] | None, typer.Option(help="Live: kill robot ID's process S wall-clock seconds after the fleet's start: ID@S (repeatable).")] = None,
-
+    unsafe: Annotated[bool, typer.Option("--unsafe", help="Turn the safety layer off: the policy as written.", rich_help_panel=POLICIES)] = False,
+    loss: Annotated[float | None, typer.Option(help="Probability that a message is lost.", show_default=SCENARIO_DEFAULT, rich_help_panel=FAULTS)] = None,
+    delay: Annotated[str | None, typer.Option(help="Message delay in ticks.", metavar="N|A..B", show_default=SCENARIO_DEFAULT, rich_help_panel=FAULTS)] = None,
+    duplicate: Annotated[float | None, typer.Option(help="Probability that a message is duplicated.", show_default=SCENARIO_DEFAULT, rich_help_panel=FAULTS)] = None,
+    reorder: Annotated[float | None, typer.Option(help="Probability that a message overtakes earlier ones.", show_default=SCENARIO_DEFAULT, rich_help_panel=FAULTS)] = None,
+    json_path: Annotated[Path | None, typer.Option("--json", help="Write the whole result as JSON (- for stdout).", metavar="PATH|-", rich_help_panel=OUTPUT)] = None,
+    animate: Annotated[Path | None, typer.Option(help="Write an animation: .gif, .svg or .mp4 (needs ffmpeg).", rich_help_panel=OUTPUT)] = None,
+    show_messages: Annotated[bool, typer.Option("--show-messages", help="Record each tick's messages and draw them in the --animate animation (and the --json result).", rich_help_panel=OUTPUT)] = False,
+    goal_lines: Annotated[bool, typer.Option("--goal-lines", help="Draw a line from each robot to its goal in the --animate animation.", rich_help_panel=OUTPUT)] = False,
+    colour_by: Annotated[str | None, _colour_by_option(OUTPUT)] = None,
+    speed: Annotated[float, typer.Option(help="--animate: play a live run this many times faster than real time.", rich_help_panel=OUTPUT)] = 1.0,
+    watch: Annotated[bool, typer.Option("--watch", help="Draw the grid in the terminal as the robots move.", rich_help_panel=OUTPUT)] = False,
+    watch_fps: Annotated[float, typer.Option(help="--watch: ticks drawn per second.", rich_help_panel=OUTPUT)] = 10.0,
+    planner: Annotated[str | None, typer.Option(help="Plan centrally first, then the robots execute the plan.", metavar=choices(_planner_names()), show_default="none: the policy decides", autocompletion=_planner_names, rich_help_panel=PLANNING)] = None,
+    time_limit: Annotated[float, typer.Option(help="Seconds a central planner may spend.", rich_help_panel=PLANNING)] = 30.0,
+    live: Annotated[bool, typer.Option("--live", help="One OS process per robot, in real time, over a loopback network.", rich_help_panel=LIVE)] = False,
+    transport: Annotated[str, typer.Option(help="How the robots' processes talk.", metavar=choices(TRANSPORTS.names), autocompletion=lambda: list(TRANSPORTS.names), rich_help_panel=LIVE)] = "udp",
+    time_scale: Annotated[float, typer.Option(help="Run this many times faster than the robots' real speed.", rich_help_panel=LIVE)] = 1.0,
+    delay_ms: Annotated[str | None, typer.Option(help="Message delay in milliseconds.", metavar="N|A..B", show_default="the scenario's delay in ticks, at this speed", rich_help_panel=LIVE)] = None,
+    jitter: Annotated[float, typer.Option(help="Each move takes its time times 1 +- jitter.", rich_help_panel=LIVE)] = 0.0,
+    miss_line: Annotated[float, typer.Option(help="Probability that a body misses a grid line.", rich_help_panel=LIVE)] = 0.0,
+    results: Annotated[Path | None, typer.Option(help="Folder for the robots' traces and reports (mrmp agent's --results, for the whole fleet).", show_default="a new temporary folder", rich_help_panel=LIVE)] = None,
+    kill: Annotated[list[str] | None, typer.Option(help="Kill robot ID's process S wall-clock seconds after the fleet's start (repeatable).", metavar="ID@S", show_default=False, rich_help_panel=LIVE)] = None,
 ) -> None:
     """Run a scenario (lockstep simulator, or --live processes) and report what happened."""
     # --resolve, --heading-aware, --radius, --swap and --search come from PolicyOptions' fields (with_policy_flags)
     request = RunRequest(
-        json_path, animate, show_messages, watch, watch_fps, planner, time_limit, live, transport, time_scale,
-        delay_ms, jitter, miss_line, results, kill or [], unsafe, goal_lines=goal_lines,
+        None if json_path is None else str(json_path), animate, show_messages, watch, watch_fps, planner, time_limit, live, transport, time_scale,
+        delay_ms, jitter, miss_line, results, kill or [], unsafe, goal_lines=goal_lines, colour_by=colour_by, speed=speed,
     )
-    console = Console(stderr=json_path == "-", highlight=False)
+    console = Console(stderr=request.json_path == "-", highlight=False)
     try:
-        scenario = _apply_options(
+        scenario = apply_run_options(
             _load(scenario_path, map_path, scen_path, agents),
             policy,
             policy_settings,
+            names=FLAG_NAMES,
             loss=loss,
             delay=delay,
             duplicate=duplicate,
@@ -495,6 +590,8 @@ class RunRequest:
     kill: list[str]
     unsafe: bool
     goal_lines: bool = False
+    colour_by: str | None = None
+    speed: float = 1.0
 
 
 def _validate_run(scenario: Scenario, request: RunRequest) -> None:
@@ -518,6 +615,7 @@ def _validate_run(scenario: Scenario, request: RunRequest) -> None:
         animation_issue = animation_problem(request.animate)
         if animation_issue is not None:
             raise InputError(Problem("--animate", animation_issue))
+        _check_drawing(request.colour_by, request.speed)
     if request.show_messages:
         written = request.animate is not None or request.json_path is not None
         _check_show_messages(scenario, written, request.live, request.planner is not None)
@@ -564,7 +662,7 @@ def _simulated_run(scenario: Scenario, request: RunRequest, plan: PlanningResult
 
 
 def _live_run(scenario: Scenario, request: RunRequest, plan: PlanningResult | None, console: Console) -> RunResult:
-    """Run ``scenario`` live: one OS process per robot over a loopback network."""
+    """Run ``scenario`` live: one OS process per robot over a loopback network, its progress shown on a terminal."""
     from mrmp.live.launcher import LiveOptions, run_live
 
     options = LiveOptions(
@@ -579,7 +677,13 @@ def _live_run(scenario: Scenario, request: RunRequest, plan: PlanningResult | No
         seed=scenario.seed,
         plan=plan,
     )
-    return run_live(scenario, options, say=lambda text: console.print(text, markup=False))
+    from mrmp.viz.progress import LiveProgressLine
+
+    with LiveProgressLine(console) as progress:
+        return run_live(
+            scenario, options, say=lambda text: console.print(text, markup=False),
+            on_progress=progress.on_progress if console.is_terminal else None,
+        )  # fmt: skip
 
 
 def _output_run(result: RunResult, scenario: Scenario, request: RunRequest, console: Console) -> None:
@@ -592,7 +696,8 @@ def _output_run(result: RunResult, scenario: Scenario, request: RunRequest, cons
             from mrmp.viz import write_animation
 
             write_animation(
-                scenario.grid, result, request.animate, show_messages=request.show_messages, goal_lines=request.goal_lines
+                scenario.grid, result, request.animate, show_messages=request.show_messages, goal_lines=request.goal_lines,
+                colour_by=request.colour_by, speed=request.speed,
             )
             console.print(f"animation written to {request.animate}")
     except (MrmpError, OSError) as error:
@@ -601,19 +706,19 @@ def _output_run(result: RunResult, scenario: Scenario, request: RunRequest, cons
     raise typer.Exit(0 if result.success else 1)
 
 
-@app.command()
+@command()
 def compare(
-    scenario_path: Annotated[Path | None, typer.Argument(metavar="SCENARIO", help="A YAML scenario.")] = None,
-    map_path: Annotated[Path | None, typer.Option("--map", help="A MovingAI .map file.")] = None,
-    scen_path: Annotated[Path | None, typer.Option("--scen", help="A MovingAI .scen file.")] = None,
-    agents: Annotated[int | None, typer.Option(help="Robots taken from the .scen (default: all).")] = None,
+    scenario_path: Annotated[Path | None, typer.Argument(metavar="SCENARIO", help="A YAML scenario (or --map and --scen).", show_default=False)] = None,
+    map_path: Annotated[Path | None, typer.Option("--map", help="A MovingAI .map file (with --scen).")] = None,
+    scen_path: Annotated[Path | None, typer.Option("--scen", help="A MovingAI .scen file (with --map).")] = None,
+    agents: Annotated[int | None, typer.Option(help="Robots taken from the .scen.", show_default="all")] = None,
     time_limit: Annotated[float, typer.Option(help="Seconds each central planner may spend.")] = 30.0,
-    json_path: Annotated[str | None, typer.Option("--json", help="Write the rows as JSON (- for stdout).")] = None,
+    json_path: Annotated[Path | None, typer.Option("--json", help="Write the rows as JSON (- for stdout).", metavar="PATH|-")] = None,
 ) -> None:
     """Solve one scenario every way: each decentralized policy, and each central planner plus execution."""
     from mrmp.experiments.compare import compare_methods
 
-    console = Console(stderr=json_path == "-", highlight=False)
+    console = Console(stderr=str(json_path) == "-", highlight=False)
     try:
         scenario = _load(scenario_path, map_path, scen_path, agents)
         rows = compare_methods(scenario, time_limit_s=_positive(time_limit, "--time-limit", MAX_RUN_SECONDS, "seconds"))
@@ -640,7 +745,7 @@ def compare(
         from mrmp.io.live_files import write_json
 
         rows_data = [row.__dict__ for row in rows]
-        if json_path == "-":
+        if str(json_path) == "-":
             import json
 
             print(json.dumps(rows_data, indent=1))
@@ -648,11 +753,11 @@ def compare(
             write_json(json_path, rows_data)
 
 
-@app.command()
+@command()
 def report(
     source: Annotated[Path, typer.Argument(metavar="DIR_OR_JSONL", help="A benchmark's --out folder, or its results.jsonl.")],
     out: Annotated[Path, typer.Option(help="The HTML page to write; its plots go to <stem>_plots/ next to it.")] = Path("report.html"),
-    title: Annotated[str | None, typer.Option(help="The page's title (default: named after the benchmark).")] = None,
+    title: Annotated[str | None, typer.Option(help="The page's title.", metavar="TEXT", show_default="named after the benchmark")] = None,
     markdown: Annotated[Path | None, typer.Option(help="Also write the headline table as Markdown to this file.")] = None,
 ) -> None:
     """Write an HTML report of a benchmark: what was run, the headline table, plots, timeouts and errors."""
@@ -691,12 +796,14 @@ def report(
         console.print(f"headline table (Markdown) written to {markdown}", markup=False, soft_wrap=True)
 
 
-@app.command("animate")
+@command("animate")
 def animate_command(
     result_path: Annotated[Path, typer.Argument(metavar="RESULT", help="A run saved with mrmp run --json (it holds the map).")],
     out: Annotated[Path, typer.Option("--out", help="The animation to write: .gif, .svg or .mp4 (needs ffmpeg).")],
     show_messages: Annotated[bool, typer.Option("--show-messages", help="Draw each tick's messages (runs saved with them).")] = False,
     goal_lines: Annotated[bool, typer.Option("--goal-lines", help="Draw a line from each robot to its goal.")] = False,
+    colour_by: Annotated[str | None, _colour_by_option()] = None,
+    speed: Annotated[float, typer.Option(help="Play a live run this many times faster than real time.")] = 1.0,
 ) -> None:
     """Draw a saved run as an animation."""
     from mrmp.io.results import read_result_json
@@ -707,6 +814,7 @@ def animate_command(
         animation_issue = animation_problem(out)
         if animation_issue is not None:
             raise InputError(Problem("--out", animation_issue))
+        _check_drawing(colour_by, speed)
         result, grid = read_result_json(result_path)
         if grid is None:
             raise InputError(Problem(str(result_path), "no map is stored with this run: save it with mrmp run --json"))
@@ -717,21 +825,28 @@ def animate_command(
     except InputError as error:
         raise _fail(error.problems) from None
     try:
-        write_animation(grid, result, out, show_messages=show_messages, goal_lines=goal_lines)
+        write_animation(grid, result, out, show_messages=show_messages, goal_lines=goal_lines, colour_by=colour_by, speed=speed)
     except (MrmpError, OSError) as error:
         Console(stderr=True).print(f"error: {error}", markup=False)
         raise typer.Exit(2) from None
     console.print(f"animation written to {out}", markup=False)
 
 
-@app.command()
+@command()
 def bench(
     config_path: Annotated[Path, typer.Argument(metavar="CONFIG.yaml", help="A benchmark configuration (see bench/tiny.yaml).")],
     out: Annotated[Path, typer.Option(help="Output folder: results.jsonl (one record per run) and results.csv.")],
-    workers: Annotated[int | None, typer.Option(help="Worker processes (default: the number of CPUs).")] = None,
-    dask: Annotated[str | None, typer.Option(help="Run on this dask.distributed scheduler (HOST:PORT) instead.")] = None,
-    time_limit: Annotated[float | None, typer.Option(help="Seconds per run, replacing the configuration's time_limit.")] = None,
-    only_missing: Annotated[bool, typer.Option("--only-missing", help="Also run again the runs whose last record is an error.")] = False,
+    workers: Annotated[int | None, typer.Option(help="Worker processes.", show_default="the number of CPUs")] = None,
+    dask: Annotated[str | None, typer.Option(help="Run on this dask.distributed scheduler instead.", metavar="HOST:PORT")] = None,
+    time_limit: Annotated[float | None, typer.Option(help="Seconds per run.", show_default="the configuration's time_limit")] = None,
+    only_missing: Annotated[
+        bool,
+        typer.Option(
+            "--only-missing",
+            help="Count a run whose last record is an error as missing, and run it again. "
+            "A bench always resumes: runs with no record are run; without this, runs recorded as errors are kept.",
+        ),
+    ] = False,
 ) -> None:
     """Run a benchmark matrix (maps x robots x methods x seeds x faults); resumes where it stopped."""
     from mrmp.bench.runner import run_bench
@@ -777,7 +892,7 @@ def bench(
         raise typer.Exit(1)
 
 
-@app.command()
+@command()
 def validate(
     files: Annotated[list[Path], typer.Argument(metavar="FILE...", help="Scenarios (.yaml), maps (.map) or .scen files.")],
 ) -> None:
@@ -794,33 +909,34 @@ def validate(
         raise _fail(problems)
 
 
-@app.command()
+@command()
 def agent(
-    scenario_path: Annotated[Path, typer.Option("--scenario", help="The fleet's scenario (the same file on every robot).")],
-    robot: Annotated[str, typer.Option(help="Which robot of the scenario this process is (its id).")],
-    transport: Annotated[str, typer.Option(help=f"{TRANSPORTS.listed()}.")] = "udp",
-    bind: Annotated[str, typer.Option(help="UDP: address to receive on, HOST:PORT.")] = "127.0.0.1:9001",
-    peer: Annotated[list[str] | None, typer.Option(help="UDP: a peer, ID=HOST:PORT (repeat for each).")] = None,
-    group: Annotated[str, typer.Option(help="Multicast: group HOST:PORT.")] = "239.255.77.1:47000",
-    interface: Annotated[str, typer.Option(help="Multicast: IPv4 address of the interface to use.")] = "127.0.0.1",
-    listen: Annotated[str, typer.Option(help="Zenoh: this robot's endpoint, e.g. tcp/127.0.0.1:7447.")] = "",
-    connect: Annotated[list[str] | None, typer.Option(help="Zenoh: a peer's endpoint (repeat for each).")] = None,
-    fleet: Annotated[str, typer.Option(help="Zenoh: key-expression prefix of the fleet.")] = "mrmp",
-    key_file: Annotated[Path | None, typer.Option(help="Fleet key file (or set MRMP_FLEET_KEY).")] = None,
+    scenario_path: Annotated[Path | None, typer.Argument(metavar="SCENARIO", help="The fleet's scenario (the same file on every robot).", show_default=False)] = None,
+    robot: Annotated[str | None, typer.Option(help="Which robot of the scenario this process is (required).", metavar="ID")] = None,
+    transport: Annotated[str, typer.Option(help="How the robots talk.", metavar=choices(TRANSPORTS.names), autocompletion=lambda: list(TRANSPORTS.names))] = "udp",
+    bind: Annotated[str, typer.Option(help="UDP: address to receive on.", metavar="HOST:PORT")] = "127.0.0.1:9001",
+    peer: Annotated[list[str] | None, typer.Option(help="UDP: a peer (repeat for each).", metavar="ID=HOST:PORT", show_default=False)] = None,
+    group: Annotated[str, typer.Option(help="Multicast: the group.", metavar="HOST:PORT")] = "239.255.77.1:47000",
+    interface: Annotated[str, typer.Option(help="Multicast: IPv4 address of the interface to use.", metavar="IPV4")] = "127.0.0.1",
+    listen: Annotated[str, typer.Option(help="Zenoh: this robot's endpoint, e.g. tcp/127.0.0.1:7447.", metavar="ENDPOINT", show_default="none")] = "",
+    connect: Annotated[list[str] | None, typer.Option(help="Zenoh: a peer's endpoint (repeat for each).", metavar="ENDPOINT", show_default=False)] = None,
+    fleet: Annotated[str, typer.Option(help="Zenoh: key-expression prefix of the fleet.", metavar="PREFIX")] = "mrmp",
+    key_file: Annotated[Path | None, typer.Option(help="Fleet key file.", show_default="MRMP_FLEET_KEY")] = None,
     session: Annotated[int, typer.Option(help="Run number shared by the fleet; other runs' messages are dropped.")] = 1,
-    results: Annotated[Path, typer.Option(help="Folder for this robot's report and trace.")] = Path("results"),
+    results: Annotated[Path, typer.Option(help="Folder for this robot's report and trace (mrmp run --live gives each robot its run's folder).")] = Path("results"),
     time_scale: Annotated[float, typer.Option(help="Run this many times faster than the robot's real speed.")] = 1.0,
     jitter: Annotated[float, typer.Option(help="Each move takes its time times 1 +- jitter.")] = 0.0,
     miss_line: Annotated[float, typer.Option(help="Probability that the body misses a grid line.")] = 0.0,
     loss: Annotated[float, typer.Option(help="Inject: probability that a sent message is lost.")] = 0.0,
-    delay_ms: Annotated[str, typer.Option(help="Inject: delay of sent messages, N or A..B milliseconds.")] = "0",
+    delay_ms: Annotated[str, typer.Option(help="Inject: delay of sent messages, in milliseconds.", metavar="N|A..B")] = "0",
     duplicate: Annotated[float, typer.Option(help="Inject: probability that a sent message is duplicated.")] = 0.0,
     reorder: Annotated[float, typer.Option(help="Inject: probability that a sent message is held back.")] = 0.0,
     listen_time: Annotated[float, typer.Option(help="Seconds between announcing Next and deciding.")] = 0.05,
     unsafe: Annotated[bool, typer.Option("--unsafe", help="No safety layer: the policy as written.")] = False,
-    plan: Annotated[Path | None, typer.Option(help="Follow this robot's share of a central plan (plan-<index>.json).")] = None,
+    plan: Annotated[Path | None, typer.Option(help="Follow this robot's share of a central plan (plan-<index>.json).", show_default="none: the policy decides")] = None,
     seed: Annotated[int, typer.Option(help="Seed of the body's and the fault injector's randomness.")] = 0,
     timeout: Annotated[float, typer.Option(help="Give up after this many seconds.")] = 600.0,
+    scenario_option: Annotated[Path | None, typer.Option("--scenario", hidden=True, help="SCENARIO, as an option.")] = None,
 ) -> None:
     """Run one robot of a fleet as this process (one command per robot, on its own computer)."""
     import os
@@ -833,6 +949,9 @@ def agent(
 
     die_with_parent()
     try:
+        scenario_path = _scenario_argument(scenario_path, scenario_option)
+        if robot is None:
+            raise InputError(Problem("--robot", "give the id of the robot this process is"))
         scenario = load_scenario(scenario_path, known_policies=policy_names())
         ids = [spec.id for spec in scenario.robots]
         if robot not in ids:
@@ -876,29 +995,50 @@ def agent(
     raise typer.Exit(0 if report.arrived else 1)
 
 
-@app.command()
+@command()
 def referee(
-    scenario_path: Annotated[Path, typer.Option("--scenario", help="The fleet's scenario.")],
-    results: Annotated[Path, typer.Option(help="The folder the robots write their traces to.")],
-    start_time: Annotated[float, typer.Option(help="The run's start on this machine's monotonic clock.")],
-    done_file: Annotated[Path, typer.Option(help="Stop when this file appears.")],
+    scenario_path: Annotated[Path | None, typer.Argument(metavar="SCENARIO", help="The fleet's scenario.", show_default=False)] = None,
+    results: Annotated[Path, typer.Option(help="The folder the robots wrote (or write) their traces to.")] = Path("results"),
+    start_time: Annotated[
+        float | None,
+        typer.Option(help="The run's start on this machine's monotonic clock (collision ticks count milliseconds from it).", show_default="the traces' first event"),
+    ] = None,
+    done_file: Annotated[
+        Path | None,
+        typer.Option(help="Follow the traces as they grow, until this file appears.", show_default="none: judge the traces as they are and stop"),
+    ] = None,
+    scenario_option: Annotated[Path | None, typer.Option("--scenario", hidden=True, help="SCENARIO, as an option.")] = None,
 ) -> None:
-    """Judge a live run from the robots' ground-truth traces, until told to stop."""
+    """Judge a run from the robots' ground-truth traces: as they are, or following them until told to stop."""
     from mrmp.io.lifetime import die_with_parent
     from mrmp.live.process import run_referee, warn
 
     die_with_parent()
     try:
-        scenario = load_scenario(scenario_path, known_policies=policy_names())
+        scenario = load_scenario(_scenario_argument(scenario_path, scenario_option), known_policies=policy_names())
+        if not results.is_dir():
+            raise InputError(Problem("--results", f"no such folder: {results}"))
     except InputError as error:
         raise _fail(error.problems) from None
     collisions = run_referee(scenario, results, start_time, done_file, warn)
+    if done_file is None:  # by hand: say what was found (beside a live run, the launcher reports)
+        found = f"{len(collisions)} collision{'' if len(collisions) == 1 else 's'}"
+        Console(highlight=False).print(f"{found}; verdict written to {results / 'referee.json'}", markup=False)
     raise typer.Exit(1 if collisions else 0)
+
+
+def _scenario_argument(argument: Path | None, option: Path | None) -> Path:
+    """The scenario named by the ``SCENARIO`` argument, or by ``--scenario`` (the same, spelled as an option)."""
+    if argument is not None and option is not None:
+        raise InputError(Problem("--scenario", "give the scenario once: as SCENARIO or as --scenario"))
+    if argument is None and option is None:
+        raise InputError(Problem("SCENARIO", "give the fleet's scenario file"))
+    return argument if argument is not None else option  # type: ignore[return-value]
 
 
 def main() -> None:
     """Entry point of the ``mrmp`` command."""
     try:
-        app()
+        app(prog_name="mrmp")  # also under python -m mrmp: its help, and its shell completion's variable, _MRMP_COMPLETE
     except KeyboardInterrupt:
         sys.exit(130)

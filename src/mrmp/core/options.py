@@ -77,12 +77,15 @@ class Setting:
         Its ``mrmp run`` option: ``--name``, or ``--name/--no-name`` for a switch.
     check:
         Why a value is wrong (None when it is right).
+    choices:
+        The values it may take, when they are a list of names (listed by ``mrmp run --help``).
     """
 
     help: str
     yaml_key: str
     flag: str
     check: Check = _always_right
+    choices: tuple[str, ...] = ()
 
     @property
     def path(self) -> str:
@@ -94,9 +97,11 @@ class Setting:
         return f"policy.{self.yaml_key}"
 
 
-def setting(default: Any, *, help: str, yaml_key: str, flag: str, check: Check = _always_right) -> Any:
+def setting(
+    default: Any, *, help: str, yaml_key: str, flag: str, check: Check = _always_right, choices: tuple[str, ...] = ()
+) -> Any:
     """A dataclass field holding a policy setting (its default, and its :class:`Setting` as metadata)."""
-    return dataclasses.field(default=default, metadata={SETTING: Setting(help, yaml_key, flag, check)})
+    return dataclasses.field(default=default, metadata={SETTING: Setting(help, yaml_key, flag, check, choices)})
 
 
 def settings(options_type: type) -> tuple[tuple[dataclasses.Field[Any], Setting], ...]:
@@ -150,8 +155,8 @@ def _one_of_searches(value: object) -> str | None:
 def resolve_setting() -> Any:
     """``resolve``: the thesis's two collision-avoidance techniques (section 2.1), ``divert`` or ``wait``."""
     return setting(
-        "divert", help=f"Conflict resolution: {', '.join(RESOLUTIONS)}.", yaml_key="resolve", flag="--resolve",
-        check=_one_of_resolutions,
+        "divert", help="Conflict resolution: divert (change of route) or wait (velocity tuning).", yaml_key="resolve",
+        flag="--resolve", check=_one_of_resolutions, choices=RESOLUTIONS,
     )
 
 
@@ -186,9 +191,9 @@ def search_setting() -> Any:
     """
     return setting(
         POLICY_DEFAULT_SEARCH,
-        help=f"thesis, astar: the single-robot search, {'|'.join(SEARCH_NAMES)} "
-        f"({POLICY_DEFAULT_SEARCH}: update-coordinate for thesis, astar for astar).",
-        yaml_key="search", flag="--search", check=_one_of_searches,
+        help=f"thesis, astar: the single-robot search; {POLICY_DEFAULT_SEARCH} is the policy's own "
+        "(thesis: update-coordinate, astar: astar).",
+        yaml_key="search", flag="--search", check=_one_of_searches, choices=(POLICY_DEFAULT_SEARCH, *SEARCH_NAMES),
     )
 
 

@@ -9,6 +9,7 @@ A scenario file looks like this (only ``map`` and ``robots`` are required)::
       # file: ../maps/random-32-32-20.map   (relative to this file's folder)
       # width: 5     (number of y values, east-west)
       # height: 5    (number of x values, north-south)
+      # obstacles: [[2, 2], [3, 1]]   (with width and height: blocked cells [x, y])
     robots:                           # or, at top level: scen: file.scen + agents: N
       - id: A
         start: [0, 2]                 # [x, y]: x grows NORTH, y grows EAST
@@ -113,7 +114,7 @@ TOP_KEYS = (
     "lifelong",
 )
 """Keys allowed at the top level of a scenario file."""
-MAP_KEYS = ("rows", "file", "width", "height")
+MAP_KEYS = ("rows", "file", "width", "height", "obstacles")
 """Keys allowed under ``map``."""
 ROBOT_KEYS = ("id", "start", "goal", "heading")
 """Keys allowed in each item of ``robots``."""
@@ -178,6 +179,8 @@ class _Reader:
     robot_sources: dict[int, str] = field(default_factory=dict)
     robot_trouble: bool = False
     constructor: SafeConstructor = field(default_factory=SafeConstructor)
+    obstacles: dict[Cell, int] = field(default_factory=dict)
+    """The cells of ``map.obstacles``, each with its index there."""
 
     # -- recording ---------------------------------------------------------------------
 
@@ -365,6 +368,10 @@ class _Reader:
             )
             self.report(_line(node), "map", reason)
             return None
+        if "obstacles" in entries and "width and height" not in forms:
+            reason = f"goes with width and height; draw obstacles in the map's {forms[0]}"
+            self.report(entries["obstacles"].key_line, "map.obstacles", reason)
+            return None
         if "rows" in entries:
             return self.read_rows(entries["rows"].value, name)
         if "file" in entries:
@@ -385,7 +392,35 @@ class _Reader:
         if too_large is not None:
             self.report(_line(node), "map", too_large)
             return None
-        return Grid(height, width, name=name)
+        obstacles = self.read_obstacles(entries["obstacles"].value, Grid(height, width)) if "obstacles" in entries else []
+        if obstacles is None:
+            return None
+        return Grid(height, width, obstacles, name=name)
+
+    def read_obstacles(self, node: Node, bounds: Grid) -> list[Cell] | None:
+        """The blocked cells of ``map.obstacles`` (a list of ``[x, y]`` inside ``bounds``), or None if any is wrong."""
+        if not isinstance(node, SequenceNode):
+            got = _describe(node, self.scalar(node))
+            self.report(_line(node), "map.obstacles", f"expected a list of cells [x, y], got {got}")
+            return None
+        ok = True
+        for index, item in enumerate(node.value):
+            path = f"map.obstacles[{index}]"
+            self.lines[path] = _line(item)
+            cell = self.cell(item, path)
+            if cell is _BAD:
+                ok = False
+            elif not bounds.in_bounds(cell):
+                size = f"{bounds.x_size}x{bounds.y_size}"
+                reason = f"cell {cell} is outside the {size} map (x from 0 to {bounds.x_max}, y from 0 to {bounds.y_max})"
+                self.report(_line(item), path, reason)
+                ok = False
+            elif cell in self.obstacles:
+                self.report(_line(item), path, f"cell {cell} is already map.obstacles[{self.obstacles[cell]}]")
+                ok = False
+            else:
+                self.obstacles[cell] = index
+        return list(self.obstacles) if ok else None
 
     def read_rows(self, node: Node, name: str) -> Grid | None:
         """A grid from ``map.rows`` (first row northmost), or None."""
@@ -663,7 +698,20 @@ class _Reader:
             ):
                 continue
             path = original(problem.where)
-            self.problems.append(Problem(self.where(path), f"{path}: {original(problem.reason)}"))
+            reason = original(problem.reason) + self.obstacle_named(scenario, problem)
+            self.problems.append(Problem(self.where(path), f"{path}: {reason}"))
+
+    def obstacle_named(self, scenario: Scenario, problem: Problem) -> str:
+        """For a robot's start or goal on a cell of ``map.obstacles``, which entry (and line) blocks it; else ``""``."""
+        match = re.fullmatch(r"robots\[(\d+)\]\.(start|goal)", problem.where)
+        if match is None or not problem.reason.endswith("is an obstacle"):
+            return ""
+        robot = scenario.robots[int(match.group(1))]
+        cell = robot.start if match.group(2) == "start" else robot.goal
+        if cell not in self.obstacles:
+            return ""
+        entry = f"map.obstacles[{self.obstacles[cell]}]"
+        return f" ({entry}, line {self.lines[entry]}; cells are [x, y], x growing north)"
 
 
 def _unusable(what: str, path: Path, problem: str) -> str:

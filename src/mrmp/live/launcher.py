@@ -23,6 +23,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections import Counter
 from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
@@ -31,6 +32,7 @@ from mrmp.centralized.execution import distributed_bytes, plan_policies
 from mrmp.centralized.plan import PlanningResult
 from mrmp.core.errors import InputError, Problem
 from mrmp.core.limits import MAX_RUN_SECONDS
+from mrmp.core.progress import LiveProgress
 from mrmp.core.result import RunResult
 from mrmp.core.scenario import Scenario
 from mrmp.io.lifetime import preexec_dying_with
@@ -95,16 +97,26 @@ class _Fleet:
     """The folder the robots write their reports to."""
 
 
+PROGRESS_EVERY_S = 0.25
+"""Least time between two progress reports of :func:`run_live` (each reads every robot's report)."""
+
 _PYTHON = [sys.executable, "-m", "mrmp"]
 """How to start the ``mrmp`` command with this interpreter."""
 
 
-def run_live(scenario: Scenario, options: LiveOptions, say: Callable[[str], None] = lambda text: None) -> RunResult:
+def run_live(
+    scenario: Scenario,
+    options: LiveOptions,
+    say: Callable[[str], None] = lambda text: None,
+    on_progress: Callable[[LiveProgress], None] | None = None,
+) -> RunResult:
     """Run ``scenario`` with one process per robot over a loopback network; return the judged result.
 
     The steps: check the options, write the run's files, lay the fleet out on
     loopback, start the referee and the robots, watch them until they stop
-    (killing robots on schedule), stop what is left, and judge what they wrote.
+    (killing robots on schedule, and passing ``on_progress`` the fleet's
+    progress from their reports every :data:`PROGRESS_EVERY_S`), stop what is
+    left, and judge what they wrote.
 
     Raises
     ------
@@ -120,7 +132,7 @@ def run_live(scenario: Scenario, options: LiveOptions, say: Callable[[str], None
     timeout = min(timeout, MAX_RUN_SECONDS)  # what mrmp agent --timeout accepts
     fleet = _start_fleet(options, files, layout, session, timeout)
     say(f"live: {len(ids)} robot processes and a referee over {options.transport} on loopback; results in {files.results}")
-    stop_reason = _watch(fleet, options.kill, say)
+    stop_reason = _watch(fleet, options.kill, say, on_progress)
     wall_time = time.monotonic() - fleet.started
     reports = [_read_if_there(files.results / f"agent-{index}.json") for index in range(len(ids))]
     verdict = _read_if_there(files.results / "referee.json")
@@ -167,7 +179,7 @@ def _start_fleet(options: LiveOptions, files: _RunFiles, layout: FleetLayout, se
     started = time.monotonic()
     referee = _start(
         [
-            *_PYTHON, "referee", f"--scenario={files.scenario}", f"--results={files.results}",
+            *_PYTHON, "referee", str(files.scenario), f"--results={files.results}",
             f"--start-time={started}", f"--done-file={files.done}",
         ],
     )
@@ -176,7 +188,8 @@ def _start_fleet(options: LiveOptions, files: _RunFiles, layout: FleetLayout, se
     for index, robot_id in enumerate(layout.ids):
         transport = TRANSPORTS.fleet_spec(options.transport, layout, index)
         plan = [f"--plan={files.shares[index]}"] if files.shares else []
-        command = [*_PYTHON, "agent", f"--robot={robot_id}", *common, *plan, *transport.arguments(layout.ids)]
+        robot = [str(files.scenario), f"--robot={robot_id}"]
+        command = [*_PYTHON, "agent", *robot, *common, *plan, *transport.arguments(layout.ids)]
         agents.append(_start(command))
     return _Fleet(list(layout.ids), agents, referee, started, timeout, files.done, files.results)
 
@@ -184,7 +197,6 @@ def _start_fleet(options: LiveOptions, files: _RunFiles, layout: FleetLayout, se
 def _agent_arguments(options: LiveOptions, files: _RunFiles, session: int, timeout: float) -> list[str]:
     """The ``mrmp agent`` arguments every robot of the run gets."""
     return [
-        f"--scenario={files.scenario}",
         f"--key-file={files.key}",
         f"--session={session}",
         f"--results={files.results}",
@@ -199,7 +211,12 @@ def _agent_arguments(options: LiveOptions, files: _RunFiles, session: int, timeo
     ]
 
 
-def _watch(fleet: _Fleet, kill: Mapping[str, float], say: Callable[[str], None]) -> str:
+def _watch(
+    fleet: _Fleet,
+    kill: Mapping[str, float],
+    say: Callable[[str], None],
+    on_progress: Callable[[LiveProgress], None] | None = None,
+) -> str:
     """Wait for the robots to stop, killing those of ``kill`` on time; then stop every process. Why the run stopped.
 
     Kill times count from the fleet's start (the last robot to begin its run, as its
@@ -209,9 +226,13 @@ def _watch(fleet: _Fleet, kill: Mapping[str, float], say: Callable[[str], None])
     stop_reason = "all arrived"
     pending_kills = {fleet.ids.index(robot_id): seconds for robot_id, seconds in kill.items()}
     fleet_start: float | None = None
+    shown_at: float | None = None
     try:
         while any(agent.poll() is None for agent in fleet.agents):
             now = time.monotonic()
+            if on_progress is not None and (shown_at is None or now - shown_at >= PROGRESS_EVERY_S):
+                shown_at = now
+                on_progress(fleet_progress(fleet.results, len(fleet.ids), now - fleet.started))
             if pending_kills and fleet_start is None:
                 fleet_start = _fleet_start(fleet)
             for index, seconds in list(pending_kills.items()):
@@ -229,6 +250,31 @@ def _watch(fleet: _Fleet, kill: Mapping[str, float], say: Callable[[str], None])
     finally:
         _shut_down(fleet)
     return stop_reason
+
+
+def fleet_progress(results: Path, robots: int, elapsed_s: float) -> LiveProgress:
+    """The fleet's progress summed from the reports the robots have written in ``results`` so far.
+
+    >>> import json, tempfile
+    >>> folder = Path(tempfile.mkdtemp())
+    >>> report = {"arrived": True, "messages_sent": 7, "faults": {"sent": 7, "lost": 2}}
+    >>> _ = (folder / "agent-0.json").write_text(json.dumps(report))
+    >>> fleet_progress(folder, 2, 1.25).text()
+    '1.2 s: 1 of 2 robots arrived, 7 messages, faults injected: lost 2'
+    """
+    arrived = messages = 0
+    faults: Counter[str] = Counter()
+    for index in range(robots):
+        try:
+            report = _read_if_there(results / f"agent-{index}.json")
+        except InputError:  # cannot happen with atomic writes; a report being replaced is read next time
+            report = None
+        if report is None:
+            continue
+        arrived += bool(report.get("arrived"))
+        messages += int(report.get("messages_sent", 0))
+        faults.update({kind: int(count) for kind, count in dict(report.get("faults", {})).items() if kind != "sent"})
+    return LiveProgress(robots, arrived, messages, dict(faults), elapsed_s)
 
 
 def _fleet_start(fleet: _Fleet) -> float | None:

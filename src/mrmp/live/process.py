@@ -203,25 +203,34 @@ def _wait_for_peers(transport: ConnectedTransport, count: int, stop: threading.E
             return
 
 
-def run_referee(scenario: Scenario, results: Path, start_time: float, done_file: Path, report: Callable[[str], None]) -> list:
+def run_referee(
+    scenario: Scenario, results: Path, start_time: float | None, done_file: Path | None, report: Callable[[str], None]
+) -> list:
     """Follow the fleet's traces until ``done_file`` appears (or a signal, or the end of its parent), reporting collisions.
 
-    Writes ``referee.json``: the collisions and every robot's ground-truth
-    intervals. Returns the collisions.
+    Without a ``done_file``, judge the traces as they are and stop. Without a
+    ``start_time``, the run starts at the traces' first event (or now, when
+    there is none). Writes ``referee.json``: the collisions and every robot's
+    ground-truth intervals. Returns the collisions.
     """
     stop = threading.Event()
     _on_stop_signals(stop.set)
     watch_parent(stop.set)
     ids, starts = [robot.id for robot in scenario.robots], [robot.start for robot in scenario.robots]
-    referee = IntervalReferee(scenario.grid, ids, starts, start_time)
     readers = [TraceReader(results / f"trace-{index}.jsonl") for index in range(len(scenario.robots))]
+    pending = [event for reader in readers for event in reader.read_new()]
+    if start_time is None:
+        start_time = min((t for *_, t in pending), default=time.monotonic())
+    referee = IntervalReferee(scenario.grid, ids, starts, start_time)
     reported = 0
     finishing = False
     while True:
-        finishing = finishing or stop.is_set() or done_file.exists()
+        finishing = finishing or stop.is_set() or done_file is None or done_file.exists()
         for reader in readers:
-            for robot, event, cell, t in reader.read_new():
-                referee.feed(robot, event, cell, t)
+            pending.extend(reader.read_new())
+        for robot, event, cell, t in pending:
+            referee.feed(robot, event, cell, t)
+        pending = []
         collisions = referee.collisions()
         for collision in collisions[reported:]:
             report(f"referee: {collision.describe()} (tick = milliseconds since the start)")

@@ -1,6 +1,8 @@
-"""A one-line progress report of a simulation on a terminal: ticks, arrivals, collisions, elapsed time.
+"""A one-line progress report on a terminal: of a simulation (ticks, arrivals, collisions, elapsed) or a live run.
 
-:class:`ProgressLine` is a simulator's ``on_tick`` observer. On a terminal it
+:class:`ProgressLine` is a simulator's ``on_tick`` observer; :class:`LiveProgressLine`
+shows a live run's progress (robots arrived, messages, faults injected, elapsed)
+as its launcher reports it. On a terminal it
 keeps one line up to date (at most a few times per second, so a fast run is
 not slowed by its own report) and clears it when the run ends; elsewhere
 (a pipe, a file, ``--json -``) it prints nothing.
@@ -28,6 +30,7 @@ from rich.live import Live
 from rich.text import Text
 
 from mrmp.core.cell import Cell
+from mrmp.core.progress import LiveProgress
 from mrmp.core.scenario import Scenario
 
 REFRESH_S = 0.25
@@ -90,6 +93,40 @@ class ProgressLine:
         elapsed = time.monotonic() - self.started
         arrivals = "" if self.goals is None else f"{self.arrived} of {self.robots} robots on their goals, "
         return f"{ticks}: {arrivals}{collisions}, {elapsed:.0f} s"
+
+
+class LiveProgressLine:
+    """A live run's progress on one terminal line, redrawn as the launcher reports it; nothing elsewhere.
+
+    >>> from io import StringIO
+    >>> with LiveProgressLine(Console(file=StringIO())) as line:
+    ...     line.on_progress(LiveProgress(robots=2, arrived=1, messages=12, elapsed_s=0.5))
+    >>> line.shown
+    '0.5 s: 1 of 2 robots arrived, 12 messages'
+    """
+
+    def __init__(self, console: Console) -> None:
+        self.console = console
+        self.live: Live | None = None
+        self.shown = ""
+
+    def __enter__(self) -> LiveProgressLine:
+        if self.console.is_terminal:
+            self.live = Live(Text(""), console=self.console, auto_refresh=False, transient=True)
+            self.live.__enter__()
+        return self
+
+    def __exit__(
+        self, kind: type[BaseException] | None, error: BaseException | None, trace: TracebackType | None
+    ) -> None:
+        if self.live is not None:
+            self.live.__exit__(kind, error, trace)
+
+    def on_progress(self, progress: LiveProgress) -> None:
+        """Show ``progress`` (on a terminal)."""
+        self.shown = progress.text()
+        if self.live is not None:
+            self.live.update(Text(self.shown), refresh=True)
 
 
 def _vertex_collisions(cells: Sequence[Cell]) -> int:

@@ -40,3 +40,24 @@ def test_a_pipe_sees_no_progress_line() -> None:
     finished = subprocess.run(COMMAND, capture_output=True, text=True, check=False)
     assert finished.returncode == 0 and "success" in finished.stdout
     assert "robots on their goals" not in finished.stdout + finished.stderr
+
+
+LIVE = [sys.executable, "-m", "mrmp", "run", str(ROOT / "examples" / "thesis-swap.yaml"), "--live", "--time-scale", "10"]
+
+
+def test_a_terminal_sees_the_live_progress_line(tmp_path: Path) -> None:
+    parent, child = pty.openpty()
+    command = [*LIVE, "--results", str(tmp_path), "--loss", "0.2"]
+    process = subprocess.Popen(command, stdin=child, stdout=child, stderr=child, env={**os.environ, "COLUMNS": "120"})
+    os.close(child)
+    output = _read_all(parent).decode("utf-8", "replace")
+    os.close(parent)
+    assert process.wait() == 0, output
+    assert "0 of 2 robots arrived, 0 messages" in output  # the first report, before any robot has written its own
+    assert " s: " in output and "of 2 robots arrived" in output and "success" in output
+
+
+def test_a_pipe_sees_no_live_progress_line(tmp_path: Path) -> None:
+    finished = subprocess.run([*LIVE, "--results", str(tmp_path)], capture_output=True, text=True, check=False)
+    assert finished.returncode == 0 and "success" in finished.stdout
+    assert "robots arrived" not in finished.stdout + finished.stderr
