@@ -204,8 +204,8 @@ def _one_of_sequencings(value: object) -> str | None:
 def sequencing_setting() -> Any:
     """``sequencing``: who orders ``pibt``'s calls, ``driver`` (the simulator) or ``local`` (the robots themselves)."""
     return setting(
-        "driver", help=f"pibt: who orders the robots' calls, {'|'.join(SEQUENCINGS)} (the simulator, or the robots).",
-        yaml_key="sequencing", flag="--sequencing", check=_one_of_sequencings,
+        "driver", help="pibt: who orders the robots' calls: driver (the simulator) or local (the robots themselves).",
+        yaml_key="sequencing", flag="--sequencing", check=_one_of_sequencings, choices=SEQUENCINGS,
     )  # fmt: skip
 
 
