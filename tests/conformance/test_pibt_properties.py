@@ -9,7 +9,8 @@
   walks robots away from their goals) is off: the theorem covers plain PIBT.
 * With ``heading_aware`` (turns cost time), the same holds in the heading-aware cost:
   within ``D * N`` steps, ``D`` the largest heading-aware cost to a goal.
-* On random maps of any shape, with the swap technique, it never collides.
+* On random maps of any shape, with the swap technique, it never collides; with the
+  robots ordering their calls themselves (``sequencing: local``) too.
 """
 
 import math
@@ -22,6 +23,7 @@ from map_strategies import FAULTS, any_worlds, biconnected_worlds, free_graph
 from reaching import assert_every_robot_reaches_its_goal
 
 from mrmp.core import PolicyOptions, Scenario, Timing
+from mrmp.sim.local_rounds import LocalRoundsSimulator
 from mrmp.sim.rounds import RoundsSimulator
 
 
@@ -70,5 +72,18 @@ def test_never_collides_on_any_map(world, faults, seed, radius):
     scenario = Scenario(grid, robots, network=faults, policy=PolicyOptions(name="pibt", radius=radius), seed=seed)
     simulator = RoundsSimulator(scenario.with_changes(max_ticks=10**9))
     for _ in range(40):
+        simulator.step()
+    assert simulator.referee.collisions == []
+
+
+@settings(max_examples=60, derandomize=True, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(world=any_worlds(), faults=FAULTS, seed=st.integers(0, 1000), radius=st.integers(2, 4))
+def test_local_sequencing_never_collides_on_any_map(world, faults, seed, radius):
+    """With the robots ordering their calls themselves, over the same faulty networks (a lost message is lost)."""
+    grid, robots = world
+    policy = PolicyOptions(name="pibt", radius=radius, sequencing="local")
+    scenario = Scenario(grid, robots, network=faults, policy=policy, seed=seed, max_ticks=10**9)
+    simulator = LocalRoundsSimulator(scenario)
+    for _ in range(25):
         simulator.step()
     assert simulator.referee.collisions == []

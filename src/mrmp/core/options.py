@@ -45,6 +45,10 @@ SEARCH_NAMES = ("update-coordinate", "dijkstra", "best-first", "astar")
 :data:`mrmp.search.choices.SEARCH_TABLE`): the thesis's update coordinate method
 (sections 3.1-3.2) and the three searches of its chapter 1 and future work 1."""
 
+SEQUENCINGS = ("driver", "local")
+"""Who orders ``pibt``'s calls: the simulator, in priority order (:mod:`mrmp.sim.rounds`), or the robots
+themselves, by messages among neighbours (:mod:`mrmp.sim.local_rounds`)."""
+
 POLICY_DEFAULT_SEARCH = "default"
 """The ``search`` value that leaves each policy its own search (``thesis``: update-coordinate, ``astar``: A*)."""
 
@@ -110,7 +114,7 @@ def setting_types(options_type: type) -> dict[str, type]:
 
     >>> from mrmp.core.scenario import PolicyOptions
     >>> {name: kind.__name__ for name, kind in setting_types(PolicyOptions).items()}
-    {'resolve': 'str', 'heading_aware': 'bool', 'radius': 'int', 'swap': 'bool', 'search': 'str'}
+    {'resolve': 'str', 'heading_aware': 'bool', 'radius': 'int', 'swap': 'bool', 'search': 'str', 'sequencing': 'str'}
     """
     hints = typing.get_type_hints(options_type)
     return {field.name: hints[field.name] for field, _ in settings(options_type)}
@@ -191,6 +195,18 @@ def search_setting() -> Any:
         "(thesis: update-coordinate, astar: astar).",
         yaml_key="search", flag="--search", check=_one_of_searches, choices=(POLICY_DEFAULT_SEARCH, *SEARCH_NAMES),
     )
+
+
+def _one_of_sequencings(value: object) -> str | None:
+    return None if value in SEQUENCINGS else f"must be one of {', '.join(SEQUENCINGS)}, got {value!r}"
+
+
+def sequencing_setting() -> Any:
+    """``sequencing``: who orders ``pibt``'s calls, ``driver`` (the simulator) or ``local`` (the robots themselves)."""
+    return setting(
+        "driver", help="pibt: who orders the robots' calls: driver (the simulator) or local (the robots themselves).",
+        yaml_key="sequencing", flag="--sequencing", check=_one_of_sequencings, choices=SEQUENCINGS,
+    )  # fmt: skip
 
 
 def swap_setting() -> Any:

@@ -34,6 +34,7 @@ from mrmp.core.options import (
     radius_setting,
     resolve_setting,
     search_setting,
+    sequencing_setting,
     swap_setting,
 )
 
@@ -127,6 +128,7 @@ class PolicyOptions:
     radius: int = radius_setting()
     swap: bool = swap_setting()
     search: str = search_setting()
+    sequencing: str = sequencing_setting()
 
     def __post_init__(self) -> None:
         check_settings(self)

@@ -988,8 +988,9 @@ def _setting_text(value: object) -> str:
 def _policy_text(policy: PolicyOptions) -> str:
     """The ``policy`` section's items: its name, then every setting by its YAML key.
 
-    >>> _policy_text(PolicyOptions())
-    'name: "thesis", resolve: "divert", heading_aware: false, radius: 2, swap: true, search: "default"'
+    >>> _policy_text(PolicyOptions())  # doctest: +NORMALIZE_WHITESPACE
+    'name: "thesis", resolve: "divert", heading_aware: false, radius: 2, swap: true, search: "default",
+     sequencing: "driver"'
     """
     items = [f"name: {_quote(policy.name)}"]
     items += [f"{setting.yaml_key}: {_setting_text(getattr(policy, option.name))}" for option, setting in POLICY_SETTINGS]

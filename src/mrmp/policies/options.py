@@ -28,6 +28,7 @@ from mrmp.core.options import (
     radius_setting,
     resolve_setting,
     search_setting,
+    sequencing_setting,
     swap_setting,
 )
 from mrmp.core.scenario import PolicyOptions
@@ -60,11 +61,12 @@ class AstarOptions:
 
 @dataclass(frozen=True)
 class PibtOptions:
-    """PIBT by messages (:class:`~mrmp.robot.pibt_robot.PibtRobot`): turn-aware order, beacon radius, swap."""
+    """PIBT by messages (:class:`~mrmp.robot.pibt_robot.PibtRobot`): turn-aware order, beacon radius, swap, who sequences."""
 
     heading_aware: bool = heading_aware_setting()
     radius: int = radius_setting()
     swap: bool = swap_setting()
+    sequencing: str = sequencing_setting()
 
     def __post_init__(self) -> None:
         check_settings(self)

@@ -28,7 +28,7 @@ Examples
 >>> policy_names()
 ('thesis', 'astar', 'pibt', 'causal')
 >>> policy_entry("pibt").simulator.__name__, policy_entry("pibt").live_driver
-('RoundsSimulator', None)
+('pibt_simulator', None)
 >>> make_policy(PolicyOptions(name="thesis", resolve="wait")).resolve
 'wait'
 """
@@ -52,6 +52,7 @@ from mrmp.robot.pibt_robot import PibtRobot
 from mrmp.robot.robot import Robot
 from mrmp.search.choices import chosen_search
 from mrmp.sim.asynchronous import AsynchronousSimulator
+from mrmp.sim.local_rounds import LocalRoundsSimulator
 from mrmp.sim.rounds import RoundsSimulator
 from mrmp.sim.ticking import TickObserver
 
@@ -145,6 +146,18 @@ class PolicyEntry:
         return self.simulator(scenario, on_tick=on_tick)
 
 
+def pibt_simulator(scenario: Scenario, on_tick: TickObserver | None = None) -> RoundsSimulator:
+    """Policy ``pibt``'s simulator: the robots' calls ordered by the driver, or by the robots (``sequencing``).
+
+    >>> from mrmp.core import Grid, RobotSpec
+    >>> robots = (RobotSpec("A", (0, 0), (2, 0)),)
+    >>> type(pibt_simulator(Scenario(Grid(3, 1), robots, policy=PolicyOptions(name="pibt", sequencing="local")))).__name__
+    'LocalRoundsSimulator'
+    """
+    if options_from(PibtOptions, scenario.policy).sequencing == "local":
+        return LocalRoundsSimulator(scenario, on_tick=on_tick)
+    return RoundsSimulator(scenario, on_tick=on_tick)
+
 POLICY_TABLE: dict[str, PolicyEntry] = {
     "thesis": PolicyEntry(
         "thesis",
@@ -173,7 +186,7 @@ POLICY_TABLE: dict[str, PolicyEntry] = {
         "pibt",
         PibtOptions,
         PibtRobot,
-        simulator=RoundsSimulator,
+        simulator=pibt_simulator,
         runs="runs in synchronous rounds (mrmp.sim.rounds)",
         not_live="runs in the simulator's synchronous rounds only; its live, asynchronous form is --policy causal",
     ),

@@ -104,6 +104,9 @@ class RoundsSimulator:
         None turns them on with ``random_ties``.
     """
 
+    robot_type: type[PibtRobot] = PibtRobot
+    """The brain every robot runs."""
+
     def __init__(
         self,
         scenario: Scenario,
@@ -123,7 +126,7 @@ class RoundsSimulator:
             start = flat.index(spec.start)
             distance = flat.distances(goal)[start]
             self.robots.append(
-                PibtRobot(
+                self.robot_type(
                     index,
                     start,
                     goal,

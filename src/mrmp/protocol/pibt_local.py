@@ -1,0 +1,153 @@
+"""The messages of PIBT sequenced by the robots themselves (``pibt`` with local sequencing).
+
+:class:`~mrmp.robot.pibt_local.LocalPibtRobot` runs several PIBT calls at
+once, one per *root* (a robot that starts a call on its own), so its
+reservations and inheritance requests say which call they belong to and with
+what priority: the root's index and priority ``(elapsed, tie)``. A reservation
+is first *provisional*, then *final* (the robot will not change its mind this
+step). Beacons, answers and pulls are those of :mod:`mrmp.protocol.messages`.
+
+Over a network that loses messages every message but an acknowledgement is
+acknowledged (:class:`CallAckMessage`), and the acknowledgement carries the
+acknowledging robot's own reservation, so that two calls claiming one cell
+hear of it before either claim is confirmed.
+
+Registered in the message table (:mod:`mrmp.protocol.wire`) under codes 40 to 42.
+
+Examples
+--------
+>>> from mrmp.protocol.codec import decode, encode
+>>> claim = CallReserveMessage(3, 9, 12, (4, 5), root=7, root_elapsed=2, root_tie=30, final=True)
+>>> decode(encode(claim)) == claim, len(encode(claim))
+(True, 35)
+>>> decode(encode(CallInheritMessage(3, 10, 12, (4, 6), 7, 2, 30))).root
+7
+>>> decode(encode(CallAckMessage(4, 1, 12, 9, NO_CLAIM, 0, 0, 0))).claim
+(-1, -1)
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+from mrmp.core.cell import Cell
+from mrmp.protocol import formats  # noqa: F401  (the project's own types first, so codes never clash silently)
+from mrmp.protocol.messages import PibtMessage
+from mrmp.protocol.wire import DecodeError, WireFormat, register
+
+__all__ = ["NO_CLAIM", "CallAckMessage", "CallInheritMessage", "CallReserveMessage"]
+
+NO_CLAIM = (-1, -1)
+"""The ``claim`` of an acknowledgement from a robot that holds no reservation."""
+
+
+@dataclass(frozen=True, slots=True)
+class CallReserveMessage(PibtMessage):
+    """The sender reserved ``cell`` for the end of step ``step`` within the PIBT call of robot ``root``.
+
+    ``final``: the sender has decided and will not change its mind this step
+    (otherwise the reservation is provisional: it may be withdrawn when a call
+    of higher priority reserved the same cell in the same round, or replaced
+    after backtracking).
+    """
+
+    sender: int
+    seq: int
+    step: int
+    cell: Cell
+    root: int
+    root_elapsed: int
+    root_tie: int
+    final: bool = False
+
+    @property
+    def rank(self) -> tuple[int, int, int]:
+        """The priority of the call: ``(elapsed, tie, -root)``, larger first."""
+        return (self.root_elapsed, self.root_tie, -self.root)
+
+
+@dataclass(frozen=True, slots=True)
+class CallInheritMessage(PibtMessage):
+    """Priority inheritance within the call of ``root``: the sender reserved ``cell``, the recipient's cell."""
+
+    sender: int
+    seq: int
+    step: int
+    cell: Cell
+    root: int
+    root_elapsed: int
+    root_tie: int
+
+    @property
+    def rank(self) -> tuple[int, int, int]:
+        """The priority of the call: ``(elapsed, tie, -root)``, larger first."""
+        return (self.root_elapsed, self.root_tie, -self.root)
+
+
+@dataclass(frozen=True, slots=True)
+class CallAckMessage(PibtMessage):
+    """The sender received message ``acked`` (a sequence number) of this step; it holds reservation ``claim``.
+
+    ``claim`` is :data:`NO_CLAIM` when the sender holds none; otherwise the
+    claim belongs to the call of ``root`` with priority ``(root_elapsed, root_tie)``,
+    and ``settled`` says whether it is no longer provisional.
+    """
+
+    sender: int
+    seq: int
+    step: int
+    acked: int
+    claim: Cell
+    root: int
+    root_elapsed: int
+    root_tie: int
+    settled: bool = False
+
+    @property
+    def rank(self) -> tuple[int, int, int]:
+        """The priority of the call of the claim: ``(elapsed, tie, -root)``, larger first."""
+        return (self.root_elapsed, self.root_tie, -self.root)
+
+
+def _unpack_reserve(sender: int, seq: int, fields: Any, _: tuple[Cell, ...]) -> CallReserveMessage:
+    step, x, y, root, elapsed, tie, final = fields
+    if final > 1:
+        raise DecodeError("malformed", f"reservation with final={final}")
+    return CallReserveMessage(sender, seq, step, (x, y), root, elapsed, tie, bool(final))
+
+
+def _unpack_ack(sender: int, seq: int, fields: Any, _: tuple[Cell, ...]) -> CallAckMessage:
+    step, acked, x, y, root, elapsed, tie, settled = fields
+    if settled > 1:
+        raise DecodeError("malformed", f"acknowledgement with settled={settled}")
+    return CallAckMessage(sender, seq, step, acked, (x, y), root, elapsed, tie, bool(settled))
+
+
+CALL_RESERVE = register(
+    WireFormat(
+        40,
+        CallReserveMessage,
+        "!IiiIIIB",
+        lambda m: (m.step, *m.cell, m.root, m.root_elapsed, m.root_tie, int(m.final)),
+        _unpack_reserve,
+    )
+)
+CALL_INHERIT = register(
+    WireFormat(
+        41,
+        CallInheritMessage,
+        "!IiiIII",
+        lambda m: (m.step, *m.cell, m.root, m.root_elapsed, m.root_tie),
+        lambda sender, seq, f, _: CallInheritMessage(sender, seq, f[0], (f[1], f[2]), f[3], f[4], f[5]),
+    )
+)
+CALL_ACK = register(
+    WireFormat(
+        42,
+        CallAckMessage,
+        "!IIiiIIIB",
+        lambda m: (m.step, m.acked, *m.claim, m.root, m.root_elapsed, m.root_tie, int(m.settled)),
+        _unpack_ack,
+    )
+)

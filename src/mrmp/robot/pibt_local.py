@@ -1,0 +1,361 @@
+"""PIBT whose calls the robots sequence themselves: the sans-IO brain of ``pibt`` with local sequencing.
+
+:class:`~mrmp.robot.pibt_robot.PibtRobot` decides as central PIBT (Okumura,
+Machida, Défago and Tamura, IJCAI 2019; AIJ 310, 2022) when a driver starts
+the robots one at a time in priority order. :class:`LocalPibtRobot` needs no
+such driver: every robot decides *itself* when its call starts, from what its
+neighbours told it, and several calls run at once in different parts of the
+map. The step runs in synchronous rounds (Lynch, *Distributed Algorithms*,
+1996, ch. 2: every robot takes in what was sent to it in the round before,
+then acts):
+
+1. every robot broadcasts its beacon (cell, goal, priority) to the robots
+   within its radio radius (at least 2 cells);
+2. a robot that has not decided and was not asked to decide *starts its own
+   call* (it becomes a *root*) in the first round in which every robot within
+   its radio radius that has a higher priority has decided for good (its final
+   reservation reaches that far), and no robot within 2 cells is in the middle
+   of a call (it holds a provisional reservation). Everything a call reads
+   lies within 2 cells of the robots it reaches, and a call reaches robots
+   only through their neighbours, so this is the local form of "the
+   highest-priority robot that has not decided starts" (exactly that when the
+   radius covers the map);
+3. an asked robot (priority inheritance, :class:`CallInheritMessage`) decides
+   at once, within the call of the robot that asked (its *root*), as in PIBT;
+4. a reservation (:class:`CallReserveMessage`, to every robot within 2
+   cells) is *provisional* for one round: two calls can reserve the same cell
+   only in the same round (a robot that reserves a cell has heard every
+   earlier reservation of it, since both reservers stand next to the cell and
+   so within 2 cells of each other). In the next round both hear of it; the
+   call of lower priority withdraws and tries its next cell; staying on one's
+   own cell always wins (whoever reserved it asked its occupant, who refuses).
+   A robot that has decided and whose reservation survived its round says so:
+   the same reservation, marked *final*, and the answer to its parent;
+5. a robot treats the cell of a neighbour as free to take only when that
+   neighbour's reservation elsewhere is final, or the neighbour is in the same
+   call (PIBT's rotations); a neighbour busy in another call is passed by;
+6. at the end of the step a robot moves if it has decided *finally*; one that
+   has not (it did not finish in time) stays and counts an abandoned step.
+
+Counted by the robot itself (:attr:`LocalPibtRobot.stats`): ``waits`` (rounds
+in which it could not start yet), ``withdrawn`` (reservations lost to a call
+of higher priority), ``refused`` (requests refused because it was busy),
+``passed_busy`` (cells passed by because their occupant was busy in another
+call) and ``abandoned`` (steps it ended undecided).
+
+Examples
+--------
+Two robots in a corridor ``0-1-2`` with a bay above cell 1 (as in
+:mod:`mrmp.robot.pibt_robot`): nobody tells robot 0 to start; it starts
+because nobody within 2 cells outranks it, while robot 1 waits for it.
+
+>>> from mrmp.core.grid import Grid
+>>> from mrmp.search.flat_map import FlatMap
+>>> flat = FlatMap(Grid.from_rows(["#.#", "..."]))
+>>> a = LocalPibtRobot(0, flat.index((0, 0)), flat.index((0, 2)), flat, tie=2)
+>>> b = LocalPibtRobot(1, flat.index((0, 1)), flat.index((0, 0)), flat, tie=1)
+>>> robots = {0: a, 1: b}
+>>> sent = [(robot.index, item) for robot in (a, b) for item in robot.begin_step(1)]
+>>> rounds = 0
+>>> while sent or any(robot.wake for robot in (a, b)):
+...     rounds += 1
+...     for sender, item in sent:
+...         _ = robots[1 - sender].receive(item.message)
+...     sent = [(robot.index, item) for robot in (a, b) for item in robot.act()]
+>>> [flat.cell(robot.finish_step()) for robot in (a, b)], rounds, b.stats["waits"]
+([(0, 1), (1, 1)], 5, 1)
+"""
+
+from __future__ import annotations
+
+import random
+from collections import Counter
+
+from mrmp.core.heading import Heading
+from mrmp.protocol.messages import AnswerMessage, BeaconMessage, Message, PullMessage
+from mrmp.protocol.pibt_local import CallInheritMessage, CallReserveMessage
+from mrmp.robot.messaging import Handlers, Outgoing
+from mrmp.robot.pibt_robot import MIN_RADIUS, RESERVE_RADIUS, PibtRobot
+from mrmp.search.flat_map import FlatMap
+
+__all__ = ["LocalPibtRobot"]
+
+Rank = tuple[int, int, int]
+"""A priority ``(elapsed, tie, -index)``: larger goes first."""
+
+
+class LocalPibtRobot(PibtRobot):
+    """One robot's PIBT brain that decides itself when its call starts (module docstring).
+
+    Parameters are those of :class:`~mrmp.robot.pibt_robot.PibtRobot`.
+    After :meth:`begin_step` and after every :meth:`act`, :attr:`wake` says
+    whether the robot wants to act in the next round even if nothing reaches
+    it (a timer of one round: its provisional reservation becomes final then).
+    """
+
+    def __init__(
+        self,
+        index: int,
+        start: int,
+        goal: int,
+        flat: FlatMap,
+        *,
+        tie: int = 0,
+        heading: Heading = Heading.NORTH,
+        radius: int = MIN_RADIUS,
+        swap: bool = True,
+        heading_aware: bool = False,
+        turn_cost: float = 0.5,
+        rng: random.Random | None = None,
+        tie_penalties: bool | None = None,
+    ) -> None:
+        super().__init__(
+            index, start, goal, flat, tie=tie, heading=heading, radius=radius, swap=swap,
+            heading_aware=heading_aware, turn_cost=turn_cost, rng=rng, tie_penalties=tie_penalties,
+        )  # fmt: skip
+        self.stats: Counter[str] = Counter()
+        self.wake = False
+        self._ranks: dict[int, Rank] = {}
+        self._near: list[int] = []
+        self._final: set[int] = set()
+        self._calls: dict[int, int] = {}  # robot -> root of the call its provisional reservation belongs to
+        self._claims: dict[int, Rank] = {}  # robot -> rank of the call of its latest reservation
+        self._root = index
+        self._rank: Rank = self.priority
+        self._confirmed = True
+        self._finishing: bool | None = None
+        self._lost = False
+        self._done = False
+
+    # -- the step ------------------------------------------------------------------
+
+    def begin_step(self, step: int) -> list[Outgoing]:
+        """Start step ``step``: forget the last step's view, announce cell, goal and priority; act next round."""
+        out = super().begin_step(step)
+        self._ranks = {}
+        self._near = []
+        self._final = set()
+        self._calls = {}
+        self._claims = {}
+        self._root, self._rank = self.index, self.priority
+        self._confirmed, self._finishing, self._lost, self._done = True, None, False, False
+        self.wake = True  # evaluate the start rule once the beacons are in
+        return out
+
+    @property
+    def final(self) -> bool:
+        """Whether the robot has decided for good this step (it moves at the step's end)."""
+        return self._done
+
+    def receive_once(self, message: Message) -> bool:
+        """Take in one message (see :meth:`PibtRobot.receive`); True when the robot should act on it this round."""
+        inform = self.informing.get(message)
+        if inform is not None:
+            return bool(inform(self, message))
+        self._control.append(message)
+        return True
+
+    def receive_beacons(self, beacons: list[BeaconMessage]) -> None:
+        """Take in beacons: cells, goals and priorities; note the robots within 2 cells."""
+        super().receive_beacons(beacons)
+        x, y = self.flat.cells[self.present]
+        for message in beacons:
+            self._ranks[message.sender] = (message.elapsed, message.tie, -message.sender)
+            px, py = message.present
+            if abs(px - x) + abs(py - y) <= self.radius:
+                self._near.append(message.sender)
+
+    rotations = True
+    """Take the cell of a robot busy in the robot's own call (PIBT's rotations): safe when every call ends in its step."""
+
+    informing = Handlers()
+
+    @informing.on(BeaconMessage)
+    def _take_beacon_local(self, message: BeaconMessage) -> bool:
+        self.receive_beacons([message])
+        return False
+
+    @informing.on(CallReserveMessage)
+    def _take_call_reservation(self, message: CallReserveMessage) -> bool:
+        sender = message.sender
+        cell = self.flat.index(message.cell)
+        reserved, targets = self._reserved, self._targets
+        old = targets.get(sender)
+        if old is not None and old != cell and reserved.get(old) == sender:
+            del reserved[old]  # a reservation replaced (after a lost conflict or backtracking)
+        targets[sender] = cell
+        self._claims[sender] = message.rank
+        if message.final:
+            self._final.add(sender)
+            self._calls.pop(sender, None)
+        else:
+            self._calls[sender] = message.root
+        if cell == self.target and not self._confirmed and sender != self.index:
+            if cell != self.present and (message.final or message.rank > self._rank):
+                self._lost = True  # a call of higher priority reserved it in the same round: withdraw
+                reserved[cell] = sender
+            else:
+                reserved[cell] = self.index
+            return True
+        holder = reserved.get(cell)
+        if holder is None or holder == sender or targets.get(holder) != cell or self._outranks(sender, holder, cell):
+            reserved[cell] = sender  # two claims of one cell in one round: the winner holds it, as the robots decide
+        return self.target is None  # a robot waiting to start reconsiders
+
+    def _outranks(self, claimant: int, holder: int, cell: int) -> bool:
+        """Whether ``claimant``'s claim of ``cell`` beats ``holder``'s: staying on one's cell first, then the call's rank."""
+        occupant = self._occupants.get(cell)
+        if (occupant == claimant) != (occupant == holder):
+            return occupant == claimant
+        return self._claims.get(claimant, (0, 0, 0)) > self._claims.get(holder, (0, 0, 0))
+
+    # -- acting --------------------------------------------------------------------
+
+    def act(self) -> list[Outgoing]:
+        """Act on this round: settle the last round's reservation, take requests and answers, maybe start."""
+        out: list[Outgoing] = []
+        self.wake = False
+        if self._lost:
+            self._lost = False
+            self.stats["withdrawn"] += 1
+            self._waiting = None  # the pushed robot answers the winner; a late answer to us is dropped
+            self._finishing = None
+            self.target = None
+            self._next += 1
+            self._continue(out)
+        elif not self._confirmed and self._may_confirm():
+            self._confirmed = True
+            if self._finishing is not None:
+                moved, self._finishing = self._finishing, None
+                self._finalize(moved, out)
+        if self._control:
+            control, self._control = self._control, []
+            inherits = sorted(
+                (message for message in control if isinstance(message, CallInheritMessage)),
+                key=lambda message: message.rank,
+                reverse=True,
+            )
+            for inherit in inherits:
+                self._take_inherit_local(inherit, out)
+            for message in control:
+                if isinstance(message, AnswerMessage):
+                    self._take_answer(message, out)
+                elif isinstance(message, PullMessage):
+                    self._take_pull_local(message, out)
+        if self.target is None and self._parent is None:
+            if self._may_start():
+                self._root, self._rank = self.index, self.priority
+                self._begin_call(out)
+            else:
+                self.stats["waits"] += 1
+        return out
+
+    def _may_confirm(self) -> bool:
+        """Whether the provisional reservation has survived: in synchronous rounds, one round has passed."""
+        return True
+
+    def _may_start(self) -> bool:
+        """Every robot within 2 cells of higher priority has decided, and none is in the middle of a call."""
+        mine = self.priority
+        final, targets, ranks = self._final, self._targets, self._ranks
+        for other in self._near:
+            if other in final:
+                continue
+            if other in targets or ranks[other] > mine:
+                return False
+        return True
+
+    def start(self) -> list[Outgoing]:
+        """Not used: the robot starts by itself in :meth:`act` (kept for the driver interface)."""
+        return []
+
+    def _take_inherit_local(self, message: CallInheritMessage, out: list[Outgoing]) -> None:
+        if self.target is not None or self._parent is not None:
+            self.stats["refused"] += 1  # busy in a call already: the asker tries its next cell
+            out.append(Outgoing(AnswerMessage(self.index, self._seq(), self.step, False), (message.sender,)))
+            return
+        self._reserved[self.present] = message.sender
+        self._targets[message.sender] = self.present
+        self._parent = message.sender
+        self._root, self._rank = message.root, message.rank
+        self._begin_call(out)
+
+    def _take_pull_local(self, message: PullMessage, out: list[Outgoing]) -> None:
+        cell = self.flat.index(message.cell)
+        if self.target is None and self._parent is None and cell not in self._reserved:
+            self._root, self._rank = self.index, self.priority
+            self._candidates, self._next, self._pulled = [cell], 0, None
+            self._continue(out)
+
+    def finish_step(self) -> int:
+        """Move to the reserved cell if decided for good, else stay (an abandoned step); return the cell."""
+        if not self._done:
+            self.stats["abandoned"] += 1
+            self.target = None
+        return super().finish_step()
+
+    # -- PIBT's call, by messages -------------------------------------------------------
+
+    def _reserve(self, cell: int, out: list[Outgoing], final: bool = False) -> None:
+        self.target = cell
+        self._reserved[cell] = self.index
+        self._targets[self.index] = cell
+        self._claims[self.index] = self._rank
+        self._confirmed = final
+        if not final:
+            self.wake = True
+        self.seq += 1
+        root, (elapsed, tie, _) = self._root, self._rank
+        message = CallReserveMessage(self.index, self.seq, self.step, self.flat.cells[cell], root, elapsed, tie, final)
+        out.append(Outgoing(message, None, self.radius if final else RESERVE_RADIUS))
+
+    def _continue(self, out: list[Outgoing]) -> None:
+        here = self.present
+        reserved, occupants, targets, final = self._reserved, self._occupants, self._targets, self._final
+        candidates = self._candidates
+        while self._next < len(candidates):
+            cell = candidates[self._next]
+            if cell in reserved:
+                self._next += 1
+                continue
+            occupant = occupants.get(cell)
+            if occupant is None or occupant == self.index or occupant in final:
+                if occupant is not None and targets.get(occupant) == here:
+                    self._next += 1  # would swap
+                    continue
+                self._reserve(cell, out)
+                self._finish(True, out)
+                return
+            target = targets.get(occupant)
+            if target == here:
+                self._next += 1  # the occupant moves into our cell: taking its cell would swap
+                continue
+            if target is not None:
+                if self.rotations and self._calls.get(occupant) == self._root:
+                    self._reserve(cell, out)  # a robot of our own call leaves it (a rotation, as in PIBT)
+                    self._finish(True, out)
+                    return
+                self.stats["passed_busy"] += 1  # busy in another call: it may yet stay
+                self._next += 1
+                continue
+            self._reserve(cell, out)
+            self._waiting = occupant  # priority inheritance
+            root, (elapsed, tie, _) = self._root, self._rank
+            inherit = CallInheritMessage(self.index, self._seq(), self.step, self.flat.cells[cell], root, elapsed, tie)
+            out.append(Outgoing(inherit, (occupant,)))
+            return
+        self._reserve(here, out)  # no candidate left: stay
+        self._finish(False, out)
+
+    def _finish(self, moved: bool, out: list[Outgoing]) -> None:
+        if self._confirmed:
+            self._finalize(moved, out)
+        else:
+            self._finishing = moved  # final once the reservation has survived its round
+
+    def _finalize(self, moved: bool, out: list[Outgoing]) -> None:
+        self._done = True
+        self._final.add(self.index)
+        assert self.target is not None
+        self._reserve(self.target, out, final=True)
+        super()._finish(moved, out)

@@ -1,0 +1,281 @@
+"""Locally sequenced PIBT over a network that loses, delays, duplicates and reorders: acknowledgements and timers.
+
+:class:`~mrmp.robot.pibt_local.LocalPibtRobot` rests on synchronous rounds:
+what is sent in a round arrives in the next. :class:`ReliablePibtRobot` keeps
+its rules and replaces that assumption by acknowledgements, in the manner of
+Awerbuch's α synchronizer (B. Awerbuch, "Complexity of network
+synchronization", J. ACM 32(4), 1985: a node moves on when every neighbour has
+acknowledged its messages):
+
+* every message but an acknowledgement is acknowledged by its recipient
+  (:class:`~mrmp.protocol.pibt_local.CallAckMessage`), second copies too, and
+  sent again every ``retry`` ticks to the recipients that have not
+  acknowledged it (the robot's own timers: :meth:`ReliablePibtRobot.on_tick`,
+  time passed in);
+* the robot's sensor tells it which cells within 2 hold a body
+  (:meth:`ReliablePibtRobot.begin_step`'s ``sensed``): until it has the beacon
+  of each, it neither starts a call nor takes part in one (it could take a cell
+  it believes empty), and it sends its beacon again until each has
+  acknowledged it;
+* a provisional reservation becomes final once every robot within 2 cells has
+  acknowledged it (instead of "after one round"). An acknowledgement carries
+  its sender's own reservation: of two calls claiming one cell, each either
+  heard the other's claim before claiming (and passed the cell by) or receives
+  it in the acknowledgement of its own claim, before confirming; the call of
+  lower priority withdraws, as in synchronous rounds;
+* a call never takes the cell of a robot busy in the same call (no
+  rotations): a step can end before such a call has finished, and the robot
+  whose cell was taken would then stay.
+
+The step ends at a tick the driver's clock fixes for everyone; a robot that
+has decided for good moves, any other stays (an abandoned step, counted).
+Every robot moving into a cell knows its occupant decided for good to leave
+(its final reservation or its answer), and decided reservations are unique,
+so the moves are safe whatever was lost. Counted by the robot: ``acks``,
+``retransmissions``, ``stale`` and ``duplicate`` (in ``dropped``), with the
+counts of :class:`~mrmp.robot.pibt_local.LocalPibtRobot`.
+
+Examples
+--------
+Two robots, and a network that loses every other datagram: the timers send
+again what was lost, and both decide.
+
+>>> from mrmp.core.grid import Grid
+>>> from mrmp.search.flat_map import FlatMap
+>>> flat = FlatMap(Grid.from_rows(["#.#", "..."]))
+>>> a = ReliablePibtRobot(0, flat.index((0, 0)), flat.index((0, 2)), flat, tie=2)
+>>> b = ReliablePibtRobot(1, flat.index((0, 1)), flat.index((0, 0)), flat, tie=1)
+>>> robots = (a, b)
+>>> sent = [(0, item) for item in a.begin_step(1, sensed=[b.present])]
+>>> sent += [(1, item) for item in b.begin_step(1, sensed=[a.present])]
+>>> datagrams = 0
+>>> for now in range(1, 20):
+...     for sender, item in sent:
+...         datagrams += 1
+...         if datagrams % 2 == 0:
+...             _ = robots[1 - sender].receive(item.message)
+...     sent = [(robot.index, item) for robot in robots for item in robot.act() + robot.on_tick(now)]
+>>> a.final and b.final, [flat.cell(robot.finish_step()) for robot in robots], a.stats["retransmissions"] > 0
+(True, [(0, 1), (1, 1)], True)
+"""
+
+from __future__ import annotations
+
+import random
+from collections.abc import Iterable
+
+from mrmp.core.heading import Heading
+from mrmp.protocol.messages import BeaconMessage, PibtMessage, PullMessage
+from mrmp.protocol.pibt_local import NO_CLAIM, CallAckMessage, CallInheritMessage, CallReserveMessage
+from mrmp.robot.messaging import Outgoing
+from mrmp.robot.pibt_local import LocalPibtRobot
+from mrmp.robot.pibt_robot import MIN_RADIUS, RESERVE_RADIUS
+from mrmp.search.flat_map import FlatMap
+
+__all__ = ["ReliablePibtRobot"]
+
+
+class _Unacknowledged:
+    """A message sent and not yet acknowledged by every recipient it must reach."""
+
+    __slots__ = ("item", "pending", "sent_at")
+
+    def __init__(self, item: Outgoing, pending: set[int], sent_at: int) -> None:
+        self.item = item
+        self.pending = pending
+        self.sent_at = sent_at
+
+
+class ReliablePibtRobot(LocalPibtRobot):
+    """A :class:`~mrmp.robot.pibt_local.LocalPibtRobot` with acknowledgements and timers (module docstring).
+
+    Parameters are those of :class:`~mrmp.robot.pibt_robot.PibtRobot`, and:
+
+    retry:
+        Ticks to wait for an acknowledgement before sending a message again
+        (at least 1; ``2 * delay_max + 1`` covers a round trip).
+    """
+
+    rotations = False
+
+    def __init__(
+        self,
+        index: int,
+        start: int,
+        goal: int,
+        flat: FlatMap,
+        *,
+        tie: int = 0,
+        heading: Heading = Heading.NORTH,
+        radius: int = MIN_RADIUS,
+        swap: bool = True,
+        heading_aware: bool = False,
+        turn_cost: float = 0.5,
+        rng: random.Random | None = None,
+        tie_penalties: bool | None = None,
+        retry: int = 1,
+    ) -> None:
+        super().__init__(
+            index, start, goal, flat, tie=tie, heading=heading, radius=radius, swap=swap,
+            heading_aware=heading_aware, turn_cost=turn_cost, rng=rng, tie_penalties=tie_penalties,
+        )  # fmt: skip
+        if retry < 1:
+            raise ValueError(f"retry {retry} is below 1 tick")
+        self.retry = retry
+        self._now = 0
+        self._sensed: tuple[int, ...] = ()
+        self._unacknowledged: dict[int, _Unacknowledged] = {}
+        self._beacon_seq = 0
+        self._beacon_sent_at = 0
+        self._beacon_acks: set[int] = set()
+        self._replies: list[Outgoing] = []
+        self._deferred = False
+        self._claim_seq = 0
+        self._latest: dict[int, int] = {}
+
+    # -- the step ------------------------------------------------------------------
+
+    def begin_step(self, step: int, sensed: Iterable[int] = (), now: int = 0) -> list[Outgoing]:
+        """Start step ``step`` at tick ``now``; ``sensed``: the cells within 2 that hold a body (the robot's sensor)."""
+        out = super().begin_step(step)
+        self._now = now
+        self._sensed = tuple(cell for cell in sensed if cell != self.present)
+        self._unacknowledged = {}
+        self._beacon_seq = self.seq
+        self._beacon_sent_at = now
+        self._beacon_acks = set()
+        self._replies = []
+        self._deferred = False
+        self._claim_seq = 0
+        self._latest = {}
+        return out
+
+    def on_tick(self, now: int) -> list[Outgoing]:
+        """The robot's timers at tick ``now``: send again what was not acknowledged within ``retry`` ticks."""
+        self._now = now
+        out: list[Outgoing] = []
+        if not self._beacon_heard() and now - self._beacon_sent_at >= self.retry:
+            self._beacon_sent_at = now
+            self.stats["retransmissions"] += 1
+            out.append(Outgoing(self._beacon(), None, self.radius))
+        for entry in self._unacknowledged.values():
+            if entry.pending and now - entry.sent_at >= self.retry:
+                entry.sent_at = now
+                self.stats["retransmissions"] += len(entry.pending)
+                out.append(Outgoing(entry.item.message, tuple(sorted(entry.pending))))
+        return out
+
+    def _beacon(self) -> BeaconMessage:
+        cells = self.flat.cells
+        return BeaconMessage(
+            self.index, self._beacon_seq, self.step, cells[self.present], cells[self.goal], self.elapsed, self.tie,
+            self.heading,
+        )  # fmt: skip
+
+    def _beacon_heard(self) -> bool:
+        """Every body within 2 cells is a robot whose beacon arrived and who acknowledged ours."""
+        occupants, acks = self._occupants, self._beacon_acks
+        return all(occupants.get(cell) in acks for cell in self._sensed)
+
+    def _complete(self) -> bool:
+        """The robot knows who stands on every cell within 2 that holds a body."""
+        occupants = self._occupants
+        return all(cell in occupants for cell in self._sensed)
+
+    # -- receiving -----------------------------------------------------------------
+
+    def receive(self, message: PibtMessage) -> bool:
+        """Take in a message of this step (acknowledging it, second copies too); True when :meth:`act` should run."""
+        if message.step != self.step:
+            self.dropped["stale"] += 1
+            return False
+        if isinstance(message, CallAckMessage):
+            return self._take_ack(message)
+        claim = self.target
+        cell = self.flat.cells[claim] if claim is not None else NO_CLAIM
+        root, (elapsed, tie, _) = self._root, self._rank
+        self.seq += 1
+        ack = CallAckMessage(self.index, self.seq, self.step, message.seq, cell, root, elapsed, tie, self._confirmed)
+        self._replies.append(Outgoing(ack, (message.sender,)))
+        self.stats["acks"] += 1
+        key = (message.sender, message.seq)
+        if key in self._seen:
+            self.dropped["duplicate"] += 1
+            return True  # the acknowledgement goes out in act
+        self._seen.add(key)
+        if isinstance(message, CallReserveMessage | CallInheritMessage):  # both say what the sender reserved
+            if message.seq < self._latest.get(message.sender, 0):
+                self.dropped["overtaken"] += 1  # a later reservation of the sender arrived first
+                return True
+            self._latest[message.sender] = message.seq
+        self.receive_once(message)
+        return True
+
+    def _take_ack(self, message: CallAckMessage) -> bool:
+        sender = message.sender
+        if message.acked == self._beacon_seq:
+            self._beacon_acks.add(sender)
+        entry = self._unacknowledged.get(message.acked)
+        if entry is not None:
+            entry.pending.discard(sender)
+        if message.claim != NO_CLAIM and not self._confirmed and self.target is not None:
+            cell = self.flat.index(message.claim)
+            if cell == self.target and cell != self.present and sender != self.index:
+                theirs = (message.settled, self._occupants.get(cell) == sender, message.rank)
+                if theirs > (False, False, self._rank):
+                    self._lost = True  # a call of higher priority claims our cell: withdraw
+                    self._reserved[cell] = sender
+        return True
+
+    # -- acting --------------------------------------------------------------------
+
+    def act(self) -> list[Outgoing]:
+        """:meth:`LocalPibtRobot.act`, then the acknowledgements owed; messages to acknowledge are remembered."""
+        out: list[Outgoing] = []
+        if self._deferred and self._complete():
+            self._deferred = False
+            super()._begin_call(out)
+        out.extend(super().act())
+        self._track(out)
+        replies, self._replies = self._replies, []
+        return replies + out
+
+    def _track(self, out: list[Outgoing]) -> None:
+        """Remember what ``out`` sends until acknowledged: named recipients, or the known robots within 2 cells."""
+        now = self._now
+        for item in out:
+            message = item.message
+            pending = set(item.recipients) if item.recipients is not None else self._known_within(RESERVE_RADIUS)
+            self._unacknowledged[message.seq] = _Unacknowledged(item, pending, now)
+
+    def _known_within(self, radius: int) -> set[int]:
+        cells = self.flat.cells
+        x, y = cells[self.present]
+        return {
+            robot
+            for cell, robot in self._occupants.items()
+            if robot != self.index and abs(cells[cell][0] - x) + abs(cells[cell][1] - y) <= radius
+        }
+
+    def _may_confirm(self) -> bool:
+        """Every robot within 2 cells acknowledged the provisional reservation (no conflict came back)."""
+        entry = self._unacknowledged.get(self._claim_seq)
+        return entry is not None and not entry.pending  # None: sent in this very act, not yet out
+
+    def _may_start(self) -> bool:
+        return self._complete() and super()._may_start()
+
+    def _begin_call(self, out: list[Outgoing]) -> None:
+        if not self._complete():
+            self._deferred = True  # asked before every neighbour is known: decide once they are
+            return
+        super()._begin_call(out)
+
+    def _take_pull_local(self, message: PullMessage, out: list[Outgoing]) -> None:
+        if self._complete():  # else it could take a cell whose claimants it does not all know
+            super()._take_pull_local(message, out)
+
+    def _reserve(self, cell: int, out: list[Outgoing], final: bool = False) -> None:
+        super()._reserve(cell, out, final)
+        if not final:
+            self._claim_seq = self.seq

@@ -1,0 +1,244 @@
+"""Synchronous rounds without a sequencer: the simulator of ``pibt`` with local sequencing.
+
+The robots are :class:`~mrmp.robot.pibt_local.LocalPibtRobot` brains, which
+decide among themselves whose PIBT call runs when. This driver is only a
+radio, a network and a clock:
+
+* the *radio* turns a broadcast of radius ``r`` into datagrams to the robots
+  whose bodies stand within ``r`` cells (Manhattan) of the sender's body (the
+  physical world, read from the bodies' cells, never from a brain);
+* every message is encoded (:func:`mrmp.protocol.codec.encode`) and crosses
+  the scenario's seeded :class:`~mrmp.sim.network.SimulatedNetwork`, as for
+  the other policies, and is decoded by its recipient;
+* the *clock*: a message of delay 0 arrives within the tick it was sent, in
+  the next round. A round delivers everything due, then every robot that got
+  something to act on, or asked for the round (its one-round timer,
+  :attr:`~mrmp.robot.pibt_local.LocalPibtRobot.wake`), acts. When nothing is
+  due and no timer is set, the tick ends; every robot moves if it decided for
+  good, else stays (and counts an abandoned step itself).
+
+Nobody sorts the robots, finds their groups or waits for them to finish: the
+order of calls is the robots' own (``docs/protocol.md``, "Local sequencing").
+Only a perfect network is run: the one-round provisional reservation rests on
+every round's messages arriving in that round (a lossy or slow network is
+refused with a one-line error; ``pibt``'s default, sequenced driver,
+:mod:`mrmp.sim.rounds`, runs those).
+
+Deterministic for a seed.
+
+Examples
+--------
+>>> from mrmp.core import Grid, PolicyOptions, RobotSpec, Scenario
+>>> swap = Scenario(Grid(5, 5), (RobotSpec("A", (0, 2), (4, 2)), RobotSpec("B", (4, 2), (0, 2))),
+...                 policy=PolicyOptions(name="pibt"))
+>>> result = LocalRoundsSimulator(swap).run()
+>>> result.success, result.makespan, result.sum_of_costs, result.lower_bound
+(True, 7, 11, 8)
+>>> result.network["abandoned"], result.network["sent"] == result.network["delivered"]
+(0, True)
+"""
+
+from __future__ import annotations
+
+from collections import Counter
+
+from mrmp.core.errors import InputError
+from mrmp.core.result import RunResult
+from mrmp.core.scenario import Scenario
+from mrmp.protocol.codec import decode, encode
+from mrmp.protocol.messages import Message, PibtMessage
+from mrmp.robot.messaging import Outgoing
+from mrmp.robot.pibt_local import LocalPibtRobot
+from mrmp.robot.pibt_reliable import ReliablePibtRobot
+from mrmp.robot.pibt_robot import RESERVE_RADIUS
+from mrmp.sim.metrics import default_max_ticks
+from mrmp.sim.rounds import NO_ROBOT, RoundsSimulator
+from mrmp.sim.ticking import TickObserver, link_faults, run_result, scenario_network
+
+__all__ = ["STEP_RETRIES", "LocalRoundsSimulator"]
+
+STEP_RETRIES = 8
+"""Over a faulty network a step lasts this many retry intervals (``2 * delay_max + 1`` ticks each) by default."""
+
+ROBOT_COUNTS = ("waits", "withdrawn", "refused", "passed_busy", "abandoned", "acks", "retransmissions")
+"""What the robots count themselves, reported in the result's ``network``."""
+
+
+class LocalRoundsSimulator(RoundsSimulator):
+    """Runs a scenario with robots that sequence their PIBT calls themselves (module docstring).
+
+    Parameters are those of :class:`~mrmp.sim.rounds.RoundsSimulator`.
+
+    Raises
+    ------
+    InputError
+        If the scenario's network is not perfect.
+    """
+
+    robot_type = LocalPibtRobot
+    """The brain over a perfect network."""
+    reliable_type: type[ReliablePibtRobot] = ReliablePibtRobot
+    """The brain over a faulty network."""
+    robots: list[LocalPibtRobot]  # type: ignore[assignment]
+
+    def __init__(
+        self,
+        scenario: Scenario,
+        random_ties: bool = True,
+        on_tick: TickObserver | None = None,
+        tie_penalties: bool | None = None,
+        step_ticks: int | None = None,
+    ) -> None:
+        self.perfect = scenario.network.is_perfect and not link_faults(scenario)
+        worst = scenario.worst_faults()
+        self.retry = 2 * worst.delay_max + 1
+        if step_ticks is None:
+            step_ticks = 1 if self.perfect else STEP_RETRIES * self.retry
+        if step_ticks < 1:
+            raise InputError(f"step_ticks: must be at least 1, got {step_ticks}")
+        self.step_ticks = step_ticks
+        if not self.perfect:
+            self.robot_type = self.reliable_type
+        super().__init__(scenario, random_ties, on_tick, tie_penalties)
+        for robot in self.robots:
+            if isinstance(robot, ReliablePibtRobot):
+                robot.retry = self.retry
+        self.network = scenario_network(scenario)
+        self._everyone = range(len(self.robots))
+        self._hearers: dict[tuple[int, int], tuple[int, ...]] = {}
+
+    def _default_max_ticks(self) -> int:
+        """Room for PIBT's steps (:func:`~mrmp.sim.metrics.default_max_ticks`) of ``step_ticks`` each; twice that when faulty."""
+        ticks = default_max_ticks(self.scenario.with_changes(safety=False), self.lengths) * self.step_ticks
+        return ticks if self.perfect else 2 * ticks
+
+    def step(self) -> None:
+        """One PIBT step: beacons, rounds until nothing is due and no timer is set, then the moves."""
+        if not self.perfect:
+            self._timed_step()
+            return
+        self.step_count += 1
+        step = self.step_count
+        robots = self.robots
+        occupant = self._occupant = [NO_ROBOT] * len(self.flat.neighbours)
+        self._hearers = {}
+        for robot in robots:
+            occupant[robot.present] = robot.index
+        now = self.tick
+        send = self._send
+        for robot in robots:
+            for item in robot.begin_step(step):
+                send(robot.index, item, now)
+        woken = [robot.index for robot in robots if robot.wake]
+        network = self.network
+        receivers = self._receivers  # a perfect network: every datagram once, in its step
+        rounds = 0
+        while True:
+            batch = network.deliver(now)
+            if not batch and not woken:
+                break
+            rounds += 1
+            acting = dict.fromkeys(woken)
+            decoded: dict[int, Message] = {}
+            for _, recipient, payload in batch:
+                message = decoded.get(id(payload))
+                if message is None:
+                    message = decoded[id(payload)] = decode(payload)
+                if receivers[recipient](message):
+                    acting[recipient] = None
+            woken = []
+            for index in acting:
+                robot = robots[index]
+                for item in robot.act():
+                    send(index, item, now)
+                if robot.wake:
+                    woken.append(index)
+        self.stats["rounds"] += rounds
+        self._advance(moves=True)
+
+    def _timed_step(self) -> None:
+        """One step over a faulty network: ``step_ticks`` ticks of deliveries, timers and rounds, then the moves."""
+        self.step_count += 1
+        step = self.step_count
+        robots = self.robots
+        occupant = self._occupant = [NO_ROBOT] * len(self.flat.neighbours)
+        self._hearers = {}
+        for robot in robots:
+            occupant[robot.present] = robot.index
+        send = self._send
+        within = self._within
+        reliable = [robot for robot in robots if isinstance(robot, ReliablePibtRobot)]
+        for robot in reliable:
+            sensed = [cell for cell in within(robot.present, RESERVE_RADIUS) if occupant[cell] != NO_ROBOT]
+            for item in robot.begin_step(step, sensed, self.tick):
+                send(robot.index, item, self.tick)
+        for tick_of_step in range(self.step_ticks):
+            now = self.tick
+            if tick_of_step:
+                for robot in reliable:
+                    for item in robot.on_tick(now):
+                        send(robot.index, item, now)
+            for robot in robots:
+                for item in robot.act():
+                    send(robot.index, item, now)
+            self._deliver_rounds(now)
+            if self.tick >= self.max_ticks:
+                return
+            self._advance(moves=tick_of_step == self.step_ticks - 1)
+
+    def _deliver_rounds(self, now: int) -> None:
+        """Deliver what is due at ``now`` and let the recipients act, until nothing more is due this tick."""
+        robots = self.robots
+        network = self.network
+        send = self._send
+        while True:
+            batch = network.deliver(now)
+            if not batch:
+                return
+            self.stats["rounds"] += 1
+            acting: dict[int, None] = {}
+            decoded: dict[int, Message] = {}
+            for _, recipient, payload in batch:
+                message = decoded.get(id(payload))
+                if message is None:
+                    message = decoded[id(payload)] = decode(payload)
+                assert isinstance(message, PibtMessage), "a PIBT robot sends PIBT messages"
+                if robots[recipient].receive(message):
+                    acting[recipient] = None
+            for index in acting:
+                for item in robots[index].act():
+                    send(index, item, now)
+
+    def _send(self, sender: int, item: Outgoing, now: int) -> None:
+        """Hand ``item`` to the network: to its named recipients, or by radio to the bodies within its radius."""
+        recipients = item.recipients
+        if recipients is None:
+            assert item.radius is not None, "a PIBT robot broadcasts within a radius"
+            key = (sender, item.radius)
+            recipients = self._hearers.get(key)
+            if recipients is None:  # the bodies stand still during a step: who hears whom is found once
+                occupant = self._occupant
+                cells = self._within(self.robots[sender].present, item.radius)
+                recipients = self._hearers[key] = tuple(other for cell in cells if (other := occupant[cell]) != NO_ROBOT)
+        payload = encode(item.message)
+        network_send = self.network.send
+        for recipient in recipients:
+            network_send(sender, recipient, payload, now)
+        result = self._results[sender]
+        result.messages_sent += len(recipients)
+        result.bytes_sent += len(payload) * len(recipients)
+
+    def _result(self, stop_reason: str, wall_time: float) -> RunResult:
+        for index, result in enumerate(self._results):
+            result.time_s = sum(self._durations[index][: result.cost])
+        counts: Counter[str] = Counter()
+        for robot in self.robots:
+            counts.update(robot.stats)
+        network = {name: int(value) for name, value in sorted(self.stats.items())}
+        network.update(self.network.stats.as_dict())
+        network.update({name: counts[name] for name in ROBOT_COUNTS})
+        network["steps"] = self.step_count
+        network["messages"] = sum(result.messages_sent for result in self._results)
+        network["dropped_by_robots"] = sum(sum(robot.dropped.values()) for robot in self.robots)
+        network["distance_tables"] = self.flat.tables_computed
+        return run_result(self, self._results, "pibt", stop_reason, wall_time, network, planning_time_s=self.flat.table_seconds)

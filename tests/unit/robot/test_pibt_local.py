@@ -1,0 +1,258 @@
+"""PIBT sequenced by the robots themselves: safe in crowds, close to central PIBT, and every rule needed."""
+
+import random
+
+import pytest
+
+from mrmp.centralized.pibt_step import PIBT
+from mrmp.core import Grid, NetworkFaults, PolicyOptions, RobotSpec, Scenario
+from mrmp.core.errors import InputError
+from mrmp.core.grid import connected_regions
+from mrmp.robot.pibt_local import LocalPibtRobot
+from mrmp.robot.pibt_reliable import ReliablePibtRobot
+from mrmp.sim.local_rounds import LocalRoundsSimulator
+
+
+def random_scenario(seed, swap, radius=2, faults=None):
+    """The random scenarios of ``test_pibt_robot.py``: up to half the largest region's cells hold robots."""
+    rng = random.Random(seed)
+    x_size, y_size = rng.randint(3, 9), rng.randint(3, 9)
+    cells = [(x, y) for x in range(x_size) for y in range(y_size)]
+    blocked = set(rng.sample(cells, k=rng.randint(0, len(cells) // 5)))
+    grid = Grid(x_size, y_size, blocked)
+    free = sorted(max(connected_regions(grid, grid.free_cells())[1], key=len))
+    count = rng.randint(1, max(1, len(free) // 2))
+    starts, goals = rng.sample(free, count), rng.sample(free, count)
+    robots = tuple(RobotSpec(f"r{i}", s, g) for i, (s, g) in enumerate(zip(starts, goals)))
+    policy = PolicyOptions(name="pibt", radius=radius, swap=swap)
+    return Scenario(grid, robots, network=faults or NetworkFaults(), policy=policy, seed=seed)
+
+
+def central_next(simulator, swap):
+    """The cells central PIBT gives the simulator's robots next, for their present cells and priorities."""
+    robots = simulator.robots
+    flat = simulator.flat
+    pibt = PIBT(flat.neighbours, [flat.distances(robot.goal) for robot in robots], [robot.goal for robot in robots], swap=swap)
+    order = [robot.index for robot in sorted(robots, key=lambda robot: robot.priority, reverse=True)]
+    return pibt.step([robot.present for robot in robots], order)
+
+
+def crowd(seed, density=0.8, swap=None, max_ticks=40):
+    """A random map with up to ``density`` of its largest region's cells holding robots."""
+    rng = random.Random(seed)
+    x_size, y_size = rng.randint(4, 10), rng.randint(4, 10)
+    cells = [(x, y) for x in range(x_size) for y in range(y_size)]
+    grid = Grid(x_size, y_size, set(rng.sample(cells, k=rng.randint(0, len(cells) // 6))))
+    free = sorted(max(connected_regions(grid, grid.free_cells())[1], key=len))
+    count = rng.randint(1, max(1, int(len(free) * density)))
+    starts, goals = rng.sample(free, count), rng.sample(free, count)
+    robots = tuple(RobotSpec(f"r{i}", s, g) for i, (s, g) in enumerate(zip(starts, goals)))
+    swap = bool(seed % 2) if swap is None else swap
+    return Scenario(grid, robots, policy=PolicyOptions(name="pibt", swap=swap), seed=seed, max_ticks=max_ticks)
+
+
+def collisions(robot_type, seeds):
+    """Collisions the referee saw over crowded runs of ``robot_type``."""
+
+    class Simulator(LocalRoundsSimulator):
+        pass
+
+    Simulator.robot_type = robot_type
+    return sum(len(Simulator(crowd(seed)).run().collisions) for seed in seeds)
+
+
+@pytest.mark.parametrize("seed", range(60))
+def test_crowds_never_collide_and_nobody_abandons_a_step(seed):
+    result = LocalRoundsSimulator(crowd(seed)).run()
+    assert result.collisions == []
+    assert result.network["abandoned"] == 0
+    assert result.network["sent"] == result.network["delivered"] == result.network["messages"]
+
+
+def test_decisions_stay_close_to_central_pibt():
+    steps = differ = decisions = moved_otherwise = 0
+    for seed in range(40):
+        for swap in (False, True):
+            simulator = LocalRoundsSimulator(random_scenario(seed, swap, radius=2), random_ties=False)
+            for _ in range(30):
+                expected = central_next(simulator, swap)
+                simulator.step()
+                got = [robot.present for robot in simulator.robots]
+                steps += 1
+                differ += got != expected
+                decisions += len(got)
+                moved_otherwise += sum(a != b for a, b in zip(got, expected))
+            assert simulator.referee.collisions == []
+    # measured: 72 of 2,400 steps, 213 of 19,020 decisions (docs/protocol.md, "Local sequencing")
+    assert differ <= 0.05 * steps
+    assert moved_otherwise <= 0.02 * decisions
+
+
+@pytest.mark.parametrize("seed", range(20))
+def test_robots_within_two_cells_of_each_other_decide_as_central_pibt(seed):
+    # on a 1 x 3 corridor plus one bay every robot is within 2 cells of every other: the local order is the global one
+    rng = random.Random(seed)
+    grid = Grid.from_rows(["...", ".##"])
+    free = sorted(grid.free_cells())
+    count = rng.randint(1, 3)
+    starts, goals = rng.sample(free, count), rng.sample(free, count)
+    robots = tuple(RobotSpec(f"r{i}", s, g) for i, (s, g) in enumerate(zip(starts, goals)))
+    scenario = Scenario(grid, robots, policy=PolicyOptions(name="pibt", swap=False), seed=seed)
+    simulator = LocalRoundsSimulator(scenario, random_ties=False)
+    for _ in range(10):
+        expected = central_next(simulator, False)
+        simulator.step()
+        assert [robot.present for robot in simulator.robots] == expected
+
+
+def test_robots_count_their_waits_and_the_network_carries_everything():
+    result = LocalRoundsSimulator(crowd(3, density=0.6, max_ticks=20)).run()
+    assert result.network["waits"] > 0
+    assert result.network["rounds"] > result.network["steps"]
+    assert all(key in result.network for key in ("withdrawn", "refused", "passed_busy", "abandoned", "lost"))
+
+
+FAULTS = {
+    "lossy": NetworkFaults(loss=0.3, duplicate=0.1),
+    "slow": NetworkFaults(loss=0.1, delay_min=0, delay_max=2, duplicate=0.1, reorder=0.2),
+}
+
+
+@pytest.mark.parametrize("faults", FAULTS)
+@pytest.mark.parametrize("seed", range(12))
+def test_over_a_faulty_network_crowds_never_collide(seed, faults):
+    scenario = crowd(seed, density=0.5, max_ticks=120).with_changes(network=FAULTS[faults])
+    simulator = LocalRoundsSimulator(scenario)
+    result = simulator.run()
+    assert result.collisions == []
+    assert simulator.step_ticks == 8 * (2 * FAULTS[faults].delay_max + 1)
+    if len(scenario.robots) > 1:
+        assert result.network["lost"] > 0 and result.network["retransmissions"] > 0 and result.network["acks"] > 0
+
+
+def test_over_a_lossy_network_robots_arrive():
+    scenario = crowd(4, density=0.3, max_ticks=4000).with_changes(network=FAULTS["lossy"])
+    result = LocalRoundsSimulator(scenario).run()
+    assert result.success and result.collisions == []
+    assert 0 < result.network["abandoned"] < result.network["steps"] * len(scenario.robots) / 2
+
+
+def test_a_cut_network_abandons_every_step_and_only_robots_alone_move():
+    scenario = crowd(5, density=0.5, max_ticks=12).with_changes(network=NetworkFaults(loss=1.0))
+    result = LocalRoundsSimulator(scenario, step_ticks=3).run()
+    starts = [spec.start for spec in scenario.robots]
+
+    def alone(cell):  # nobody within 2 cells: nothing to ask, nobody to tell
+        return all(other == cell or abs(other[0] - cell[0]) + abs(other[1] - cell[1]) > 2 for other in starts)
+
+    crowded = [robot for robot in result.robots if not alone(robot.start)]
+    assert crowded and all(set(robot.path) == {robot.start} for robot in crowded)
+    assert result.network["abandoned"] >= 4 * len(crowded)
+    assert result.collisions == []
+
+
+def test_a_step_of_no_ticks_is_refused_in_one_line():
+    with pytest.raises(InputError, match=r"^step_ticks: must be at least 1, got 0$"):
+        LocalRoundsSimulator(crowd(1), step_ticks=0)
+
+
+# -- every rule is needed: broken variants that the tests above would catch ----------------------------
+
+
+class Hasty(LocalPibtRobot):
+    """Broken: a reservation is final at once (no round for a call of higher priority to win the cell)."""
+
+    def _reserve(self, cell, out, final=False):
+        super()._reserve(cell, out, final)
+        self._confirmed = True
+
+
+class Stubborn(LocalPibtRobot):
+    """Broken: a robot never withdraws a reservation that a call of higher priority made in the same round."""
+
+    def act(self):
+        self._lost = False
+        return super().act()
+
+
+class Trusting(LocalPibtRobot):
+    """Broken: the cell of a neighbour busy in another call counts as free (that neighbour may yet stay)."""
+
+    def _continue(self, out):
+        self._calls = {robot: self._root for robot in self._calls}
+        super()._continue(out)
+
+
+@pytest.mark.parametrize("variant", [Hasty, Stubborn, Trusting])
+def test_each_broken_variant_collides(variant):
+    seeds = range(60)
+    assert collisions(LocalPibtRobot, seeds) == 0
+    assert collisions(variant, seeds) > 0
+
+
+class Eager(LocalPibtRobot):
+    """Broken: a robot starts its call without waiting for the robots within 2 cells that outrank it."""
+
+    def _may_start(self):
+        return True
+
+
+def test_without_waiting_for_higher_priorities_decisions_drift_from_central_pibt():
+    def differing(robot_type):
+        class Simulator(LocalRoundsSimulator):
+            pass
+
+        Simulator.robot_type = robot_type
+        count = 0
+        for seed in range(20):
+            simulator = Simulator(random_scenario(seed, True, radius=2), random_ties=False)
+            for _ in range(20):
+                expected = central_next(simulator, True)
+                simulator.step()
+                count += sum(robot.present != cell for robot, cell in zip(simulator.robots, expected))
+        return count
+
+    assert differing(Eager) > 3 * differing(LocalPibtRobot)
+
+
+@pytest.mark.parametrize("swap", [False, True])
+@pytest.mark.parametrize("seed", range(40))
+def test_a_radius_that_covers_the_map_gives_central_pibt_exactly(seed, swap):
+    # every robot waits for every robot of higher priority: the calls run one at a time, in priority order
+    simulator = LocalRoundsSimulator(random_scenario(seed, swap, radius=32), random_ties=False)
+    for _ in range(30):
+        expected = central_next(simulator, swap)
+        simulator.step()
+        assert [robot.present for robot in simulator.robots] == expected
+    assert simulator.referee.collisions == []
+
+
+class Impatient(ReliablePibtRobot):
+    """Broken: over a faulty network, a reservation is confirmed without waiting for the acknowledgements."""
+
+    def _may_confirm(self):
+        return True
+
+
+class Secretive(ReliablePibtRobot):
+    """Broken: an acknowledgement does not carry its sender's claim, so claims of one cell go unnoticed."""
+
+    def receive(self, message):
+        target, self.target = self.target, None
+        try:
+            return super().receive(message)
+        finally:
+            self.target = target
+
+
+@pytest.mark.parametrize("variant", [Impatient, Secretive])
+def test_each_broken_variant_collides_over_a_faulty_network(variant):
+    class Simulator(LocalRoundsSimulator):
+        reliable_type = variant
+
+    collided = 0
+    for seed in range(30):
+        scenario = crowd(seed, density=0.5, max_ticks=60).with_changes(network=FAULTS["slow"])
+        assert LocalRoundsSimulator(scenario).run().collisions == []
+        collided += len(Simulator(scenario).run().collisions)
+    assert collided > 0
