@@ -24,7 +24,7 @@ one computer); *first move*: the wall time before the first robot can move
 (decentralized: the slowest robot's first decision, robots deciding in
 parallel; centralized: the planning time; neither counts the network's latency);
 *msgs/move* and *bytes/move*: datagrams and bytes sent per robot-move
-(a broadcast to N - 1 peers counts N - 1), of which *states/move* are states
+(a message to k robots counts k), of which *states/move* are states
 (Present and Next; for a plan, with the robot's progress), the others the safety
 layer's claims, replies and releases (``pibt``: its beacons, requests and
 answers, not told apart); *plan bytes*: the shares of
@@ -32,8 +32,8 @@ the plan handed to the robots; *waiting*: the share of robot-ticks before
 arrival spent standing still (waiting for a claim, a higher-priority robot, or a
 dependency of the plan; the plan's own waits are included). Counts are
 deterministic; times are this machine's, the least of ``--repeats`` runs.
-``astar`` runs up to ``--astar-up-to`` robots: its robots broadcast their state
-to the whole fleet every tick, so beyond that a run takes minutes.
+``astar`` runs up to ``--astar-up-to`` robots (its crowds livelock, and a
+livelocked run lasts until the tick limit).
 
 With ``--plots DIR`` it also draws one figure per claim, against N: the busiest
 robot's computation (complexity), datagrams per robot-move (speed) and the share
@@ -233,8 +233,8 @@ def main() -> int:
     parser.add_argument("--max-ticks", type=int, default=300)
     parser.add_argument("--time-limit", type=float, default=30.0, help="central planners' limit, seconds")
     parser.add_argument("--repeats", type=int, default=3, help="runs of each method; wall times are the least")
-    parser.add_argument("--astar-up-to", type=int, default=100,
-                        help="largest fleet for astar (it broadcasts to every robot every tick)")  # fmt: skip
+    parser.add_argument("--astar-up-to", type=int, default=200,
+                        help="largest fleet for astar (its crowds livelock until the tick limit)")  # fmt: skip
     parser.add_argument("--plots", type=Path, default=None, help="write one PNG per claim into this folder")
     arguments = parser.parse_args()
     warm_up = load_movingai_scenario(MAPS / f"{arguments.map}.map", MAPS / f"{arguments.map}-random-1.scen", 2)

@@ -125,6 +125,20 @@ def interaction_radius(policy: object) -> int | None:
     return radius if isinstance(radius, int) else None
 
 
+def owes_state(policy: object, robot: int, progress: int) -> bool:
+    """Whether a peer just heard from, having completed ``progress`` moves, must get this robot's state at once.
+
+    A policy says so with a method ``owes_state`` (a plan-following robot: the
+    peer waits for a move it has made and missed the state that reported it);
+    any other policy owes nothing.
+
+    >>> owes_state(object(), 3, 0)
+    False
+    """
+    method = getattr(policy, "owes_state", None)
+    return bool(method(robot, progress)) if callable(method) else False
+
+
 def listeners(policy: object, heard: Iterable[int] = (), progress: Mapping[int, int] | None = None) -> Iterable[int]:
     """The peers beyond the interaction radius that must hear this robot's state now (policy method ``listeners``).
 

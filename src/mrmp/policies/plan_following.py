@@ -148,6 +148,20 @@ class PlanFollowingPolicy:
                 robots.add(robot)
         return tuple(sorted(robots))
 
+    def owes_state(self, robot: int, progress: int) -> bool:
+        """Whether peer ``robot``, having completed ``progress`` moves, still waits for a move this robot has made.
+
+        Such a peer has missed the state that reported the move (a lost push);
+        the robot answers it at once (:func:`~mrmp.policies.base.owes_state`).
+
+        >>> policy = PlanFollowingPolicy([(0, 1), (0, 2)], {}, dependents={1: [(3, 0)], 2: [(3, 1)]})
+        >>> policy.done = 1
+        >>> policy.owes_state(3, progress=0), policy.owes_state(3, progress=1), policy.owes_state(4, progress=0)
+        (True, False, False)
+        """
+        done = self.done
+        return any(needed <= done and progress <= move for needed, move in self._waiting_on_me.get(robot, ()))
+
     def intend(self, situation: Situation) -> Cell:
         """The next cell of the plan (the present cell once the plan is done), whether or not it may go yet.
 

@@ -51,7 +51,7 @@ from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
 from mrmp.core.heading import Heading
 from mrmp.core.scenario import RobotSpec
-from mrmp.policies.base import Decision, Policy, Situation, interaction_radius, listeners
+from mrmp.policies.base import Decision, Policy, Situation, interaction_radius, listeners, owes_state
 from mrmp.protocol.messages import (
     ClaimMessage,
     HandoffMessage,
@@ -141,6 +141,7 @@ class Robot(MessageEndpoint):
         self.moving = False
         self.belief = Belief()
         self._heard_since: set[int] = set()
+        self._answered: set[int] = set()
         self.safety = SafetyLayer(
             index,
             starts,
@@ -202,6 +203,7 @@ class Robot(MessageEndpoint):
         if self.state_radius is None:
             return [Outgoing(self.state_message())]
         heard, self._heard_since = self._heard_since, set()
+        self._answered.clear()
         extra = tuple(listeners(self.policy, heard, self.belief.progress))
         return [Outgoing(self.state_message(), extra, self.state_radius)]
 
@@ -289,8 +291,12 @@ class Robot(MessageEndpoint):
     @handlers.on(StateMessage)
     def _take_state(self, message: StateMessage, now: float) -> list[Outgoing]:
         self.belief.update(message, now)
-        if self.state_radius is not None:
-            self._heard_since.add(message.sender)
+        if self.state_radius is None:
+            return []
+        self._heard_since.add(message.sender)
+        if message.sender not in self._answered and owes_state(self.policy, message.sender, message.progress):
+            self._answered.add(message.sender)  # once a step: two robots waiting on each other do not ping-pong
+            return [Outgoing(self.state_message(), (message.sender,))]  # a pull answered within the step
         return []
 
     @handlers.on(ClaimMessage)
