@@ -21,8 +21,8 @@ that first reports a completed move goes to that move's dependents (*push*:
 on a perfect network a dependent hears it exactly when it would from states
 sent to everyone); a robot that waits for a peer's move sends its own state to
 that peer every step, and a peer that hears from a dependent still waiting for
-a move it has completed answers with its state (*pull*: a lost push is made up
-within a step of the next heard request).
+a move it has completed answers with its state at once, once a step (*pull*:
+a lost push is made up as soon as the next request gets through).
 
 The dependencies themselves are computed from the plan by
 :func:`mrmp.centralized.dependencies.action_dependencies`; this policy only
