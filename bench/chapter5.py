@@ -59,7 +59,7 @@ from mrmp.core.cell import Cell
 from mrmp.core.result import RunResult
 from mrmp.experiments.execution import execute_in_simulator
 from mrmp.io import load_movingai_scenario
-from mrmp.policies.base import Decision, Policy, Situation
+from mrmp.policies.base import Decision, Policy, Situation, interaction_radius
 from mrmp.sim.policy_table import make_policy
 from mrmp.sim.simulator import simulate
 from mrmp.viz.series_plot import write_series_plot
@@ -78,6 +78,11 @@ class TimedPolicy:
     @property
     def name(self) -> str:
         return self.inner.name
+
+    @property
+    def interaction_radius(self) -> int | None:
+        """The timed rule's own radius, so that its robots' states go where they would without the timing."""
+        return interaction_radius(self.inner)
 
     def intend(self, situation: Situation) -> Cell:
         started = time.perf_counter()
