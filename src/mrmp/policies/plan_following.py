@@ -28,6 +28,30 @@ The dependencies themselves are computed from the plan by
 :func:`mrmp.centralized.dependencies.action_dependencies`; this policy only
 follows them, knowing its peers only through their messages.
 
+**Crashed robots** (this rule is mrmp's own, not Hönig et al.'s). A robot the
+next move waits for and that has fallen *silent* (not heard for the driver's
+silence timeout: :attr:`~mrmp.policies.base.PeerState.silent`) is taken for
+crashed, standing for ever on its last heard Present and Next. The robot stops
+waiting for it:
+
+* if the rest of its plan avoids those cells, it drops its dependencies on that
+  robot (for as long as it stays silent) and goes on with its plan;
+* otherwise it leaves the plan for good and drives to its goal reactively
+  (:class:`~mrmp.policies.astar.AstarPolicy`, which plans around silent robots).
+  It then reports its progress as past every move of its plan
+  (:meth:`PlanFollowingPolicy.reported_progress`), so that its dependents stop
+  waiting for it, and so on transitively: a robot that waits for one that has
+  left its plan is released, not stuck behind a dead robot two links away.
+
+What is lost is the plan's order of visits between the robots released this way
+and the robot they no longer wait for, and with it the plan's freedom from
+deadlock (a robot off its plan and one following it can block each other). What
+is kept is safety: the safety layer guards every move whatever the policy
+decides, a crashed robot's cells stay claimed, and a robot wrongly taken for
+crashed (its states lost for a silence timeout) only loses that order too.
+Robots whose plans neither need the dead robot's cells nor wait, directly or
+through robots off their plans, for it keep every guarantee of their plans.
+
 Examples
 --------
 >>> from mrmp.core import Grid, Heading
@@ -51,7 +75,8 @@ from __future__ import annotations
 from collections.abc import Iterable, Mapping, Sequence
 
 from mrmp.core.cell import Cell
-from mrmp.policies.base import Decision, Situation
+from mrmp.policies.astar import AstarPolicy
+from mrmp.policies.base import Decision, PeerState, Situation
 
 
 class PlanFollowingPolicy:
@@ -75,6 +100,10 @@ class PlanFollowingPolicy:
         simulator), so that on a perfect network the robot keeps the plan's
         waits too and its path is the planned one; late robots go as soon as
         their dependencies allow.
+    follow_crashed:
+        Wait for silent robots as for any other (the rule of Hönig et al.
+        without mrmp's crash rule, module docstring): a robot crashed before a
+        move that others wait for then holds them for ever.
 
     >>> from mrmp.core import Grid, Heading
     >>> policy = PlanFollowingPolicy([(0, 1)], {}, not_before=[3])
@@ -91,6 +120,7 @@ class PlanFollowingPolicy:
         dependents: Mapping[int, Sequence[tuple[int, int]]] | None = None,
         *,
         not_before: Sequence[int] | None = None,
+        follow_crashed: bool = False,
     ) -> None:
         self.moves = list(moves)
         self.dependencies = {move: list(needs) for move, needs in dependencies.items()}
@@ -103,24 +133,86 @@ class PlanFollowingPolicy:
         self._pushed = 0
         self.done = 0
         self.waits_for: list[int] = []
+        self.follow_crashed = follow_crashed
+        self._last_heard: dict[int, frozenset[Cell]] = {}
+        self._waited_for = sorted({robot for needs in self.dependencies.values() for robot, _ in needs})
+        self.dropped: set[int] = set()
+        """The silent robots whose dependencies the robot has dropped (its plan avoids their cells)."""
+        self.reactive: AstarPolicy | None = None
+        """The reactive policy driving the robot once it has left its plan (None while it follows it)."""
 
     def _catch_up(self, present: Cell) -> None:
         while self.done < len(self.moves) and present == self.moves[self.done]:
             self.done += 1
 
+    @property
+    def off_plan(self) -> bool:
+        """Whether the robot has left its plan (a crashed robot holds a cell of it) and drives reactively."""
+        return self.reactive is not None
+
+    def reported_progress(self, moves: int) -> int:
+        """The progress its states report, ``moves`` being the moves it has made: past every move of its plan
+        once it has left the plan, so that no robot waits for it any longer.
+
+        >>> policy = PlanFollowingPolicy([(0, 1), (0, 2), (0, 3)], {})
+        >>> policy.reported_progress(1)
+        1
+        >>> policy.reactive = AstarPolicy()
+        >>> policy.reported_progress(1), policy.reported_progress(5)
+        (3, 5)
+        """
+        return max(moves, len(self.moves)) if self.off_plan else moves
+
+    def _crashed_cells(self, peer: PeerState) -> frozenset[Cell]:
+        """A silent peer's last heard Present and Next (a driver shows a silent peer's Next as its Present)."""
+        return self._last_heard.get(peer.index, frozenset()) | {peer.present, peer.next}
+
+    def _remember(self, situation: Situation) -> None:
+        """Keep the last cells heard from each robot the plan waits for while it is not silent."""
+        for robot in self._waited_for:
+            peer = situation.peers.get(robot)
+            if peer is not None and not peer.silent:
+                self._last_heard[robot] = frozenset((peer.present, peer.next))
+                self.dropped.discard(robot)
+
+    def _crash_rule(self, situation: Situation) -> None:
+        """Apply the crash rule (module docstring) to the silent robots the next move waits for."""
+        if self.follow_crashed or self.off_plan:
+            return
+        self._remember(situation)
+        rest = set(self.moves[self.done :])
+        for robot, progress in self.dependencies.get(self.done, ()):
+            peer = situation.peers.get(robot)
+            if peer is None or not peer.silent or situation.progress_of(robot) >= progress:
+                continue
+            if rest.isdisjoint(self._crashed_cells(peer)):
+                self.dropped.add(robot)
+            else:
+                self.reactive = AstarPolicy()
+                self.waits_for = []
+                return
+
     def ready(self, situation: Situation) -> bool:
-        """Whether every dependency of the next move is met, by what the peers have said."""
+        """Whether every dependency of the next move is met, by what the peers have said
+        (a silent robot whose dependencies were dropped counts as met while it stays silent)."""
         waiting = []
         for robot, progress in self.dependencies.get(self.done, ()):
-            if situation.progress_of(robot) < progress:
+            if situation.progress_of(robot) < progress and not self._dropped(situation, robot):
                 waiting.append(robot)
         self.waits_for = waiting
         return not waiting
 
+    def _dropped(self, situation: Situation, robot: int) -> bool:
+        peer = situation.peers.get(robot)
+        return robot in self.dropped and peer is not None and peer.silent
+
     @property
     def interaction_radius(self) -> int | None:
-        """0 when the dependents are known (the policy reads no peer's cells), else None (states go fleet-wide)."""
-        return None if self.dependents is None else 0
+        """0 when the dependents are known (the policy reads no peer's cells), else None (states go fleet-wide);
+        off its plan, the reactive policy's radius."""
+        if self.dependents is None:
+            return None
+        return self.reactive.interaction_radius if self.reactive is not None else 0
 
     def listeners(self, heard: Iterable[int] = (), progress: Mapping[int, int] | None = None) -> tuple[int, ...]:
         """Whom this step's state must reach beyond the radius (module docstring): push, pull and the peers waited for.
@@ -152,13 +244,20 @@ class PlanFollowingPolicy:
         """The next cell of the plan (the present cell once the plan is done), whether or not it may go yet.
 
         Announced as the robot's Next, it tells the robot it waits for which cell it wants.
+        Off its plan, the reactive policy's Next.
         """
+        if self.reactive is not None:
+            return self.reactive.intend(situation)
         self._catch_up(situation.present)
         return self.moves[self.done] if self.done < len(self.moves) else situation.present
 
     def _allowed(self, situation: Situation) -> Cell:
         """The next cell of the plan once its dependencies are met and its tick has come, else the present cell."""
         self._catch_up(situation.present)
+        if self.done < len(self.moves):
+            self._crash_rule(situation)
+        if self.reactive is not None:
+            return situation.present
         if self.done >= len(self.moves) or not self.ready(situation):
             return situation.present
         if self.not_before is not None and situation.now < self.not_before[self.done]:
@@ -168,9 +267,12 @@ class PlanFollowingPolicy:
     def decide(self, situation: Situation, intended: Cell) -> Decision:
         """Follow the plan: the dependencies already ruled out every conflict.
 
-        Readiness is checked with what the peers have said by now.
+        Readiness is checked with what the peers have said by now. Off its plan
+        (crash rule, module docstring), the reactive policy decides.
         """
         intended = self._allowed(situation)
+        if self.reactive is not None:
+            return self.reactive.decide(situation, self.reactive.intend(situation))
         if intended == situation.present:
             reason = "arrived" if situation.present == situation.goal and self.done >= len(self.moves) else "wait"
             return Decision(situation.present, reason, tuple(self.waits_for))
