@@ -22,7 +22,7 @@ from mrmp.core.scenario import Scenario
 from mrmp.core.seeds import Stream, derive_seed, stream_random
 from mrmp.io.lifetime import watch_parent
 from mrmp.io.live_files import TraceReader, TraceWriter, write_json
-from mrmp.io.plans import read_share
+from mrmp.io.plans import read_share, read_share_dependents
 from mrmp.live.agent import Agent, AgentReport, AgentTiming
 from mrmp.live.body import OccupancyRecorder, SimulatedBody
 from mrmp.live.causal_agent import CausalAgent
@@ -158,7 +158,8 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
     policy = None
     if options.plan is not None:
         moves, dependencies = read_share(options.plan, scenario.robots[index].id)
-        policy = PlanFollowingPolicy(moves, dependencies)
+        dependents = read_share_dependents(options.plan, scenario.robots[index].id)
+        policy = PlanFollowingPolicy(moves, dependencies, dependents)
     spec = scenario.robots[index]
     report_path = options.results / f"agent-{index}.json"
     trace = TraceWriter(options.results / f"trace-{index}.jsonl", index)

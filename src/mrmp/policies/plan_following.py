@@ -22,7 +22,9 @@ on a perfect network a dependent hears it exactly when it would from states
 sent to everyone); a robot that waits for a peer's move sends its own state to
 that peer every step, and a peer that hears from a dependent still waiting for
 a move it has completed answers with its state (*pull*: a lost push is made up
-within a step of the next heard request).
+within a step of the next heard request). It answers a dependent waiting for a
+move it has not made yet too, so that a robot that waits hears from the robot it
+waits for at every pull, and does not take it for crashed (below).
 
 The dependencies themselves are computed from the plan by
 :func:`mrmp.centralized.dependencies.action_dependencies`; this policy only
@@ -167,6 +169,14 @@ class PlanFollowingPolicy:
         """A silent peer's last heard Present and Next (a driver shows a silent peer's Next as its Present)."""
         return self._last_heard.get(peer.index, frozenset()) | {peer.present, peer.next}
 
+    def _reactive(self, situation: Situation) -> AstarPolicy:
+        """The reactive policy, told the cells the silent robots may hold (their registries keep them)."""
+        assert self.reactive is not None
+        self.reactive.held = frozenset(
+            cell for peer in situation.peers.values() if peer.silent for cell in self._crashed_cells(peer)
+        )
+        return self.reactive
+
     def _remember(self, situation: Situation) -> None:
         """Keep the last cells heard from each robot the plan waits for while it is not silent."""
         for robot in self._waited_for:
@@ -226,6 +236,9 @@ class PlanFollowingPolicy:
         (3, 4)
         >>> policy.listeners(heard=[3, 4], progress={3: 1, 4: 6})   # 3 still waits for move 2; 4 is past it
         (3,)
+        >>> policy.done = 0
+        >>> policy.listeners(heard=[3], progress={3: 0})   # 3 waits for a move not made yet: it hears the robot lives
+        (3,)
         """
         if self.dependents is None:
             return ()
@@ -236,7 +249,11 @@ class PlanFollowingPolicy:
         self._pushed = max(self._pushed, done)
         known = progress or {}
         for robot in heard:
-            if any(needed <= done and known.get(robot, 0) <= move for needed, move in self._waiting_on_me.get(robot, ())):
+            reached = known.get(robot, 0)
+            if any(
+                reached <= move and (needed <= done or reached == move)
+                for needed, move in self._waiting_on_me.get(robot, ())
+            ):
                 robots.add(robot)
         return tuple(sorted(robots))
 
@@ -247,7 +264,7 @@ class PlanFollowingPolicy:
         Off its plan, the reactive policy's Next.
         """
         if self.reactive is not None:
-            return self.reactive.intend(situation)
+            return self._reactive(situation).intend(situation)
         self._catch_up(situation.present)
         return self.moves[self.done] if self.done < len(self.moves) else situation.present
 
@@ -272,7 +289,8 @@ class PlanFollowingPolicy:
         """
         intended = self._allowed(situation)
         if self.reactive is not None:
-            return self.reactive.decide(situation, self.reactive.intend(situation))
+            reactive = self._reactive(situation)
+            return reactive.decide(situation, reactive.intend(situation))
         if intended == situation.present:
             reason = "arrived" if situation.present == situation.goal and self.done >= len(self.moves) else "wait"
             return Decision(situation.present, reason, tuple(self.waits_for))

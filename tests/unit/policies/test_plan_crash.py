@@ -101,3 +101,14 @@ def test_off_its_plan_the_robot_reads_its_neighbourhood():
     assert policy.interaction_radius == 0
     leaves_plan_around_dead_robot(policy)
     assert policy.interaction_radius == 2
+
+
+def test_off_its_plan_the_robot_avoids_the_cell_the_dead_robot_was_entering():
+    """Robot 1 was heard leaving (0, 2) for (1, 2) and died; robot 0, off its plan, goes round both cells."""
+    policy = PlanFollowingPolicy([(0, 1), (0, 2), (0, 3), (1, 3), (2, 3)], {1: [(1, 1)]})
+    step(policy, situation((0, 0), (2, 3), peer(1, (0, 2), 0, next=(1, 2))))
+    where = situation((0, 1), (2, 3), peer(1, (0, 2), 0, silent=True))
+    decision = step(policy, where)
+    assert policy.off_plan and decision.next == (1, 1)
+    assert policy.reactive is not None and policy.reactive.held == {(0, 2), (1, 2)}
+    assert (1, 2) not in policy.reactive._path  # its path to (2, 3) goes round (1, 2) too
