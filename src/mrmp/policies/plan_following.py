@@ -80,6 +80,10 @@ from mrmp.core.cell import Cell
 from mrmp.policies.astar import AstarPolicy
 from mrmp.policies.base import Decision, PeerState, Situation
 
+REFUSED_TRIES = 4
+"""Off its plan, after choosing the same cell this many decisions in a row without leaving its own, the robot
+plans around that cell until it moves (a crashed robot may hold a cell it was not heard announcing)."""
+
 
 class PlanFollowingPolicy:
     """Execute one robot's share of a central plan, honouring its action dependencies.
@@ -141,6 +145,8 @@ class PlanFollowingPolicy:
         self.dropped: set[int] = set()
         """The silent robots whose dependencies the robot has dropped (its plan avoids their cells)."""
         self.reactive: AstarPolicy | None = None
+        self._stuck: tuple[Cell, Cell, int] | None = None
+        self._refused: set[Cell] = set()
         """The reactive policy driving the robot once it has left its plan (None while it follows it)."""
 
     def _catch_up(self, present: Cell) -> None:
@@ -174,8 +180,25 @@ class PlanFollowingPolicy:
         assert self.reactive is not None
         self.reactive.held = frozenset(
             cell for peer in situation.peers.values() if peer.silent for cell in self._crashed_cells(peer)
-        )
+        ) | self._refused
         return self.reactive
+
+    def _reactive_decision(self, situation: Situation) -> Decision:
+        """The reactive policy's decision; a cell chosen :data:`REFUSED_TRIES` times in a row from the same
+        cell (its claim refused each time) is planned around until the robot moves or finds no other way."""
+        present = situation.present
+        if self._stuck is not None and self._stuck[0] != present:
+            self._stuck, self._refused = None, set()
+        reactive = self._reactive(situation)
+        decision = reactive.decide(situation, reactive.intend(situation))
+        if not decision.moves:
+            self._stuck, self._refused = None, set()
+            return decision
+        tries = self._stuck[2] + 1 if self._stuck is not None and self._stuck[1] == decision.next else 1
+        self._stuck = (present, decision.next, tries)
+        if tries >= REFUSED_TRIES:
+            self._refused.add(decision.next)
+        return decision
 
     def _remember(self, situation: Situation) -> None:
         """Keep the last cells heard from each robot the plan waits for while it is not silent."""
@@ -289,8 +312,7 @@ class PlanFollowingPolicy:
         """
         intended = self._allowed(situation)
         if self.reactive is not None:
-            reactive = self._reactive(situation)
-            return reactive.decide(situation, reactive.intend(situation))
+            return self._reactive_decision(situation)
         if intended == situation.present:
             reason = "arrived" if situation.present == situation.goal and self.done >= len(self.moves) else "wait"
             return Decision(situation.present, reason, tuple(self.waits_for))

@@ -112,3 +112,12 @@ def test_off_its_plan_the_robot_avoids_the_cell_the_dead_robot_was_entering():
     assert policy.off_plan and decision.next == (1, 1)
     assert policy.reactive is not None and policy.reactive.held == {(0, 2), (1, 2)}
     assert (1, 2) not in policy.reactive._path  # its path to (2, 3) goes round (1, 2) too
+
+
+def test_off_its_plan_a_cell_refused_again_and_again_is_planned_around():
+    """A crashed robot may hold a cell it was never heard announcing: the robot, staying where it is after
+    choosing the same cell four times, tries another way."""
+    policy = PlanFollowingPolicy([(0, 1), (0, 2), (1, 2)], {1: [(1, 1)]})
+    dead = situation((0, 1), (1, 2), peer(1, (0, 2), 0, silent=True))
+    choices = [step(policy, dead).next for _ in range(5)]
+    assert choices[:4] == [(1, 1)] * 4 and choices[4] != (1, 1)
