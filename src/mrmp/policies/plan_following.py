@@ -145,9 +145,9 @@ class PlanFollowingPolicy:
         self.dropped: set[int] = set()
         """The silent robots whose dependencies the robot has dropped (its plan avoids their cells)."""
         self.reactive: AstarPolicy | None = None
+        """The reactive policy driving the robot once it has left its plan (None while it follows it)."""
         self._stuck: tuple[Cell, Cell, int] | None = None
         self._refused: set[Cell] = set()
-        """The reactive policy driving the robot once it has left its plan (None while it follows it)."""
 
     def _catch_up(self, present: Cell) -> None:
         while self.done < len(self.moves) and present == self.moves[self.done]:
