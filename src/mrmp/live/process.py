@@ -159,7 +159,7 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
     if options.plan is not None:
         moves, dependencies = read_share(options.plan, scenario.robots[index].id)
         dependents = read_share_dependents(options.plan, scenario.robots[index].id)
-        policy = PlanFollowingPolicy(moves, dependencies, dependents)
+        policy = PlanFollowingPolicy(moves, dependencies, dependents, answer_all_pulls=True)
     spec = scenario.robots[index]
     report_path = options.results / f"agent-{index}.json"
     trace = TraceWriter(options.results / f"trace-{index}.jsonl", index)

@@ -22,9 +22,10 @@ on a perfect network a dependent hears it exactly when it would from states
 sent to everyone); a robot that waits for a peer's move sends its own state to
 that peer every step, and a peer that hears from a dependent still waiting for
 a move it has completed answers with its state (*pull*: a lost push is made up
-within a step of the next heard request). It answers a dependent waiting for a
-move it has not made yet too, so that a robot that waits hears from the robot it
-waits for at every pull, and does not take it for crashed (below).
+within a step of the next heard request). Under a driver that takes silent
+robots for crashed (live), it answers a dependent waiting for a move it has not
+made yet too (``answer_all_pulls``), so that a robot that waits hears from the
+robot it waits for at every pull and does not take it for crashed (below).
 
 The dependencies themselves are computed from the plan by
 :func:`mrmp.centralized.dependencies.action_dependencies`; this policy only
@@ -106,6 +107,9 @@ class PlanFollowingPolicy:
         simulator), so that on a perfect network the robot keeps the plan's
         waits too and its path is the planned one; late robots go as soon as
         their dependencies allow.
+    answer_all_pulls:
+        Answer the pull of a dependent waiting for a move not made yet too (module
+        docstring), for drivers with a silence timeout.
     follow_crashed:
         Wait for silent robots as for any other (the rule of Hönig et al.
         without mrmp's crash rule, module docstring): a robot crashed before a
@@ -126,6 +130,7 @@ class PlanFollowingPolicy:
         dependents: Mapping[int, Sequence[tuple[int, int]]] | None = None,
         *,
         not_before: Sequence[int] | None = None,
+        answer_all_pulls: bool = False,
         follow_crashed: bool = False,
     ) -> None:
         self.moves = list(moves)
@@ -140,6 +145,7 @@ class PlanFollowingPolicy:
         self.done = 0
         self.waits_for: list[int] = []
         self.follow_crashed = follow_crashed
+        self.answer_all_pulls = answer_all_pulls
         self._last_heard: dict[int, frozenset[Cell]] = {}
         self._waited_for = sorted({robot for needs in self.dependencies.values() for robot, _ in needs})
         self.dropped: set[int] = set()
@@ -260,7 +266,10 @@ class PlanFollowingPolicy:
         >>> policy.listeners(heard=[3, 4], progress={3: 1, 4: 6})   # 3 still waits for move 2; 4 is past it
         (3,)
         >>> policy.done = 0
-        >>> policy.listeners(heard=[3], progress={3: 0})   # 3 waits for a move not made yet: it hears the robot lives
+        >>> policy.listeners(heard=[3], progress={3: 0})   # 3 waits for a move not made yet
+        ()
+        >>> policy.answer_all_pulls = True
+        >>> policy.listeners(heard=[3], progress={3: 0})   # under a silence timeout, 3 hears that the robot lives
         (3,)
         """
         if self.dependents is None:
@@ -274,7 +283,7 @@ class PlanFollowingPolicy:
         for robot in heard:
             reached = known.get(robot, 0)
             if any(
-                reached <= move and (needed <= done or reached == move)
+                reached <= move and (needed <= done or (self.answer_all_pulls and reached == move))
                 for needed, move in self._waiting_on_me.get(robot, ())
             ):
                 robots.add(robot)
