@@ -67,6 +67,10 @@ def check_key_policy(key: bytes | None, spec: TransportSpec, warn: Callable[[str
     return b""
 
 
+CRASH_SILENCES = 2
+"""A robot following a plan takes a peer it waits for for crashed after this many silence timeouts without news
+(:mod:`mrmp.policies.plan_following`): a late process, starved of the CPU, is not taken for dead at once."""
+
 PEER_WAIT_SECONDS = 10.0
 """How long a robot whose transport connects first waits for its peers before it starts anyway."""
 
@@ -159,7 +163,8 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
     if options.plan is not None:
         moves, dependencies = read_share(options.plan, scenario.robots[index].id)
         dependents = read_share_dependents(options.plan, scenario.robots[index].id)
-        policy = PlanFollowingPolicy(moves, dependencies, dependents, answer_all_pulls=True)
+        crash_silence = CRASH_SILENCES * options.timing.silence_timeout
+        policy = PlanFollowingPolicy(moves, dependencies, dependents, answer_all_pulls=True, crash_silence=crash_silence)
     spec = scenario.robots[index]
     report_path = options.results / f"agent-{index}.json"
     trace = TraceWriter(options.results / f"trace-{index}.jsonl", index)

@@ -33,9 +33,9 @@ follows them, knowing its peers only through their messages.
 
 **Crashed robots** (this rule is mrmp's own, not Hönig et al.'s). A robot the
 next move waits for and that has fallen *silent* (not heard for the driver's
-silence timeout: :attr:`~mrmp.policies.base.PeerState.silent`) is taken for
-crashed, standing for ever on its last heard Present and Next. The robot stops
-waiting for it:
+silence timeout: :attr:`~mrmp.policies.base.PeerState.silent`; with
+``crash_silence``, not heard for that long) is taken for crashed, standing for
+ever on its last heard Present and Next. The robot stops waiting for it:
 
 * if the rest of its plan avoids those cells, it drops its dependencies on that
   robot (for as long as it stays silent) and goes on with its plan;
@@ -110,6 +110,11 @@ class PlanFollowingPolicy:
     answer_all_pulls:
         Answer the pull of a dependent waiting for a move not made yet too (module
         docstring), for drivers with a silence timeout.
+    crash_silence:
+        Take a silent robot for crashed only once it has not been heard for this
+        long (the driver's time units; None: as soon as the driver marks it
+        silent). A longer wait costs time after a real crash and spares the
+        plan's order when a late robot is only slow to speak.
     follow_crashed:
         Wait for silent robots as for any other (the rule of Hönig et al.
         without mrmp's crash rule, module docstring): a robot crashed before a
@@ -131,6 +136,7 @@ class PlanFollowingPolicy:
         *,
         not_before: Sequence[int] | None = None,
         answer_all_pulls: bool = False,
+        crash_silence: float | None = None,
         follow_crashed: bool = False,
     ) -> None:
         self.moves = list(moves)
@@ -146,6 +152,7 @@ class PlanFollowingPolicy:
         self.waits_for: list[int] = []
         self.follow_crashed = follow_crashed
         self.answer_all_pulls = answer_all_pulls
+        self.crash_silence = crash_silence
         self._last_heard: dict[int, frozenset[Cell]] = {}
         self._waited_for = sorted({robot for needs in self.dependencies.values() for robot, _ in needs})
         self.dropped: set[int] = set()
@@ -206,6 +213,10 @@ class PlanFollowingPolicy:
             self._refused.add(decision.next)
         return decision
 
+    def _crashed(self, situation: Situation, peer: PeerState) -> bool:
+        """Whether ``peer`` is taken for crashed: silent (for ``crash_silence``, when set)."""
+        return peer.silent and (self.crash_silence is None or situation.now - peer.heard_at >= self.crash_silence)
+
     def _remember(self, situation: Situation) -> None:
         """Keep the last cells heard from each robot the plan waits for while it is not silent."""
         for robot in self._waited_for:
@@ -222,7 +233,7 @@ class PlanFollowingPolicy:
         rest = set(self.moves[self.done :])
         for robot, progress in self.dependencies.get(self.done, ()):
             peer = situation.peers.get(robot)
-            if peer is None or not peer.silent or situation.progress_of(robot) >= progress:
+            if peer is None or not self._crashed(situation, peer) or situation.progress_of(robot) >= progress:
                 continue
             if rest.isdisjoint(self._crashed_cells(peer)):
                 self.dropped.add(robot)

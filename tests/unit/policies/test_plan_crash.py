@@ -121,3 +121,10 @@ def test_off_its_plan_a_cell_refused_again_and_again_is_planned_around():
     dead = situation((0, 1), (1, 2), peer(1, (0, 2), 0, silent=True))
     choices = [step(policy, dead).next for _ in range(5)]
     assert choices[:4] == [(1, 1)] * 4 and choices[4] != (1, 1)
+
+
+def test_with_a_crash_silence_a_robot_silent_for_less_is_still_waited_for():
+    policy = PlanFollowingPolicy([(0, 1), (0, 2), (0, 3)], {1: [(1, 1)]}, crash_silence=3.0)
+    dead = PeerState(1, (2, 2), (2, 2), Heading.NORTH, False, 1, heard_at=1.0, silent=True)
+    assert step(policy, situation((0, 1), (0, 3), dead, now=3.5)).next == (0, 1)
+    assert step(policy, situation((0, 1), (0, 3), dead, now=4.0)).next == (0, 2)
