@@ -164,3 +164,39 @@ def test_lacam_plan_for_sixteen_robots_with_delays_and_loss(tmp_path):
     assert result.collisions == [] and result.success, result.stop_reason
     assert result.policy == "lacam" and result.planning_time_s == plan.planning_time_s
     assert result.network["injected_lost"] > 0
+
+
+def test_killed_robot_in_a_live_plan_execution_blocks_only_the_goals_it_stands_on(tmp_path):
+    """Sixteen robots execute a LaCAM plan; robot 3 is killed early. Robots waiting for it drop it or leave the
+    plan (``mrmp.policies.plan_following``, crash rule): every robot whose goal the dead robot does not cut off
+    arrives, with no collision (the run ends when only silent robots are short of their goals)."""
+    from mrmp.centralized.registry import plan_with
+    from mrmp.core.errors import NoPathError
+    from mrmp.io import load_movingai_scenario
+    from mrmp.search.planners import astar
+
+    maps = Path(__file__).resolve().parents[2] / "maps"
+    scenario = load_movingai_scenario(maps / "random-32-32-20.map", maps / "random-32-32-20-random-1.scen", 16)
+    plan = plan_with("lacam", scenario, time_limit_s=30)
+    assert plan.solved and plan.paths is not None
+    result = live(scenario, tmp_path, time_scale=10, plan=plan, kill={"3": 2.0})
+    assert result.collisions == [], result.collisions
+    dead = result.robots[3]
+    assert not dead.arrived and "died" in result.stop_reason, result.stop_reason
+    last = dead.path[-1]
+    planned = plan.paths[3]
+    entering = planned[planned.index(last) + 1] if last in planned and planned.index(last) + 1 < len(planned) else last
+    held = {last, entering}  # its last cell, and the next one of its plan, which it may have been entering
+
+    def cut_off(robot):
+        if robot.goal in held:
+            return True
+        try:
+            astar(scenario.grid, robot.start, robot.goal, blocked=held)
+        except NoPathError:
+            return True
+        return False
+
+    expected = [robot.id for index, robot in enumerate(result.robots) if index != 3 and not cut_off(robot)]
+    assert len(expected) >= 12
+    assert [robot.id for robot in result.robots if robot.arrived] == expected, result.stop_reason

@@ -6,7 +6,9 @@
 * A *share* is what one robot receives: ``{"format": 1, "robot": id, "moves":
   [[x, y], ...], "dependencies": [[move, robot index, progress], ...]}``, its own
   moves and, for each, the progress of other robots it must wait for
-  (:mod:`mrmp.centralized.dependencies`).
+  (:mod:`mrmp.centralized.dependencies`); optionally ``"dependents": [[completed
+  moves, robot index, move], ...]``, the moves of others that wait for its
+  progress (whom its states must reach).
 
 Plans are written from anything shaped like a planner's answer (:class:`Plan`:
 a :class:`mrmp.centralized.plan.PlanningResult` is one) and read back as a
@@ -107,19 +109,43 @@ def read_plan(path: PathLike, robot_ids: Sequence[str]) -> PlanFile:
     return PlanFile("solved", paths, seconds, planner)
 
 
+def _rows(table: Mapping[int, Sequence[tuple[int, int]]]) -> list[list[int]]:
+    return [[key, robot, value] for key, pairs in sorted(table.items()) for robot, value in pairs]
+
+
+def _table(rows: object) -> dict[int, list[tuple[int, int]]]:
+    table: dict[int, list[tuple[int, int]]] = {}
+    for key, robot, value in rows:  # type: ignore[attr-defined]
+        table.setdefault(int(key), []).append((int(robot), int(value)))
+    return table
+
+
 def write_share(
-    path: PathLike, robot_id: str, moves: Sequence[Cell], dependencies: Mapping[int, Sequence[tuple[int, int]]]
+    path: PathLike,
+    robot_id: str,
+    moves: Sequence[Cell],
+    dependencies: Mapping[int, Sequence[tuple[int, int]]],
+    dependents: Mapping[int, Sequence[tuple[int, int]]] | None = None,
 ) -> None:
-    """Write one robot's share of a plan, atomically.
+    """Write one robot's share of a plan, atomically (with its dependents, when given).
 
     >>> import tempfile, pathlib
     >>> path = pathlib.Path(tempfile.mkdtemp()) / "plan-A.json"
     >>> write_share(path, "A", [(0, 1), (0, 2)], {1: [(1, 1)]})
-    >>> read_share(path, "A")
-    ([(0, 1), (0, 2)], {1: [(1, 1)]})
+    >>> read_share(path, "A"), read_share_dependents(path, "A")
+    (([(0, 1), (0, 2)], {1: [(1, 1)]}), None)
+    >>> write_share(path, "A", [(0, 1), (0, 2)], {1: [(1, 1)]}, dependents={2: [(1, 0)]})
+    >>> read_share_dependents(path, "A")
+    {2: [(1, 0)]}
     """
-    rows = [[move, robot, progress] for move, needs in sorted(dependencies.items()) for robot, progress in needs]
-    data = {"format": 1, "robot": robot_id, "moves": [list(cell) for cell in moves], "dependencies": rows}
+    data: dict[str, object] = {
+        "format": 1,
+        "robot": robot_id,
+        "moves": [list(cell) for cell in moves],
+        "dependencies": _rows(dependencies),
+    }
+    if dependents is not None:
+        data["dependents"] = _rows(dependents)
     atomic_write_text(path, json.dumps(data) + "\n")
 
 
@@ -136,11 +162,25 @@ def read_share(path: PathLike, robot_id: str) -> tuple[list[Cell], dict[int, lis
         data = json.loads(read_text(path))
         owner = str(data["robot"])
         moves = [(int(cell[0]), int(cell[1])) for cell in data["moves"]]
-        dependencies: dict[int, list[tuple[int, int]]] = {}
-        for move, robot, progress in data["dependencies"]:
-            dependencies.setdefault(int(move), []).append((int(robot), int(progress)))
+        dependencies = _table(data["dependencies"])
     except (ValueError, KeyError, TypeError, IndexError, RecursionError) as error:
         raise InputError(Problem(where, f"not a robot's share of a plan: {error}")) from None
     if owner != robot_id:
         raise InputError(Problem(where, f"this share belongs to robot {owner!r}, not {robot_id!r}"))
     return moves, dependencies
+
+
+def read_share_dependents(path: PathLike, robot_id: str) -> dict[int, list[tuple[int, int]]] | None:
+    """The dependents of robot ``robot_id``'s share (None when the share does not list them).
+
+    Raises
+    ------
+    InputError
+        If the file is not a share, is another robot's, or its dependents are malformed (naming the file).
+    """
+    read_share(path, robot_id)
+    try:
+        rows = json.loads(read_text(path)).get("dependents")
+        return None if rows is None else _table(rows)
+    except (ValueError, KeyError, TypeError, IndexError, AttributeError, RecursionError) as error:
+        raise InputError(Problem(str(path), f"not a robot's share of a plan: dependents: {error}")) from None

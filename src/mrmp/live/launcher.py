@@ -163,7 +163,7 @@ def _write_run_files(scenario: Scenario, options: LiveOptions, ids: list[str]) -
         write_plan(results / "plan.json", options.plan, ids)
         for index, policy in enumerate(plan_policies(options.plan)):
             shares.append(results / f"plan-{index}.json")
-            write_share(shares[-1], ids[index], policy.moves, policy.dependencies)
+            write_share(shares[-1], ids[index], policy.moves, policy.dependencies, policy.dependents)
     key_file = results / "fleet.key"
     write_key_file(key_file, os.urandom(32).hex().encode())
     return _RunFiles(results, scenario_file, key_file, results / "done", shares)

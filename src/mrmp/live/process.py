@@ -22,7 +22,7 @@ from mrmp.core.scenario import Scenario
 from mrmp.core.seeds import Stream, derive_seed, stream_random
 from mrmp.io.lifetime import watch_parent
 from mrmp.io.live_files import TraceReader, TraceWriter, write_json
-from mrmp.io.plans import read_share
+from mrmp.io.plans import read_share, read_share_dependents
 from mrmp.live.agent import Agent, AgentReport, AgentTiming
 from mrmp.live.body import OccupancyRecorder, SimulatedBody
 from mrmp.live.causal_agent import CausalAgent
@@ -66,6 +66,10 @@ def check_key_policy(key: bytes | None, spec: TransportSpec, warn: Callable[[str
     warn("WARNING: no fleet key: messages are NOT authenticated; allowed on loopback only")
     return b""
 
+
+CRASH_SILENCES = 2
+"""A robot following a plan takes a peer it waits for for crashed after this many silence timeouts without news
+(:mod:`mrmp.policies.plan_following`): a late process, starved of the CPU, is not taken for dead at once."""
 
 PEER_WAIT_SECONDS = 10.0
 """How long a robot whose transport connects first waits for its peers before it starts anyway."""
@@ -158,7 +162,9 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
     policy = None
     if options.plan is not None:
         moves, dependencies = read_share(options.plan, scenario.robots[index].id)
-        policy = PlanFollowingPolicy(moves, dependencies)
+        dependents = read_share_dependents(options.plan, scenario.robots[index].id)
+        crash_silence = CRASH_SILENCES * options.timing.silence_timeout
+        policy = PlanFollowingPolicy(moves, dependencies, dependents, answer_all_pulls=True, crash_silence=crash_silence)
     spec = scenario.robots[index]
     report_path = options.results / f"agent-{index}.json"
     trace = TraceWriter(options.results / f"trace-{index}.jsonl", index)

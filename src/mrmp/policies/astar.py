@@ -72,6 +72,9 @@ class AstarPolicy:
         self.timing = timing or Timing()
         self._path: list[Cell] = []
         self._parked: dict[int, Cell] = {}
+        self.held: frozenset[Cell] = frozenset()
+        """Cells it always plans around: those a crashed robot may hold (its last heard Present and Next), set by
+        a policy that hands its robot over to this one (:mod:`mrmp.policies.plan_following`)."""
         self._unblocked: dict[tuple[Cell, Cell, Heading | None], tuple[Cell, ...] | None] = {}
         self.replans = 0
 
@@ -99,8 +102,9 @@ class AstarPolicy:
         present = situation.present
         if present == situation.goal:
             return present
-        if len(self._path) < 2 or self._path[0] != present or self._path[-1] != situation.goal:
-            self._path = self._plan(situation) or [present]
+        stale = len(self._path) < 2 or self._path[0] != present or self._path[-1] != situation.goal
+        if stale or not self.held.isdisjoint(self._path[1:]):
+            self._path = self._plan(situation, self.held) or [present]
         return self._path[1] if len(self._path) > 1 else present
 
     def decide(self, situation: Situation, intended: Cell) -> Decision:
@@ -121,7 +125,7 @@ class AstarPolicy:
                 return Decision(intended, "priority", conflict_ids)
             if self.resolve == "wait":
                 return Decision(present, "wait", conflict_ids)
-        avoid = frozenset(cell for peer in conflicts for cell in (peer.present, peer.next)) | parked
+        avoid = frozenset(cell for peer in conflicts for cell in (peer.present, peer.next)) | parked | self.held
         self.replans += 1
         path = self._plan(situation, blocked=avoid)
         if path is None or len(path) < 2 or path[1] in claimed_cells(situation.peers):

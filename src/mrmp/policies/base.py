@@ -151,3 +151,16 @@ def listeners(policy: object, heard: Iterable[int] = (), progress: Mapping[int, 
     """
     method = getattr(policy, "listeners", None)
     return method(heard, progress) if callable(method) else ()
+
+
+def reported_progress(policy: object, moves: int) -> int:
+    """The progress a robot's states report, having made ``moves`` moves (policy method ``reported_progress``).
+
+    A plan-following policy that has left its plan reports more than its moves,
+    so that no robot waits for it any longer; other policies report the moves.
+
+    >>> reported_progress(object(), 4)
+    4
+    """
+    method = getattr(policy, "reported_progress", None)
+    return int(method(moves)) if callable(method) else moves

@@ -51,7 +51,7 @@ from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
 from mrmp.core.heading import Heading
 from mrmp.core.scenario import RobotSpec
-from mrmp.policies.base import Decision, Policy, Situation, interaction_radius, listeners, owes_state
+from mrmp.policies.base import Decision, Policy, Situation, interaction_radius, listeners, owes_state, reported_progress
 from mrmp.protocol.messages import (
     ClaimMessage,
     HandoffMessage,
@@ -187,7 +187,8 @@ class Robot(MessageEndpoint):
 
     def state_message(self) -> StateMessage:
         """A fresh state message: Present, Next, heading, arrival and safety state."""
-        return self._state(self.present, self.intended, self.heading, self.arrived, self.progress)
+        progress = reported_progress(self.policy, self.progress)
+        return self._state(self.present, self.intended, self.heading, self.arrived, progress)
 
     # -- the step -------------------------------------------------------------------
 
