@@ -1013,8 +1013,9 @@ def referee(
 ) -> None:
     """Judge a run from the robots' ground-truth traces: as they are, or following them until told to stop."""
     from mrmp.io.lifetime import die_with_parent
-    from mrmp.live.process import run_referee, warn
+    from mrmp.live.process import run_referee, stop_on_signals, warn
 
+    stop = stop_on_signals()  # first: a stop (or its parent's end) from now on still writes the verdict
     die_with_parent()
     try:
         scenario = load_scenario(_scenario_argument(scenario_path, scenario_option), known_policies=policy_names())
@@ -1022,7 +1023,7 @@ def referee(
             raise InputError(Problem("--results", f"no such folder: {results}"))
     except InputError as error:
         raise _fail(error.problems) from None
-    collisions = run_referee(scenario, results, start_time, done_file, warn)
+    collisions = run_referee(scenario, results, start_time, done_file, warn, stop=stop)
     if done_file is None:  # by hand: say what was found (beside a live run, the launcher reports)
         found = f"{len(collisions)} collision{'' if len(collisions) == 1 else 's'}"
         Console(highlight=False).print(f"{found}; verdict written to {results / 'referee.json'}", markup=False)

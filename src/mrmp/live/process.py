@@ -75,6 +75,13 @@ PEER_WAIT_SECONDS = 10.0
 """How long a robot whose transport connects first waits for its peers before it starts anyway."""
 
 
+def stop_on_signals() -> threading.Event:
+    """An event set by SIGINT or SIGTERM (from then on neither kills the process): install it before any slow work."""
+    stop = threading.Event()
+    _on_stop_signals(stop.set)
+    return stop
+
+
 def _on_stop_signals(action: Callable[[], None]) -> None:
     for signum in (signal.SIGINT, signal.SIGTERM):
         signal.signal(signum, lambda *_: action())
@@ -210,17 +217,24 @@ def _wait_for_peers(transport: ConnectedTransport, count: int, stop: threading.E
 
 
 def run_referee(
-    scenario: Scenario, results: Path, start_time: float | None, done_file: Path | None, report: Callable[[str], None]
+    scenario: Scenario,
+    results: Path,
+    start_time: float | None,
+    done_file: Path | None,
+    report: Callable[[str], None],
+    stop: threading.Event | None = None,
 ) -> list:
     """Follow the fleet's traces until ``done_file`` appears (or a signal, or the end of its parent), reporting collisions.
 
     Without a ``done_file``, judge the traces as they are and stop. Without a
     ``start_time``, the run starts at the traces' first event (or now, when
     there is none). Writes ``referee.json``: the collisions and every robot's
-    ground-truth intervals. Returns the collisions.
+    ground-truth intervals. Returns the collisions. ``stop``: the event of
+    :func:`stop_on_signals`, when the caller installed it earlier (a signal
+    that came meanwhile then finishes the verdict at once).
     """
-    stop = threading.Event()
-    _on_stop_signals(stop.set)
+    if stop is None:
+        stop = stop_on_signals()
     watch_parent(stop.set)
     ids, starts = [robot.id for robot in scenario.robots], [robot.start for robot in scenario.robots]
     readers = [TraceReader(results / f"trace-{index}.jsonl") for index in range(len(scenario.robots))]
