@@ -24,6 +24,7 @@ from __future__ import annotations
 import time
 from collections.abc import Sequence
 from types import TracebackType
+from typing import Self
 
 from rich.console import Console
 from rich.live import Live
@@ -37,7 +38,26 @@ REFRESH_S = 0.25
 """Least time between two redraws of the line."""
 
 
-class ProgressLine:
+class _TerminalLine:
+    """One line kept up to date on a terminal while the ``with`` block runs, and cleared after it; nothing elsewhere."""
+
+    console: Console
+    live: Live | None
+
+    def __enter__(self) -> Self:
+        if self.console.is_terminal:
+            self.live = Live(Text(""), console=self.console, auto_refresh=False, transient=True)
+            self.live.__enter__()
+        return self
+
+    def __exit__(
+        self, kind: type[BaseException] | None, error: BaseException | None, trace: TracebackType | None
+    ) -> None:
+        if self.live is not None:
+            self.live.__exit__(kind, error, trace)
+
+
+class ProgressLine(_TerminalLine):
     """Ticks done (of the tick limit when the scenario sets one), robots on their goals, collisions, elapsed time.
 
     In a lifelong run goals change as robots reach them, so the line counts
@@ -62,18 +82,6 @@ class ProgressLine:
         self.shown_at = 0.0
         self.live: Live | None = None
 
-    def __enter__(self) -> ProgressLine:
-        if self.console.is_terminal:
-            self.live = Live(Text(""), console=self.console, auto_refresh=False, transient=True)
-            self.live.__enter__()
-        return self
-
-    def __exit__(
-        self, kind: type[BaseException] | None, error: BaseException | None, trace: TracebackType | None
-    ) -> None:
-        if self.live is not None:
-            self.live.__exit__(kind, error, trace)
-
     def on_tick(self, tick: int, cells: Sequence[Cell]) -> None:
         """Count tick ``tick``'s arrivals and collisions, and redraw the line if it is time."""
         self.tick = tick
@@ -95,7 +103,7 @@ class ProgressLine:
         return f"{ticks}: {arrivals}{collisions}, {elapsed:.0f} s"
 
 
-class LiveProgressLine:
+class LiveProgressLine(_TerminalLine):
     """A live run's progress on one terminal line, redrawn as the launcher reports it; nothing elsewhere.
 
     >>> from io import StringIO
@@ -109,18 +117,6 @@ class LiveProgressLine:
         self.console = console
         self.live: Live | None = None
         self.shown = ""
-
-    def __enter__(self) -> LiveProgressLine:
-        if self.console.is_terminal:
-            self.live = Live(Text(""), console=self.console, auto_refresh=False, transient=True)
-            self.live.__enter__()
-        return self
-
-    def __exit__(
-        self, kind: type[BaseException] | None, error: BaseException | None, trace: TracebackType | None
-    ) -> None:
-        if self.live is not None:
-            self.live.__exit__(kind, error, trace)
 
     def on_progress(self, progress: LiveProgress) -> None:
         """Show ``progress`` (on a terminal)."""
