@@ -10,7 +10,11 @@ mechanisms make sure of it on Linux:
   kernel sends it to the child when its parent ends. :func:`preexec_dying_with`
   sets it in the forked child *before* the child executes anything, then checks
   that the parent is still the process that forked it: a parent that died in
-  between sends no signal, so the child exits at once;
+  between sends no signal, so the child exits at once. A child that must answer
+  the signal (write what it has, then stop) can have it *held* until it installs
+  its handler (:func:`release_held_signals`): a signal blocked by the forked
+  child stays pending through ``exec`` and Python's start-up, instead of
+  killing a process that had no handler yet;
 * a **watch on the parent** (:func:`watch_parent`): a daemon thread waits on a
   pidfd of the parent (pidfd_open(2): readable once the process has ended) and
   then calls back, so that a process that handles the signal, or started before
@@ -53,21 +57,38 @@ def die_with_parent(signum: int = signal.SIGTERM) -> bool:
     return int(_PRCTL(_PR_SET_PDEATHSIG, int(signum), 0, 0, 0)) == 0
 
 
-def preexec_dying_with(signum: int = signal.SIGTERM, parent: int | None = None) -> Callable[[], None]:
+STOP_SIGNALS = frozenset({signal.SIGINT, signal.SIGTERM})
+"""The signals that ask a process to stop: a child started with ``hold=True`` gets them once it can answer them."""
+
+
+def preexec_dying_with(signum: int = signal.SIGTERM, parent: int | None = None, hold: bool = False) -> Callable[[], None]:
     """A ``preexec_fn`` for :class:`subprocess.Popen`: the child gets ``signum`` when ``parent`` (default: this process) ends.
 
     The function runs in the forked child before the new program: it sets the
     parent-death signal, then exits the child at once (status 1) if the parent
-    is already gone, since no signal would ever come then.
+    is already gone, since no signal would ever come then. With ``hold``, the
+    child starts with :data:`STOP_SIGNALS` blocked: they wait, pending, until
+    the child calls :func:`release_held_signals` after installing its handlers
+    (a child that never does is stopped only by SIGKILL).
     """
     expected = os.getpid() if parent is None else parent
 
     def bind_to_parent() -> None:
+        if hold:
+            signal.pthread_sigmask(signal.SIG_BLOCK, STOP_SIGNALS)
         die_with_parent(signum)
         if os.getppid() != expected:
             os._exit(1)
 
     return bind_to_parent
+
+
+def release_held_signals() -> None:
+    """Deliver the stop signals held since the start (``preexec_dying_with(hold=True)``) to the handlers now installed.
+
+    >>> release_held_signals()  # nothing held: nothing happens
+    """
+    signal.pthread_sigmask(signal.SIG_UNBLOCK, STOP_SIGNALS)
 
 
 def watch_parent(on_gone: Callable[[], None], parent: int | None = None, period: float = 0.1) -> threading.Thread:

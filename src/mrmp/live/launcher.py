@@ -170,8 +170,12 @@ def _write_run_files(scenario: Scenario, options: LiveOptions, ids: list[str]) -
 
 
 def _start(command: list[str]) -> subprocess.Popen[bytes]:
-    """Start ``command`` in its own session, bound to this process's life (:mod:`mrmp.io.lifetime`)."""
-    return subprocess.Popen(command, start_new_session=True, preexec_fn=preexec_dying_with())
+    """Start ``command`` in its own session, bound to this process's life (:mod:`mrmp.io.lifetime`).
+
+    Its stop signals are held until it has its handlers: a launcher killed
+    while the referee is still starting Python still gets its verdict written.
+    """
+    return subprocess.Popen(command, start_new_session=True, preexec_fn=preexec_dying_with(hold=True))
 
 
 def _start_fleet(options: LiveOptions, files: _RunFiles, layout: FleetLayout, session: int, timeout: float) -> _Fleet:

@@ -20,7 +20,7 @@ from pathlib import Path
 from mrmp.core.errors import InputError, Problem
 from mrmp.core.scenario import Scenario
 from mrmp.core.seeds import Stream, derive_seed, stream_random
-from mrmp.io.lifetime import watch_parent
+from mrmp.io.lifetime import STOP_SIGNALS, release_held_signals, watch_parent
 from mrmp.io.live_files import TraceReader, TraceWriter, write_json
 from mrmp.io.plans import read_share, read_share_dependents
 from mrmp.live.agent import Agent, AgentReport, AgentTiming
@@ -83,8 +83,10 @@ def stop_on_signals() -> threading.Event:
 
 
 def _on_stop_signals(action: Callable[[], None]) -> None:
-    for signum in (signal.SIGINT, signal.SIGTERM):
+    """Call ``action`` on SIGINT or SIGTERM, including one the launcher's start held until now (:mod:`mrmp.io.lifetime`)."""
+    for signum in STOP_SIGNALS:
         signal.signal(signum, lambda *_: action())
+    release_held_signals()
 
 
 @dataclass(frozen=True)

@@ -30,12 +30,12 @@ def wait_until_ended(pids):
     return [pid for pid in pids if not ended(pid)]
 
 
-def parent_with_a_child(child_code, tmp_path):
+def parent_with_a_child(child_code, tmp_path, hold=False):
     """A Python process that starts ``python -c child_code`` bound to it, prints the child's pid, and waits for ever."""
     parent_code = textwrap.dedent(f"""
         import subprocess, sys, time
         from mrmp.io.lifetime import preexec_dying_with
-        child = subprocess.Popen([sys.executable, "-c", {child_code!r}], preexec_fn=preexec_dying_with(),
+        child = subprocess.Popen([sys.executable, "-c", {child_code!r}], preexec_fn=preexec_dying_with(hold={hold!r}),
                                  cwd={str(tmp_path)!r})
         print(child.pid, flush=True)
         time.sleep(3600)
@@ -79,3 +79,37 @@ def test_a_child_that_ignores_the_signal_still_notices_that_its_parent_is_gone(t
     parent.wait()
     assert wait_until_ended([child]) == []
     assert (tmp_path / "noticed").exists()
+
+
+SLOW_STARTER = textwrap.dedent("""
+    import signal, time
+    from pathlib import Path
+    from mrmp.io.lifetime import release_held_signals
+    Path("starting").touch()
+    while not Path("go").exists():  # still starting: no handler yet
+        time.sleep(0.01)
+    signal.signal(signal.SIGTERM, lambda *_: Path("answered").touch())
+    release_held_signals()
+""")
+"""A child that installs its SIGTERM handler only once told to, then answers a held signal by writing a file."""
+
+
+def kill_the_parent_of_a_slow_starter(tmp_path, hold):
+    parent, child = parent_with_a_child(SLOW_STARTER, tmp_path, hold=hold)
+    deadline = time.monotonic() + PATIENCE
+    while not (tmp_path / "starting").exists() and time.monotonic() < deadline:
+        time.sleep(0.02)
+    os.kill(parent.pid, signal.SIGKILL)
+    parent.wait()
+    (tmp_path / "go").touch()
+    assert wait_until_ended([child]) == []
+
+
+def test_a_child_that_holds_its_stop_signals_answers_a_parent_death_that_came_before_its_handler(tmp_path):
+    kill_the_parent_of_a_slow_starter(tmp_path, hold=True)
+    assert (tmp_path / "answered").exists()
+
+
+def test_without_holding_a_parent_death_during_start_up_kills_the_child_before_it_can_answer(tmp_path):
+    kill_the_parent_of_a_slow_starter(tmp_path, hold=False)
+    assert not (tmp_path / "answered").exists()
