@@ -126,12 +126,17 @@ class LocalPibtRobot(PibtRobot):
         self._finishing: bool | None = None
         self._lost = False
         self._done = False
+        self.stalled = 0
+        self.reach = radius
 
     # -- the step ------------------------------------------------------------------
 
     def begin_step(self, step: int) -> list[Outgoing]:
         """Start step ``step``: forget the last step's view, announce cell, goal and priority; act next round."""
         out = super().begin_step(step)
+        reach = self.reach = min(self.radius + max(0, self.stalled - self.stall_slack), max(self.radius, self.reach_cap))
+        if reach != self.radius:
+            out = [Outgoing(item.message, None, reach) for item in out]
         self._ranks = {}
         self._near = []
         self._final = set()
@@ -158,12 +163,16 @@ class LocalPibtRobot(PibtRobot):
     def receive_beacons(self, beacons: list[BeaconMessage]) -> None:
         """Take in beacons: cells, goals and priorities; note the robots within 2 cells."""
         super().receive_beacons(beacons)
-        x, y = self.flat.cells[self.present]
+        ranks, near = self._ranks, self._near
         for message in beacons:
-            self._ranks[message.sender] = (message.elapsed, message.tie, -message.sender)
-            px, py = message.present
-            if abs(px - x) + abs(py - y) <= self.radius:
-                self._near.append(message.sender)
+            sender = message.sender
+            ranks[sender] = (message.elapsed, message.tie, -sender)
+            near.append(sender)  # the radio brings a beacon only within its sender's reach
+
+    reach_cap = 8
+    """The largest reach a stalled robot's beacon and final reservation grow to (cells)."""
+    stall_slack = 2
+    """Steps a robot may stall before its reach grows beyond ``radius`` (one cell per further step)."""
 
     rotations = True
     """Take the cell of a robot busy in the robot's own call (PIBT's rotations): safe when every call ends in its step."""
@@ -292,7 +301,11 @@ class LocalPibtRobot(PibtRobot):
         if not self._done:
             self.stats["abandoned"] += 1
             self.target = None
-        return super().finish_step()
+        distances = self.flat.distances(self.goal)
+        before = distances[self.present]
+        cell = super().finish_step()
+        self.stalled = 0 if cell == self.goal or distances[cell] < before else self.stalled + 1
+        return cell
 
     # -- PIBT's call, by messages -------------------------------------------------------
 
@@ -307,7 +320,7 @@ class LocalPibtRobot(PibtRobot):
         self.seq += 1
         root, (elapsed, tie, _) = self._root, self._rank
         message = CallReserveMessage(self.index, self.seq, self.step, self.flat.cells[cell], root, elapsed, tie, final)
-        out.append(Outgoing(message, None, self.radius if final else RESERVE_RADIUS))
+        out.append(Outgoing(message, None, self.reach if final else RESERVE_RADIUS))
 
     def _continue(self, out: list[Outgoing]) -> None:
         here = self.present

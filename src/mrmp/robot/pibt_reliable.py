@@ -157,7 +157,7 @@ class ReliablePibtRobot(LocalPibtRobot):
         if not self._beacon_heard() and now - self._beacon_sent_at >= self.retry:
             self._beacon_sent_at = now
             self.stats["retransmissions"] += 1
-            out.append(Outgoing(self._beacon(), None, self.radius))
+            out.append(Outgoing(self._beacon(), None, self.reach))
         for entry in self._unacknowledged.values():
             if entry.pending and now - entry.sent_at >= self.retry:
                 entry.sent_at = now
