@@ -128,12 +128,14 @@ class LocalPibtRobot(PibtRobot):
         self._done = False
         self.stalled = 0
         self.reach = radius
+        self._before = 0.0  # distance to the goal at the start of the step
 
     # -- the step ------------------------------------------------------------------
 
     def begin_step(self, step: int) -> list[Outgoing]:
         """Start step ``step``: forget the last step's view, announce cell, goal and priority; act next round."""
         out = super().begin_step(step)
+        self._before = self.flat.distances(self.goal)[self.present]
         reach = self.reach = min(self.radius + max(0, self.stalled - self.stall_slack), max(self.radius, self.reach_cap))
         if reach != self.radius:
             out = [Outgoing(item.message, None, reach) for item in out]
@@ -301,10 +303,9 @@ class LocalPibtRobot(PibtRobot):
         if not self._done:
             self.stats["abandoned"] += 1
             self.target = None
-        distances = self.flat.distances(self.goal)
-        before = distances[self.present]
         cell = super().finish_step()
-        self.stalled = 0 if cell == self.goal or distances[cell] < before else self.stalled + 1
+        distance = self.flat.distances(self.goal)[cell]
+        self.stalled = 0 if cell == self.goal or distance < self._before else self.stalled + 1
         return cell
 
     # -- PIBT's call, by messages -------------------------------------------------------
