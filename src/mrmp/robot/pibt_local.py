@@ -12,14 +12,20 @@ then acts):
 1. every robot broadcasts its beacon (cell, goal, priority) to the robots
    within its radio radius (at least 2 cells);
 2. a robot that has not decided and was not asked to decide *starts its own
-   call* (it becomes a *root*) in the first round in which every robot within
-   its radio radius that has a higher priority has decided for good (its final
-   reservation reaches that far), and no robot within 2 cells is in the middle
-   of a call (it holds a provisional reservation). Everything a call reads
-   lies within 2 cells of the robots it reaches, and a call reaches robots
-   only through their neighbours, so this is the local form of "the
-   highest-priority robot that has not decided starts" (exactly that when the
-   radius covers the map);
+   call* (it becomes a *root*) in the first round in which every robot whose
+   beacon it heard and that has a higher priority has decided for good (its
+   final reservation reaches as far as its beacon), and no robot within 2
+   cells is in the middle of a call (it holds a provisional reservation).
+   Everything a call reads lies within 2 cells of the robots it reaches, and a
+   call reaches robots only through their neighbours, so this is the local form
+   of "the highest-priority robot that has not decided starts" (exactly that
+   when the radius covers the map). A beacon reaches the robot's *reach*: the
+   radio radius, grown by one cell for every step beyond ``stall_slack`` that
+   the robot has *stalled* (ended a step no nearer its goal, away from it), up
+   to ``reach_cap`` cells. So the robots around a robot that is stuck wait for
+   its call, which then pushes them in the order central PIBT would, farther
+   than 2 cells; a robot that advances keeps the radio radius. The cap bounds
+   what one robot sends in a step independently of the number of robots;
 3. an asked robot (priority inheritance, :class:`CallInheritMessage`) decides
    at once, within the call of the robot that asked (its *root*), as in PIBT;
 4. a reservation (:class:`CallReserveMessage`, to every robot within 2
@@ -41,7 +47,8 @@ Counted by the robot itself (:attr:`LocalPibtRobot.stats`): ``waits`` (rounds
 in which it could not start yet), ``withdrawn`` (reservations lost to a call
 of higher priority), ``refused`` (requests refused because it was busy),
 ``passed_busy`` (cells passed by because their occupant was busy in another
-call) and ``abandoned`` (steps it ended undecided).
+call) and ``abandoned`` (steps it ended undecided); :attr:`LocalPibtRobot.stalled`
+and :attr:`LocalPibtRobot.reach` are its stall count and this step's reach.
 
 Examples
 --------

@@ -19,10 +19,14 @@ radio, a network and a clock:
 
 Nobody sorts the robots, finds their groups or waits for them to finish: the
 order of calls is the robots' own (``docs/protocol.md``, "Local sequencing").
-Only a perfect network is run: the one-round provisional reservation rests on
-every round's messages arriving in that round (a lossy or slow network is
-refused with a one-line error; ``pibt``'s default, sequenced driver,
-:mod:`mrmp.sim.rounds`, runs those).
+
+Over a network that loses, delays, duplicates or reorders, the one-round
+provisional reservation no longer holds (a round's messages may not arrive in
+that round), so the robots are :class:`~mrmp.robot.pibt_reliable.ReliablePibtRobot`
+brains, which acknowledge and retransmit themselves; the clock then gives every
+step ``step_ticks`` ticks (by default :data:`STEP_RETRIES` retry intervals of
+``2 * delay_max + 1`` ticks), after which the robots that decided for good move
+(``docs/protocol.md``, "Over a faulty network").
 
 Deterministic for a seed.
 
@@ -69,10 +73,13 @@ class LocalRoundsSimulator(RoundsSimulator):
 
     Parameters are those of :class:`~mrmp.sim.rounds.RoundsSimulator`.
 
+    ``step_ticks`` (faulty networks only; None for the default) is the length
+    of a step in ticks.
+
     Raises
     ------
     InputError
-        If the scenario's network is not perfect.
+        If ``step_ticks`` is below 1.
     """
 
     robot_type = LocalPibtRobot
