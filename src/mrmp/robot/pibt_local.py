@@ -135,6 +135,7 @@ class LocalPibtRobot(PibtRobot):
         self._done = False
         self.stalled = 0
         self.reach = radius
+        self._y_size = flat.y_size
         self._before = 0.0  # distance to the goal at the start of the step
 
     # -- the step ------------------------------------------------------------------
@@ -196,20 +197,21 @@ class LocalPibtRobot(PibtRobot):
     @informing.on(CallReserveMessage)
     def _take_call_reservation(self, message: CallReserveMessage) -> bool:
         sender = message.sender
-        cell = self.flat.index(message.cell)
+        x, y = message.cell
+        cell = x * self._y_size + y  # the flat index (FlatGrid.index), inlined: this runs for every reservation heard
         reserved, targets = self._reserved, self._targets
         old = targets.get(sender)
         if old is not None and old != cell and reserved.get(old) == sender:
             del reserved[old]  # a reservation replaced (after a lost conflict or backtracking)
         targets[sender] = cell
-        self._claims[sender] = message.rank
+        rank = self._claims[sender] = (message.root_elapsed, message.root_tie, -message.root)
         if message.final:
             self._final.add(sender)
             self._calls.pop(sender, None)
         else:
             self._calls[sender] = message.root
         if cell == self.target and not self._confirmed and sender != self.index:
-            if cell != self.present and (message.final or message.rank > self._rank):
+            if cell != self.present and (message.final or rank > self._rank):
                 self._lost = True  # a call of higher priority reserved it in the same round: withdraw
                 reserved[cell] = sender
             else:

@@ -50,7 +50,7 @@ from mrmp.core.errors import InputError
 from mrmp.core.result import RunResult
 from mrmp.core.scenario import Scenario
 from mrmp.protocol.codec import decode, encode
-from mrmp.protocol.messages import Message, PibtMessage
+from mrmp.protocol.messages import BeaconMessage, Message, PibtMessage
 from mrmp.robot.messaging import Outgoing
 from mrmp.robot.pibt_local import LocalPibtRobot
 from mrmp.robot.pibt_reliable import ReliablePibtRobot
@@ -152,6 +152,15 @@ class LocalRoundsSimulator(RoundsSimulator):
                 sent_bytes += size
                 if hearers:
                     due.append((hearers, item.message))
+        if due and all(type(message) is BeaconMessage for _, message in due):
+            heard: list[list[BeaconMessage]] = [[] for _ in robots]  # the beacon round, one call per recipient
+            for hearers, message in due:
+                for recipient in hearers:
+                    heard[recipient].append(message)  # type: ignore[arg-type]
+            for robot, beacons in zip(robots, heard):
+                if beacons:
+                    robot.receive_beacons(beacons)
+            due = []
         woken = [robot.index for robot in robots if robot.wake]
         rounds = 0
         while due or woken:
