@@ -307,3 +307,15 @@ def test_the_reach_grows_one_cell_per_stalled_step_after_the_slack_up_to_the_cap
             assert robot.reach == min(robot.radius + max(0, before - robot.stall_slack), robot.reach_cap)
             seen.add(robot.reach)
     assert {2, 3, LocalPibtRobot.reach_cap} <= seen
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_handing_messages_over_equals_sending_them_encoded_through_the_network(seed):
+    class Encoded(LocalRoundsSimulator):
+        encode_perfect = True
+
+    for scenario in (crowd(seed), dead_ends(*DEAD_ENDS[seed % len(DEAD_ENDS)], max_ticks=40)):
+        handed, encoded = LocalRoundsSimulator(scenario).run(), Encoded(scenario).run()
+        assert [robot.path for robot in handed.robots] == [robot.path for robot in encoded.robots]
+        assert [robot.bytes_sent for robot in handed.robots] == [robot.bytes_sent for robot in encoded.robots]
+        assert handed.network == encoded.network
