@@ -22,7 +22,7 @@ steps themselves.
 ``--scale`` runs every map and N of ``bench/pibt_scale.py`` (every instance:
 each ``-random-*.scen``, or its seeded random instances; the thesis
 scenarios first) instead of ``--only``. ``--reach-cap`` and ``--stall-slack``
-set how far a stalled robot's reach grows
+set how far a stalled robot's reach grows over a perfect network
 (:attr:`~mrmp.robot.pibt_local.LocalPibtRobot.reach_cap`,
 :attr:`~mrmp.robot.pibt_local.LocalPibtRobot.stall_slack`); ``--order``
 runs one order only.

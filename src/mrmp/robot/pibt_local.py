@@ -222,11 +222,7 @@ class LocalPibtRobot(PibtRobot):
             reserved[cell] = sender  # two claims of one cell in one round: the winner holds it, as the robots decide
         # a robot waiting to start reconsiders when a robot it may have waited for decided for good (a provisional
         # reservation, or the final one of a robot it did not wait for, cannot let it start)
-        return (
-            self.target is None
-            and message.final
-            and (old is not None or self._ranks.get(sender, (-1, 0, 0)) > self.priority)
-        )
+        return self.target is None and message.final and (old is not None or self._ranks.get(sender, (-1, 0, 0)) > self.priority)
 
     def _outranks(self, claimant: int, holder: int, cell: int) -> bool:
         """Whether ``claimant``'s claim of ``cell`` beats ``holder``'s: staying on one's cell first, then the call's rank."""

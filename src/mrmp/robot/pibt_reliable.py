@@ -25,7 +25,9 @@ acknowledged its messages):
   lower priority withdraws, as in synchronous rounds;
 * a call never takes the cell of a robot busy in the same call (no
   rotations): a step can end before such a call has finished, and the robot
-  whose cell was taken would then stay.
+  whose cell was taken would then stay;
+* the reach of a stalled robot does not grow (``reach_cap`` 0): the beacon
+  and the final reservation go to the radio radius only.
 
 The step ends at a tick the driver's clock fixes for everyone; a robot that
 has decided for good moves, any other stays (an abandoned step, counted).
@@ -97,6 +99,11 @@ class ReliablePibtRobot(LocalPibtRobot):
     """
 
     rotations = False
+
+    reach_cap = 0
+    """The reach stays the radio radius: only robots within 2 cells acknowledge a final reservation, so a robot
+    farther away that waited for it could wait in vain for the rest of the step (and an abandoned step, counted
+    as a stall, would widen the reach further)."""
 
     def __init__(
         self,
