@@ -45,6 +45,8 @@ Examples
 from __future__ import annotations
 
 from collections import Counter
+from collections.abc import Callable, Sequence
+from typing import Any
 
 from mrmp.core.errors import InputError
 from mrmp.core.result import RunResult
@@ -66,6 +68,21 @@ STEP_RETRIES = 8
 
 ROBOT_COUNTS = ("waits", "withdrawn", "refused", "passed_busy", "abandoned", "acks", "retransmissions")
 """What the robots count themselves, reported in the result's ``network``."""
+
+
+def _take_in(batch: list[tuple[int, int, bytes]], receivers: Sequence[Callable[[Any], bool]], acting: dict[int, None]) -> None:
+    """Decode every datagram of ``batch`` (once per payload) and hand it to its recipient's receiver.
+
+    The recipients whose receiver asks to act (returns True) are added to ``acting``, in order.
+    """
+    decoded: dict[int, Message] = {}
+    for _, recipient, payload in batch:
+        message = decoded.get(id(payload))
+        if message is None:
+            message = decoded[id(payload)] = decode(payload)
+            assert isinstance(message, PibtMessage), "a PIBT robot sends PIBT messages"
+        if receivers[recipient](message):
+            acting[recipient] = None
 
 
 class LocalRoundsSimulator(RoundsSimulator):
@@ -222,13 +239,7 @@ class LocalRoundsSimulator(RoundsSimulator):
                 break
             rounds += 1
             acting = dict.fromkeys(woken)
-            decoded: dict[int, Message] = {}
-            for _, recipient, payload in batch:
-                message = decoded.get(id(payload))
-                if message is None:
-                    message = decoded[id(payload)] = decode(payload)
-                if receivers[recipient](message):
-                    acting[recipient] = None
+            _take_in(batch, receivers, acting)
             woken = []
             for index in acting:
                 robot = robots[index]
@@ -272,20 +283,14 @@ class LocalRoundsSimulator(RoundsSimulator):
         robots = self.robots
         network = self.network
         send = self._send
+        receivers = [robot.receive for robot in robots]  # checks for stale messages and second copies
         while True:
             batch = network.deliver(now)
             if not batch:
                 return
             self.stats["rounds"] += 1
             acting: dict[int, None] = {}
-            decoded: dict[int, Message] = {}
-            for _, recipient, payload in batch:
-                message = decoded.get(id(payload))
-                if message is None:
-                    message = decoded[id(payload)] = decode(payload)
-                assert isinstance(message, PibtMessage), "a PIBT robot sends PIBT messages"
-                if robots[recipient].receive(message):
-                    acting[recipient] = None
+            _take_in(batch, receivers, acting)
             for index in acting:
                 for item in robots[index].act():
                     send(index, item, now)
