@@ -196,6 +196,8 @@ class LocalPibtRobot(PibtRobot):
 
     @informing.on(CallReserveMessage)
     def _take_call_reservation(self, message: CallReserveMessage) -> bool:
+        if self._done:
+            return False  # decided for good: nothing it hears can change its cell, and the next step forgets it all
         sender = message.sender
         x, y = message.cell
         cell = x * self._y_size + y  # the flat index (FlatGrid.index), inlined: this runs for every reservation heard
