@@ -190,6 +190,10 @@ class SafetyLayer:
         end of the tick in which its claim won its majority (the lockstep
         simulator); bodies that cover both cells while they move keep the
         default, under which a cell is registered anew only once released.
+    resend_refused:
+        Under ``following``, send a refused claim again in the step's second
+        round (:meth:`resend_claim`), in case the grant a replica gave on a
+        handoff was lost; False on a network that loses nothing.
     """
 
     def __init__(
@@ -201,6 +205,7 @@ class SafetyLayer:
         replicas: int = REPLICAS,
         keep_releases: bool = True,
         following: bool = False,
+        resend_refused: bool = True,
     ) -> None:
         self.index = index
         self.fleet_size = len(starts)
@@ -210,6 +215,7 @@ class SafetyLayer:
         self.retry_interval = retry_interval
         self.keep_releases = keep_releases
         self.following = following
+        self.resend_refused = resend_refused
         self.present_handed_off = False
         self.present: Cell = starts[index]
         self.present_claim = 0
@@ -352,7 +358,7 @@ class SafetyLayer:
         pending = self.pending
         if pending is None or pending.committed or len(pending.votes) >= self.quorum:
             return []
-        if pending.refused and not self.following:
+        if pending.refused and not (self.following and self.resend_refused):
             return []
         if now - pending.sent_at < self.retry_interval:
             return []

@@ -107,6 +107,25 @@ class Robot(MessageEndpoint):
         leaves in the same tick; :class:`~mrmp.protocol.safety.SafetyLayer`),
         for drivers that move every allowed robot at once, at the end of the
         tick (the lockstep simulator). Live bodies keep the default.
+    state_refresh:
+        Send a state that has not changed only every this many steps (None: every
+        step). A changed state (Present, Next, heading, arrival or progress) goes
+        out at once, to ``state_radius`` plus one cell when the robot has moved
+        (so that every robot that knew it where it was hears that it left); a
+        robot that kept its state to itself answers at once a peer that has just
+        come within ``state_radius`` (it has not heard it yet); a named state
+        (a plan's listeners) goes again to a peer only when it differs from the
+        one the peer got in the last ``state_refresh`` steps; and the robot
+        forgets the peers last known beyond ``state_radius``, or not heard for
+        ``knowledge_lease`` plus ``state_refresh``. For drivers with steps and
+        a radio (the lockstep simulator); on a perfect network the policy's view
+        is the same as with states every step (``docs/protocol.md``, "What it
+        costs"). Needs ``state_radius`` and ``knowledge_lease``.
+    lossy:
+        Whether the network may lose messages: a robot that has just moved then
+        repeats its state to the peers waiting for it within the step
+        (:meth:`retry`), and a refused claim is sent again in the step's second
+        round. Drivers of a perfect network say False: nothing is lost to make up for.
     """
 
     def __init__(
@@ -123,11 +142,17 @@ class Robot(MessageEndpoint):
         state_radius: int | None = None,
         knowledge_lease: float | None = None,
         following: bool = False,
+        state_refresh: int | None = None,
+        lossy: bool = True,
     ) -> None:
+        if state_refresh is not None and (state_refresh < 1 or state_radius is None or knowledge_lease is None):
+            raise ValueError("a state refresh needs a positive period, a state radius and a knowledge lease")
         self.id = spec.id
         self.silence_timeout = silence_timeout
         self.state_radius = state_radius
         self.knowledge_lease = knowledge_lease
+        self.state_refresh = state_refresh
+        self.lossy = lossy
         self.now = 0.0
         self.index = index
         self.goal = spec.goal
@@ -149,12 +174,17 @@ class Robot(MessageEndpoint):
             retry_interval=retry_interval,
             keep_releases=guarded,
             following=following and guarded,
+            resend_refused=lossy,
         )
         self.seq = 0
         self.progress = 0
         self.dropped: Counter[str] = Counter()
         self.last_decision: Decision | None = None
         self._repeat_state: Cell | None = None  # the cell just left, until the state is repeated
+        self._sent: tuple[object, ...] | None = None  # what the last radius broadcast of the state said
+        self._sent_at = -float("inf")
+        self._broadcast = False  # whether this step's state went to the radius
+        self._told: dict[int, tuple[float, tuple[object, ...]]] = {}  # named states: when, and what they said
 
     @property
     def arrived(self) -> bool:
@@ -163,10 +193,16 @@ class Robot(MessageEndpoint):
 
     def situation(self) -> Situation:
         """The robot's state and beliefs at the time of its last step, as its policy sees them."""
-        peers = self.belief.peers
         radius = interaction_radius(self.policy)
         if self.knowledge_lease is not None:
-            self.belief.forget_before(self.now - self.knowledge_lease)
+            if self.state_refresh is None:
+                self.belief.forget_before(self.now - self.knowledge_lease)
+            else:
+                self.belief.forget_before(self.now - self.knowledge_lease - self.state_refresh)
+                assert self.state_radius is not None
+                self.belief.forget_beyond(self.present, self.state_radius)
+        peers = self.belief.peers
+        if self.knowledge_lease is not None:
             if radius is not None:
                 x, y = self.present
                 peers = {
@@ -205,8 +241,48 @@ class Robot(MessageEndpoint):
             return [Outgoing(self.state_message())]
         heard, self._heard_since = self._heard_since, set()
         self._answered.clear()
-        extra = tuple(listeners(self.policy, heard, self.belief.progress))
-        return [Outgoing(self.state_message(), extra, self.state_radius)]
+        if self.state_refresh is None:
+            extra = tuple(listeners(self.policy, heard, self.belief.progress))
+            return [Outgoing(self.state_message(), extra, self.state_radius)]
+        return self._announce_changes(now, heard)
+
+    def _fingerprint(self) -> tuple[object, ...]:
+        """What a peer's view of this robot holds: Present, Next, heading, arrival and reported progress."""
+        return (self.present, self.intended, self.heading, self.arrived, reported_progress(self.policy, self.progress))
+
+    def _announce_changes(self, now: float, heard: set[int]) -> list[Outgoing]:
+        """The step's state under a refresh period: to the radius when it changed or is due, to named peers when new.
+
+        A robot that has moved sends it one cell further than the state radius:
+        a peer that kept it in view stood within the radius of the cell it left.
+        """
+        assert self.state_radius is not None and self.state_refresh is not None
+        fingerprint = self._fingerprint()
+        sent = self._sent
+        due = now - self._sent_at >= self.state_refresh
+        self._broadcast = sent != fingerprint or due
+        named = [
+            robot
+            for robot in listeners(self.policy, heard, self.belief.progress)
+            if not self._recently_told(robot, fingerprint, now)
+        ]
+        if not self._broadcast and not named:
+            return []
+        message = self.state_message()
+        for robot in named:
+            self._told[robot] = (now, fingerprint)
+        if not self._broadcast:
+            return [Outgoing(message, tuple(named))]
+        moved = sent is not None and sent[0] != self.present
+        radius = self.state_radius + 1 if moved and self.state_radius > 0 else self.state_radius
+        self._sent, self._sent_at = fingerprint, now
+        return [Outgoing(message, tuple(named), radius)]
+
+    def _recently_told(self, robot: int, fingerprint: tuple[object, ...], now: float) -> bool:
+        """Whether ``robot`` got this very state by name within the refresh period."""
+        told = self._told.get(robot)
+        assert self.state_refresh is not None
+        return told is not None and told[1] == fingerprint and now - told[0] < self.state_refresh
 
     def decide(self, now: float) -> list[Outgoing]:
         """Apply the policy; when guarded, return the claim for the chosen cell."""
@@ -236,6 +312,8 @@ class Robot(MessageEndpoint):
         sends: list[Outgoing] = []
         if not self.guarded:
             return sends  # the thesis's robots as written send their state once a step
+        if self._repeat_state is not None and not self.lossy:
+            self._repeat_state = None  # nothing was lost: the peers waiting for it heard its state this step
         if self._repeat_state is not None:
             cells = (self._repeat_state, self.present)
             self._repeat_state = None
@@ -291,14 +369,35 @@ class Robot(MessageEndpoint):
 
     @handlers.on(StateMessage)
     def _take_state(self, message: StateMessage, now: float) -> list[Outgoing]:
-        self.belief.update(message, now)
+        sender = message.sender
+        was_near = self._near(sender)
+        if not self.belief.update(message, now) and self.state_refresh is not None:
+            return []
         if self.state_radius is None:
             return []
-        self._heard_since.add(message.sender)
-        if message.sender not in self._answered and owes_state(self.policy, message.sender, message.progress):
-            self._answered.add(message.sender)  # once a step: two robots waiting on each other do not ping-pong
-            return [Outgoing(self.state_message(), (message.sender,))]  # a pull answered within the step
+        self._heard_since.add(sender)
+        if sender in self._answered:
+            return []  # once a step: two robots waiting on each other do not ping-pong
+        if owes_state(self.policy, sender, message.progress):
+            if self.state_refresh is not None and self._recently_told(sender, self._fingerprint(), now):
+                return []  # it has this state already, unless it was lost: its next pull, a period on, asks again
+            self._answered.add(sender)
+            if self.state_refresh is not None:
+                self._told[sender] = (now, self._fingerprint())
+            return [Outgoing(self.state_message(), (sender,))]  # a pull answered within the step
+        if self.state_refresh is not None and not self._broadcast and not was_near and self._near(sender):
+            self._answered.add(sender)
+            return [Outgoing(self.state_message(), (sender,))]  # a peer come near, which has not heard this robot
         return []
+
+    def _near(self, peer: int) -> bool:
+        """Whether ``peer`` is last known to stand within the state radius (refresh periods only)."""
+        if self.state_refresh is None or self.state_radius is None:
+            return False
+        known = self.belief.peers.get(peer)
+        if known is None:
+            return False
+        return abs(known.present[0] - self.present[0]) + abs(known.present[1] - self.present[1]) <= self.state_radius
 
     @handlers.on(ClaimMessage)
     def _take_claim(self, message: ClaimMessage, now: float) -> list[Outgoing]:

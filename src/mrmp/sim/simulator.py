@@ -86,6 +86,26 @@ LOSS_LEASE = 2
 heartbeats in a row were lost."""
 
 
+STATE_REFRESH = 8
+"""Ticks between two sends of a robot's unchanged state on a network that loses nothing (a changed state goes at
+once; ``docs/protocol.md``, "What it costs")."""
+
+LOSSY_STATE_REFRESH = 1
+"""The same on a network that loses messages: every tick, as a heartbeat."""
+
+
+def state_refresh(policy: Policy, faults: NetworkFaults) -> int | None:
+    """Ticks between two sends of an unchanged state by a robot running ``policy`` (None: every tick, fleet-wide).
+
+    >>> from mrmp.policies.thesis import ThesisPolicy
+    >>> state_refresh(ThesisPolicy(), NetworkFaults()), state_refresh(ThesisPolicy(), NetworkFaults(loss=0.1))
+    (8, 1)
+    """
+    if interaction_radius(policy) is None:
+        return None
+    return LOSSY_STATE_REFRESH if faults.loss > 0 else STATE_REFRESH
+
+
 def neighbourhood(policy: Policy, faults: NetworkFaults) -> tuple[int | None, int | None]:
     """The state radius and knowledge lease (ticks) of a robot running ``policy`` over a network with ``faults``.
 
@@ -151,7 +171,8 @@ class LockstepSimulator:
         self.robots = []
         for index, spec in enumerate(scenario.robots):
             policy = policies[index] if policies is not None else make_policy(scenario.policy, scenario.timing)
-            state_radius, lease = neighbourhood(policy, scenario.worst_faults())
+            faults = scenario.worst_faults()
+            state_radius, lease = neighbourhood(policy, faults)
             self.robots.append(
                 Robot(
                     spec,
@@ -165,6 +186,8 @@ class LockstepSimulator:
                     state_radius=state_radius,
                     knowledge_lease=lease,
                     following=following,
+                    state_refresh=state_refresh(policy, faults),
+                    lossy=faults.loss > 0,
                 )
             )
         self.bodies = SpatialIndex(starts)
