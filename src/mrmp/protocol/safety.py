@@ -129,6 +129,8 @@ class PendingClaim:
     votes: set[int] = field(default_factory=set)
     refusers: set[int] = field(default_factory=set)
     committed: bool = False
+    standing: bool = False
+    """Refused, and kept past the step for a grant on a handoff or a release (``keep_refused``)."""
 
     @property
     def refused(self) -> bool:
@@ -194,6 +196,13 @@ class SafetyLayer:
         Under ``following``, send a refused claim again in the step's second
         round (:meth:`resend_claim`), in case the grant a replica gave on a
         handoff was lost; False on a network that loses nothing.
+    keep_refused:
+        Under ``following``, keep a refused claim past the step (a *standing*
+        claim, :attr:`standing`) rather than give it up: its replicas still keep
+        it as refused, grant it when the cell's owner hands the cell off or
+        releases it, and its robot sends it no more, until it gives it up for
+        another decision (``docs/protocol.md``, "What it costs"). For a perfect
+        network: a grant that is lost would leave it waiting.
     """
 
     def __init__(
@@ -206,6 +215,7 @@ class SafetyLayer:
         keep_releases: bool = True,
         following: bool = False,
         resend_refused: bool = True,
+        keep_refused: bool = False,
     ) -> None:
         self.index = index
         self.fleet_size = len(starts)
@@ -216,6 +226,7 @@ class SafetyLayer:
         self.keep_releases = keep_releases
         self.following = following
         self.resend_refused = resend_refused
+        self.keep_refused = keep_refused and following
         self.present_handed_off = False
         self.present: Cell = starts[index]
         self.present_claim = 0
@@ -230,6 +241,7 @@ class SafetyLayer:
         self._highest_release: dict[int, int] = {}
         self._releases: dict[tuple[Cell, int], _Release] = {}
         self._deferred: dict[Cell, dict[int, int]] = {}
+        self.granted_on_release: list[Send] = []
         for owner, cell in enumerate(starts):
             if owner != index and index in self.replicas_of(cell):
                 self._registry[cell] = _Registration(owner, 0)
@@ -332,7 +344,11 @@ class SafetyLayer:
         sends: list[Send] = []
         pending = self.pending
         if pending is not None and not pending.committed:
-            if pending.refused:
+            if pending.refused and self.keep_refused:
+                if not pending.standing:
+                    self.stats.refused += 1
+                    pending.standing = True
+            elif pending.refused:
                 self.stats.refused += 1
                 self.cancel_claim()
             elif now - pending.started_at >= self.claim_timeout:
@@ -343,6 +359,16 @@ class SafetyLayer:
                 sends.append((ClaimMessage(self.index, 0, pending.number, pending.cell), self.claim_recipients(pending.cell)))
         sends.extend(self._releases_due(now))
         return sends
+
+    @property
+    def standing(self) -> bool:
+        """Whether the pending claim is a standing one: refused in an earlier step, kept (``keep_refused``)."""
+        pending = self.pending
+        return pending is not None and pending.standing and not pending.committed
+
+    def releases_due(self, now: float) -> list[Send]:
+        """The releases due now (a claim just given up, or one to send again), without running the claim's timers."""
+        return self._releases_due(now)
 
     def resend_claim(self, now: float) -> list[Send]:
         """Send the pending claim again to the replicas that have not granted it, if it is due for a resend.
@@ -529,8 +555,16 @@ class SafetyLayer:
         registration = self._registry.get(cell)
         if registration is not None and registration.owner == sender and registration.claim <= message.claim:
             del self._registry[cell]
-            self._deferred.pop(cell, None)
+            if self.keep_refused:
+                self.granted_on_release = self._grant_deferred(cell)
+            else:
+                self._deferred.pop(cell, None)
         return ReleaseAckMessage(self.index, 0, sender, message.claim, cell)
+
+    def take_granted_on_release(self) -> list[Send]:
+        """The grant of a standing claim that the last release made (``keep_refused``), to send with its acknowledgement."""
+        sends, self.granted_on_release = self.granted_on_release, []
+        return sends
 
     def handle_release_ack(self, message: ReleaseAckMessage) -> None:
         """A replica has taken in one of this robot's releases: stop sending it there."""

@@ -122,10 +122,14 @@ class Robot(MessageEndpoint):
         is the same as with states every step (``docs/protocol.md``, "What it
         costs"). Needs ``state_radius`` and ``knowledge_lease``.
     lossy:
-        Whether the network may lose messages: a robot that has just moved then
-        repeats its state to the peers waiting for it within the step
-        (:meth:`retry`), and a refused claim is sent again in the step's second
-        round. Drivers of a perfect network say False: nothing is lost to make up for.
+        Whether the network may lose, delay, duplicate or reorder messages: a
+        robot that has just moved then repeats its state to the peers waiting for
+        it within the step (:meth:`retry`), and a refused claim is sent again in
+        the step's second round, or given up at the step's end. Drivers of a
+        perfect network say False: nothing is lost to make up for, and under the
+        lockstep rule a refused claim then *stands* while the policy keeps
+        choosing its cell (:class:`~mrmp.protocol.safety.SafetyLayer`,
+        ``keep_refused``), instead of being sent again every step.
     """
 
     def __init__(
@@ -175,6 +179,7 @@ class Robot(MessageEndpoint):
             keep_releases=guarded,
             following=following and guarded,
             resend_refused=lossy,
+            keep_refused=not lossy,
         )
         self.seq = 0
         self.progress = 0
@@ -235,7 +240,8 @@ class Robot(MessageEndpoint):
         Next stays what it announced (a heartbeat repeats it).
         """
         self.now = now
-        if not self.moving and self.wanted is None and self.safety.pending is None:
+        idle = self.wanted is None and self.safety.pending is None
+        if not self.moving and (idle or self.safety.standing):
             self.intended = self.policy.intend(self.situation())
         if self.state_radius is None:
             return [Outgoing(self.state_message())]
@@ -287,18 +293,25 @@ class Robot(MessageEndpoint):
     def decide(self, now: float) -> list[Outgoing]:
         """Apply the policy; when guarded, return the claim for the chosen cell."""
         self.now = now
-        if self.moving or (self.guarded and self.safety.pending is not None):
+        standing = self.safety.pending if self.guarded and self.safety.standing else None
+        if self.moving or (self.guarded and self.safety.pending is not None and standing is None):
             return []
         decision = self.policy.decide(self.situation(), self.intended)
         self.last_decision = decision
         self.wanted = decision.next if decision.next != self.present else None
+        if standing is not None and self.wanted == standing.cell:
+            return []  # the claim refused earlier stands: its replicas grant it when its cell is handed off or released
+        sends: list[Outgoing] = []
+        if standing is not None:
+            self.safety.cancel_claim()  # another decision: its release goes now, before this step's claims
+            sends = [Outgoing(self._stamp(message), to) for message, to in self.safety.releases_due(now)]
         if self.wanted is None or not self.guarded:
-            return []
+            return sends
         claim = self.safety.start_claim(self.wanted, now)
         if claim is None:
             self.wanted = None  # a peer owns the cell in this robot's registry: stay this step
-            return []
-        return [Outgoing(self._stamp(claim), self.safety.claim_recipients(claim.cell))]
+            return sends
+        return [*sends, Outgoing(self._stamp(claim), self.safety.claim_recipients(claim.cell))]
 
     def retry(self, now: float) -> list[Outgoing]:
         """A second round of the tick's exchange: the claim still short of its majority, sent again if due.
@@ -416,7 +429,9 @@ class Robot(MessageEndpoint):
 
     @handlers.on(ReleaseMessage)
     def _take_release(self, message: ReleaseMessage, now: float) -> list[Outgoing]:
-        return self._answer_release(message)
+        answers = self._answer_release(message)
+        granted = self.safety.take_granted_on_release()
+        return [*answers, *(Outgoing(self._stamp(sent), recipients) for sent, recipients in granted)]
 
     @handlers.on(ReleaseAckMessage)
     def _take_release_ack(self, message: ReleaseAckMessage, now: float) -> list[Outgoing]:

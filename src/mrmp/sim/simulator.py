@@ -87,11 +87,11 @@ heartbeats in a row were lost."""
 
 
 STATE_REFRESH = 8
-"""Ticks between two sends of a robot's unchanged state on a network that loses nothing (a changed state goes at
-once; ``docs/protocol.md``, "What it costs")."""
+"""Ticks between two sends of a robot's unchanged state on a perfect network (a changed state goes at once;
+``docs/protocol.md``, "What it costs")."""
 
-LOSSY_STATE_REFRESH = 1
-"""The same on a network that loses messages: every tick, as a heartbeat."""
+FAULTY_STATE_REFRESH = 1
+"""The same on a network that loses, delays, duplicates or reorders messages: every tick, as a heartbeat."""
 
 
 def state_refresh(policy: Policy, faults: NetworkFaults) -> int | None:
@@ -103,7 +103,7 @@ def state_refresh(policy: Policy, faults: NetworkFaults) -> int | None:
     """
     if interaction_radius(policy) is None:
         return None
-    return LOSSY_STATE_REFRESH if faults.loss > 0 else STATE_REFRESH
+    return STATE_REFRESH if faults.is_perfect else FAULTY_STATE_REFRESH
 
 
 def neighbourhood(policy: Policy, faults: NetworkFaults) -> tuple[int | None, int | None]:
@@ -187,7 +187,7 @@ class LockstepSimulator:
                     knowledge_lease=lease,
                     following=following,
                     state_refresh=state_refresh(policy, faults),
-                    lossy=faults.loss > 0,
+                    lossy=not faults.is_perfect,
                 )
             )
         self.bodies = SpatialIndex(starts)
