@@ -339,6 +339,17 @@ class SafetyLayer:
             self.pending = None
             self._release(pending.cell, pending.number)
 
+    def give_up_claim(self) -> list[Send]:
+        """Give up the pending claim (:meth:`cancel_claim`); with standing claims, grant the one this robot, as a
+        replica of that cell, refused for it meanwhile (the cell is free in its registry now): the grant to send."""
+        pending = self.pending
+        self.cancel_claim()
+        if pending is None or not self.keep_refused or pending.cell in self._registry:
+            return []
+        if self.index not in self.replicas_of(pending.cell):
+            return []
+        return self._grant_deferred(pending.cell)
+
     def expire(self, now: float) -> list[Send]:
         """Time out or resend the pending claim, and send the releases due: the messages to send."""
         sends: list[Send] = []
@@ -353,7 +364,7 @@ class SafetyLayer:
                 self.cancel_claim()
             elif now - pending.started_at >= self.claim_timeout:
                 self.stats.timed_out += 1
-                self.cancel_claim()
+                sends.extend(self.give_up_claim())
             elif now - pending.sent_at >= self.retry_interval and len(pending.votes) < self.quorum:
                 pending.sent_at = now
                 sends.append((ClaimMessage(self.index, 0, pending.number, pending.cell), self.claim_recipients(pending.cell)))

@@ -303,8 +303,8 @@ class Robot(MessageEndpoint):
             return []  # the claim refused earlier stands: its replicas grant it when its cell is handed off or released
         sends: list[Outgoing] = []
         if standing is not None:
-            self.safety.cancel_claim()  # another decision: its release goes now, before this step's claims
-            sends = [Outgoing(self._stamp(message), to) for message, to in self.safety.releases_due(now)]
+            given_up = self.safety.give_up_claim()  # another decision: its release goes now, before this step's claims
+            sends = [Outgoing(self._stamp(message), to) for message, to in [*self.safety.releases_due(now), *given_up]]
         if self.wanted is None or not self.guarded:
             return sends
         claim = self.safety.start_claim(self.wanted, now)
