@@ -190,6 +190,7 @@ class Robot(MessageEndpoint):
         self._sent_at = -float("inf")
         self._broadcast = False  # whether this step's state went to the radius
         self._told: dict[int, tuple[float, tuple[object, ...]]] = {}  # named states: when, and what they said
+        self._behind: dict[int, Cell] = {}  # the peers known when the robot last moved, and where
 
     @property
     def arrived(self) -> bool:
@@ -259,8 +260,10 @@ class Robot(MessageEndpoint):
     def _announce_changes(self, now: float, heard: set[int]) -> list[Outgoing]:
         """The step's state under a refresh period: to the radius when it changed or is due, to named peers when new.
 
-        A robot that has moved sends it one cell further than the state radius:
-        a peer that kept it in view stood within the radius of the cell it left.
+        A robot that has moved also sends it by name to the peers it knew within
+        the radius of the cell it left (they keep it in view) and may now stand
+        beyond the radius of its new cell: those last known at least the radius away
+        from it (each may have moved one cell further since).
         """
         assert self.state_radius is not None and self.state_refresh is not None
         fingerprint = self._fingerprint()
@@ -273,14 +276,22 @@ class Robot(MessageEndpoint):
             if not self._recently_told(robot, fingerprint, now)
         ]
         if not self._broadcast and not named:
+            self._behind = {}
             return []
         message = self.state_message()
         for robot in named:
             self._told[robot] = (now, fingerprint)
         if not self._broadcast:
+            self._behind = {}
             return [Outgoing(message, tuple(named))]
-        moved = sent is not None and sent[0] != self.present
-        radius = self.state_radius + 1 if moved and self.state_radius > 0 else self.state_radius
+        behind, self._behind = self._behind, {}
+        x, y = self.present
+        radius = self.state_radius
+        named.extend(
+            peer
+            for peer, (px, py) in behind.items()
+            if abs(px - x) + abs(py - y) >= radius and peer not in named and radius > 0
+        )
         self._sent, self._sent_at = fingerprint, now
         return [Outgoing(message, tuple(named), radius)]
 
@@ -353,6 +364,8 @@ class Robot(MessageEndpoint):
         if cell != self.present:
             self.progress += 1
             self._repeat_state = self.present
+            if self.state_refresh is not None:
+                self._behind = {index: peer.present for index, peer in self.belief.peers.items()}
         self.present = cell
         self.heading = heading
         self.moving = False
