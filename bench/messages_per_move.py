@@ -82,7 +82,9 @@ def counts(arguments: argparse.Namespace) -> None:
         for policy in arguments.policies.split(","):
             for size in [int(text) for text in sizes.split(",")]:
                 result = run(instance(name, size), policy, arguments.max_ticks, record=True)
-                loud = run(instance(name, size), policy, arguments.max_ticks, record=True, quiet=False) if arguments.loud else None
+                loud = None
+                if arguments.loud:
+                    loud = run(instance(name, size), policy, arguments.max_ticks, record=True, quiet=False)
                 if result is None:
                     print(f"{name:>16} {policy:>7} {size:>5}   no plan")
                     continue

@@ -208,14 +208,13 @@ class Robot(MessageEndpoint):
                 assert self.state_radius is not None
                 self.belief.forget_beyond(self.present, self.state_radius)
         peers = self.belief.peers
-        if self.knowledge_lease is not None:
-            if radius is not None:
-                x, y = self.present
-                peers = {
-                    index: peer
-                    for index, peer in peers.items()
-                    if abs(peer.present[0] - x) + abs(peer.present[1] - y) <= radius
-                }
+        if self.knowledge_lease is not None and radius is not None:
+            x, y = self.present
+            peers = {
+                index: peer
+                for index, peer in peers.items()
+                if abs(peer.present[0] - x) + abs(peer.present[1] - y) <= radius
+            }
         if self.silence_timeout is not None:
             horizon = self.now - self.silence_timeout
             if any(peer.heard_at < horizon for peer in peers.values()):

@@ -90,20 +90,20 @@ STATE_REFRESH = 8
 """Ticks between two sends of a robot's unchanged state on a perfect network (a changed state goes at once;
 ``docs/protocol.md``, "What it costs")."""
 
-FAULTY_STATE_REFRESH = 1
-"""The same on a network that loses, delays, duplicates or reorders messages: every tick, as a heartbeat."""
-
 
 def state_refresh(policy: Policy, faults: NetworkFaults) -> int | None:
-    """Ticks between two sends of an unchanged state by a robot running ``policy`` (None: every tick, fleet-wide).
+    """Ticks between two sends of an unchanged state by a robot running ``policy``; None: every tick.
+
+    Only on a perfect network, for a policy with an interaction radius: a network that loses, delays,
+    duplicates or reorders messages gets a state every tick, as a heartbeat.
 
     >>> from mrmp.policies.thesis import ThesisPolicy
     >>> state_refresh(ThesisPolicy(), NetworkFaults()), state_refresh(ThesisPolicy(), NetworkFaults(loss=0.1))
-    (8, 1)
+    (8, None)
     """
-    if interaction_radius(policy) is None:
+    if interaction_radius(policy) is None or not faults.is_perfect:
         return None
-    return STATE_REFRESH if faults.is_perfect else FAULTY_STATE_REFRESH
+    return STATE_REFRESH
 
 
 def neighbourhood(policy: Policy, faults: NetworkFaults) -> tuple[int | None, int | None]:
