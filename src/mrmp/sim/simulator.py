@@ -20,7 +20,11 @@ A robot whose policy has an interaction radius sends its state to the robots
 within that radius plus its knowledge lease (:func:`neighbourhood`), and the
 network delivers such a radius broadcast to the robots whose bodies stand
 there, found through a spatial index (:mod:`mrmp.sim.spatial`): no step of a
-tick scans the fleet per message.
+tick scans the fleet per message. On a perfect network the robots are *quiet*
+(the default): a state goes out when it changes (and every
+:data:`STATE_REFRESH` ticks), and a refused claim stands rather than being
+sent again every tick; their policies decide as with states every tick
+(``docs/protocol.md``, "A quiet fleet on a perfect network").
 
 Time for the safety layer's timers is counted in ticks. The run ends when every
 robot stands on its goal (never, in a lifelong run: it ends with "time up" at
