@@ -201,7 +201,7 @@ class SafetyLayer:
         claim, :attr:`standing`) rather than give it up: its replicas still keep
         it as refused, grant it when the cell's owner hands the cell off or
         releases it, and its robot sends it no more, until it gives it up for
-        another decision (``docs/protocol.md``, "What it costs"). For a perfect
+        another decision (``docs/protocol.md``, "A quiet fleet on a perfect network"). For a perfect
         network: a grant that is lost would leave it waiting.
     """
 

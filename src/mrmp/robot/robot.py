@@ -110,7 +110,8 @@ class Robot(MessageEndpoint):
     state_refresh:
         Send a state that has not changed only every this many steps (None: every
         step). A changed state (Present, Next, heading, arrival or progress) goes
-        out at once, to ``state_radius`` plus one cell when the robot has moved
+        out at once to ``state_radius``, and after a move also by name to the
+        peers it knew near the cell it left that may now stand beyond the radius
         (so that every robot that knew it where it was hears that it left); a
         robot that kept its state to itself answers at once a peer that has just
         come within ``state_radius`` (it has not heard it yet); a named state
@@ -119,8 +120,8 @@ class Robot(MessageEndpoint):
         forgets the peers last known beyond ``state_radius``, or not heard for
         ``knowledge_lease`` plus ``state_refresh``. For drivers with steps and
         a radio (the lockstep simulator); on a perfect network the policy's view
-        is the same as with states every step (``docs/protocol.md``, "What it
-        costs"). Needs ``state_radius`` and ``knowledge_lease``.
+        is the same as with states every step (``docs/protocol.md``, "A quiet
+        fleet on a perfect network"). Needs ``state_radius`` and ``knowledge_lease``.
     lossy:
         Whether the network may lose, delay, duplicate or reorder messages: a
         robot that has just moved then repeats its state to the peers waiting for

@@ -92,7 +92,7 @@ heartbeats in a row were lost."""
 
 STATE_REFRESH = 8
 """Ticks between two sends of a robot's unchanged state on a perfect network (a changed state goes at once;
-``docs/protocol.md``, "What it costs")."""
+``docs/protocol.md``, "A quiet fleet on a perfect network")."""
 
 
 def state_refresh(policy: Policy, faults: NetworkFaults) -> int | None:
