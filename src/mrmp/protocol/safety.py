@@ -29,6 +29,13 @@ enter, in the same tick, the cell its occupant leaves. A robot hands off only
 once its own claim has a majority, so the robots waiting on each other's
 handoffs form chains, never cycles: no swap, no rotation.
 
+**Standing claims** (``keep_refused``, with ``following``, for a perfect
+network): a refused claim is kept rather than given up at the step's end; its
+robot sends it no more, and its replicas grant it as soon as the cell has no
+owner in their registry (a handoff, a release that drops the cell's record, or
+the replica giving up its own claim for it). Such a grant is given, like every
+grant, only to a cell without an owner, so the argument below is unchanged.
+
 Safety (no two robots ever cover one cell, whatever is lost, delayed,
 duplicated or reordered): two majorities of one replica set share at least one
 robot, and that robot registers a cell to at most one owner at a time; a
