@@ -183,7 +183,7 @@ class Result:
 
     >>> result = run("examples/thesis-swap.yaml")
     >>> result
-    Result(thesis-swap: success, makespan 6, sum of costs 10, lower bound 8, collisions 0, messages 56)
+    Result(thesis-swap: success, makespan 6, sum of costs 10, lower bound 8, collisions 0, messages 57)
     >>> "<svg" in result._repr_html_() and "sum of costs" in result._repr_html_()
     True
     """

@@ -29,6 +29,13 @@ enter, in the same tick, the cell its occupant leaves. A robot hands off only
 once its own claim has a majority, so the robots waiting on each other's
 handoffs form chains, never cycles: no swap, no rotation.
 
+**Standing claims** (``keep_refused``, with ``following``, for a perfect
+network): a refused claim is kept rather than given up at the step's end; its
+robot sends it no more, and its replicas grant it as soon as the cell has no
+owner in their registry (a handoff, a release that drops the cell's record, or
+the replica giving up its own claim for it). Such a grant is given, like every
+grant, only to a cell without an owner, so the argument below is unchanged.
+
 Safety (no two robots ever cover one cell, whatever is lost, delayed,
 duplicated or reordered): two majorities of one replica set share at least one
 robot, and that robot registers a cell to at most one owner at a time; a
@@ -129,6 +136,8 @@ class PendingClaim:
     votes: set[int] = field(default_factory=set)
     refusers: set[int] = field(default_factory=set)
     committed: bool = False
+    standing: bool = False
+    """Refused, and kept past the step for a grant on a handoff or a release (``keep_refused``)."""
 
     @property
     def refused(self) -> bool:
@@ -190,6 +199,17 @@ class SafetyLayer:
         end of the tick in which its claim won its majority (the lockstep
         simulator); bodies that cover both cells while they move keep the
         default, under which a cell is registered anew only once released.
+    resend_refused:
+        Under ``following``, send a refused claim again in the step's second
+        round (:meth:`resend_claim`), in case the grant a replica gave on a
+        handoff was lost; False on a network that loses nothing.
+    keep_refused:
+        Under ``following``, keep a refused claim past the step (a *standing*
+        claim, :attr:`standing`) rather than give it up: its replicas still keep
+        it as refused, grant it when the cell's owner hands the cell off or
+        releases it, and its robot sends it no more, until it gives it up for
+        another decision (``docs/protocol.md``, "A quiet fleet on a perfect network"). For a perfect
+        network: a grant that is lost would leave it waiting.
     """
 
     def __init__(
@@ -201,6 +221,8 @@ class SafetyLayer:
         replicas: int = REPLICAS,
         keep_releases: bool = True,
         following: bool = False,
+        resend_refused: bool = True,
+        keep_refused: bool = False,
     ) -> None:
         self.index = index
         self.fleet_size = len(starts)
@@ -210,6 +232,8 @@ class SafetyLayer:
         self.retry_interval = retry_interval
         self.keep_releases = keep_releases
         self.following = following
+        self.resend_refused = resend_refused
+        self.keep_refused = keep_refused and following
         self.present_handed_off = False
         self.present: Cell = starts[index]
         self.present_claim = 0
@@ -224,6 +248,7 @@ class SafetyLayer:
         self._highest_release: dict[int, int] = {}
         self._releases: dict[tuple[Cell, int], _Release] = {}
         self._deferred: dict[Cell, dict[int, int]] = {}
+        self.granted_on_release: list[Send] = []
         for owner, cell in enumerate(starts):
             if owner != index and index in self.replicas_of(cell):
                 self._registry[cell] = _Registration(owner, 0)
@@ -321,22 +346,47 @@ class SafetyLayer:
             self.pending = None
             self._release(pending.cell, pending.number)
 
+    def give_up_claim(self) -> list[Send]:
+        """Give up the pending claim (:meth:`cancel_claim`); with standing claims, grant the one this robot, as a
+        replica of that cell, refused for it meanwhile (the cell is free in its registry now): the grant to send."""
+        pending = self.pending
+        self.cancel_claim()
+        if pending is None or not self.keep_refused or pending.cell in self._registry:
+            return []
+        if self.index not in self.replicas_of(pending.cell):
+            return []
+        return self._grant_deferred(pending.cell)
+
     def expire(self, now: float) -> list[Send]:
         """Time out or resend the pending claim, and send the releases due: the messages to send."""
         sends: list[Send] = []
         pending = self.pending
         if pending is not None and not pending.committed:
-            if pending.refused:
+            if pending.refused and self.keep_refused:
+                if not pending.standing:
+                    self.stats.refused += 1
+                    pending.standing = True
+            elif pending.refused:
                 self.stats.refused += 1
                 self.cancel_claim()
             elif now - pending.started_at >= self.claim_timeout:
                 self.stats.timed_out += 1
-                self.cancel_claim()
+                sends.extend(self.give_up_claim())
             elif now - pending.sent_at >= self.retry_interval and len(pending.votes) < self.quorum:
                 pending.sent_at = now
                 sends.append((ClaimMessage(self.index, 0, pending.number, pending.cell), self.claim_recipients(pending.cell)))
         sends.extend(self._releases_due(now))
         return sends
+
+    @property
+    def standing(self) -> bool:
+        """Whether the pending claim is a standing one: refused in an earlier step, kept (``keep_refused``)."""
+        pending = self.pending
+        return pending is not None and pending.standing and not pending.committed
+
+    def releases_due(self, now: float) -> list[Send]:
+        """The releases due now (a claim just given up, or one to send again), without running the claim's timers."""
+        return self._releases_due(now)
 
     def resend_claim(self, now: float) -> list[Send]:
         """Send the pending claim again to the replicas that have not granted it, if it is due for a resend.
@@ -352,7 +402,7 @@ class SafetyLayer:
         pending = self.pending
         if pending is None or pending.committed or len(pending.votes) >= self.quorum:
             return []
-        if pending.refused and not self.following:
+        if pending.refused and not (self.following and self.resend_refused):
             return []
         if now - pending.sent_at < self.retry_interval:
             return []
@@ -523,8 +573,16 @@ class SafetyLayer:
         registration = self._registry.get(cell)
         if registration is not None and registration.owner == sender and registration.claim <= message.claim:
             del self._registry[cell]
-            self._deferred.pop(cell, None)
+            if self.keep_refused:
+                self.granted_on_release = self._grant_deferred(cell)
+            else:
+                self._deferred.pop(cell, None)
         return ReleaseAckMessage(self.index, 0, sender, message.claim, cell)
+
+    def take_granted_on_release(self) -> list[Send]:
+        """The grant of a standing claim that the last release made (``keep_refused``), to send with its acknowledgement."""
+        sends, self.granted_on_release = self.granted_on_release, []
+        return sends
 
     def handle_release_ack(self, message: ReleaseAckMessage) -> None:
         """A replica has taken in one of this robot's releases: stop sending it there."""

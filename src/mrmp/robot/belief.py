@@ -70,6 +70,23 @@ class Belief:
         )
         return True
 
+    def forget_beyond(self, cell: tuple[int, int], radius: int) -> list[int]:
+        """Forget every peer last known to stand more than ``radius`` cells (Manhattan) from ``cell``; return them.
+
+        >>> belief = Belief()
+        >>> _ = belief.update(StateMessage(1, seq=1, present=(3, 2), next=(2, 2)), now=1.0)
+        >>> _ = belief.update(StateMessage(2, seq=1, present=(0, 1), next=(0, 1)), now=1.0)
+        >>> belief.forget_beyond((0, 0), 2), sorted(belief.peers)
+        ([1], [2])
+        """
+        x, y = cell
+        gone = [
+            index for index, peer in self.peers.items() if abs(peer.present[0] - x) + abs(peer.present[1] - y) > radius
+        ]
+        for index in gone:
+            del self.peers[index]
+        return gone
+
     def forget_before(self, horizon: float) -> list[int]:
         """Forget every peer last heard before ``horizon``; return their indices."""
         gone = [index for index, peer in self.peers.items() if peer.heard_at < horizon]

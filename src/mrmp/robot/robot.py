@@ -107,6 +107,30 @@ class Robot(MessageEndpoint):
         leaves in the same tick; :class:`~mrmp.protocol.safety.SafetyLayer`),
         for drivers that move every allowed robot at once, at the end of the
         tick (the lockstep simulator). Live bodies keep the default.
+    state_refresh:
+        Send a state that has not changed only every this many steps (None: every
+        step). A changed state (Present, Next, heading, arrival or progress) goes
+        out at once to ``state_radius``, and after a move also by name to the
+        peers it knew near the cell it left that may now stand beyond the radius
+        (so that every robot that knew it where it was hears that it left); a
+        robot that kept its state to itself answers at once a peer that has just
+        come within ``state_radius`` (it has not heard it yet); a named state
+        (a plan's listeners) goes again to a peer only when it differs from the
+        one the peer got in the last ``state_refresh`` steps; and the robot
+        forgets the peers last known beyond ``state_radius``, or not heard for
+        ``knowledge_lease`` plus ``state_refresh``. For drivers with steps and
+        a radio (the lockstep simulator); on a perfect network the policy's view
+        is the same as with states every step (``docs/protocol.md``, "A quiet
+        fleet on a perfect network"). Needs ``state_radius`` and ``knowledge_lease``.
+    lossy:
+        Whether the network may lose, delay, duplicate or reorder messages: a
+        robot that has just moved then repeats its state to the peers waiting for
+        it within the step (:meth:`retry`), and a refused claim is sent again in
+        the step's second round, or given up at the step's end. Drivers of a
+        perfect network say False: nothing is lost to make up for, and under the
+        lockstep rule a refused claim then *stands* while the policy keeps
+        choosing its cell (:class:`~mrmp.protocol.safety.SafetyLayer`,
+        ``keep_refused``), instead of being sent again every step.
     """
 
     def __init__(
@@ -123,11 +147,17 @@ class Robot(MessageEndpoint):
         state_radius: int | None = None,
         knowledge_lease: float | None = None,
         following: bool = False,
+        state_refresh: int | None = None,
+        lossy: bool = True,
     ) -> None:
+        if state_refresh is not None and (state_refresh < 1 or state_radius is None or knowledge_lease is None):
+            raise ValueError("a state refresh needs a positive period, a state radius and a knowledge lease")
         self.id = spec.id
         self.silence_timeout = silence_timeout
         self.state_radius = state_radius
         self.knowledge_lease = knowledge_lease
+        self.state_refresh = state_refresh
+        self.lossy = lossy
         self.now = 0.0
         self.index = index
         self.goal = spec.goal
@@ -149,12 +179,19 @@ class Robot(MessageEndpoint):
             retry_interval=retry_interval,
             keep_releases=guarded,
             following=following and guarded,
+            resend_refused=lossy,
+            keep_refused=not lossy,
         )
         self.seq = 0
         self.progress = 0
         self.dropped: Counter[str] = Counter()
         self.last_decision: Decision | None = None
         self._repeat_state: Cell | None = None  # the cell just left, until the state is repeated
+        self._sent: tuple[object, ...] | None = None  # what the last radius broadcast of the state said
+        self._sent_at = -float("inf")
+        self._broadcast = False  # whether this step's state went to the radius
+        self._told: dict[int, tuple[float, tuple[object, ...]]] = {}  # named states: when, and what they said
+        self._behind: dict[int, Cell] = {}  # the peers known when the robot last moved, and where
 
     @property
     def arrived(self) -> bool:
@@ -163,17 +200,22 @@ class Robot(MessageEndpoint):
 
     def situation(self) -> Situation:
         """The robot's state and beliefs at the time of its last step, as its policy sees them."""
-        peers = self.belief.peers
         radius = interaction_radius(self.policy)
         if self.knowledge_lease is not None:
-            self.belief.forget_before(self.now - self.knowledge_lease)
-            if radius is not None:
-                x, y = self.present
-                peers = {
-                    index: peer
-                    for index, peer in peers.items()
-                    if abs(peer.present[0] - x) + abs(peer.present[1] - y) <= radius
-                }
+            if self.state_refresh is None:
+                self.belief.forget_before(self.now - self.knowledge_lease)
+            else:
+                self.belief.forget_before(self.now - self.knowledge_lease - self.state_refresh)
+                assert self.state_radius is not None
+                self.belief.forget_beyond(self.present, self.state_radius)
+        peers = self.belief.peers
+        if self.knowledge_lease is not None and radius is not None:
+            x, y = self.present
+            peers = {
+                index: peer
+                for index, peer in peers.items()
+                if abs(peer.present[0] - x) + abs(peer.present[1] - y) <= radius
+            }
         if self.silence_timeout is not None:
             horizon = self.now - self.silence_timeout
             if any(peer.heard_at < horizon for peer in peers.values()):
@@ -199,30 +241,88 @@ class Robot(MessageEndpoint):
         Next stays what it announced (a heartbeat repeats it).
         """
         self.now = now
-        if not self.moving and self.wanted is None and self.safety.pending is None:
+        idle = self.wanted is None and self.safety.pending is None
+        if not self.moving and (idle or self.safety.standing):
             self.intended = self.policy.intend(self.situation())
         if self.state_radius is None:
             return [Outgoing(self.state_message())]
         heard, self._heard_since = self._heard_since, set()
         self._answered.clear()
-        extra = tuple(listeners(self.policy, heard, self.belief.progress))
-        return [Outgoing(self.state_message(), extra, self.state_radius)]
+        if self.state_refresh is None:
+            extra = tuple(listeners(self.policy, heard, self.belief.progress))
+            return [Outgoing(self.state_message(), extra, self.state_radius)]
+        return self._announce_changes(now, heard)
+
+    def _fingerprint(self) -> tuple[object, ...]:
+        """What a peer's view of this robot holds: Present, Next, heading, arrival and reported progress."""
+        return (self.present, self.intended, self.heading, self.arrived, reported_progress(self.policy, self.progress))
+
+    def _announce_changes(self, now: float, heard: set[int]) -> list[Outgoing]:
+        """The step's state under a refresh period: to the radius when it changed or is due, to named peers when new.
+
+        A robot that has moved also sends it by name to the peers it knew within
+        the radius of the cell it left (they keep it in view) and may now stand
+        beyond the radius of its new cell: those last known at least the radius away
+        from it (each may have moved one cell further since).
+        """
+        assert self.state_radius is not None and self.state_refresh is not None
+        fingerprint = self._fingerprint()
+        sent = self._sent
+        due = now - self._sent_at >= self.state_refresh
+        self._broadcast = sent != fingerprint or due
+        named = [
+            robot
+            for robot in listeners(self.policy, heard, self.belief.progress)
+            if not self._recently_told(robot, fingerprint, now)
+        ]
+        if not self._broadcast and not named:
+            self._behind = {}
+            return []
+        message = self.state_message()
+        for robot in named:
+            self._told[robot] = (now, fingerprint)
+        if not self._broadcast:
+            self._behind = {}
+            return [Outgoing(message, tuple(named))]
+        behind, self._behind = self._behind, {}
+        x, y = self.present
+        radius = self.state_radius
+        named.extend(
+            peer
+            for peer, (px, py) in behind.items()
+            if abs(px - x) + abs(py - y) >= radius and peer not in named and radius > 0
+        )
+        self._sent, self._sent_at = fingerprint, now
+        return [Outgoing(message, tuple(named), radius)]
+
+    def _recently_told(self, robot: int, fingerprint: tuple[object, ...], now: float) -> bool:
+        """Whether ``robot`` got this very state by name within the refresh period."""
+        told = self._told.get(robot)
+        assert self.state_refresh is not None
+        return told is not None and told[1] == fingerprint and now - told[0] < self.state_refresh
 
     def decide(self, now: float) -> list[Outgoing]:
         """Apply the policy; when guarded, return the claim for the chosen cell."""
         self.now = now
-        if self.moving or (self.guarded and self.safety.pending is not None):
+        standing = self.safety.pending if self.guarded and self.safety.standing else None
+        if self.moving or (self.guarded and self.safety.pending is not None and standing is None):
             return []
         decision = self.policy.decide(self.situation(), self.intended)
         self.last_decision = decision
         self.wanted = decision.next if decision.next != self.present else None
+        if standing is not None and self.wanted == standing.cell:
+            return []  # the claim refused earlier stands: its replicas grant it when its cell is handed off or released
+        sends: list[Outgoing] = []
+        if standing is not None:
+            given_up = self.safety.give_up_claim()  # another decision: its release goes now, before this step's claims
+            sends = [Outgoing(self._stamp(message), to) for message, to in [*self.safety.releases_due(now), *given_up]]
         if self.wanted is None or not self.guarded:
-            return []
+            return sends
         claim = self.safety.start_claim(self.wanted, now)
         if claim is None:
             self.wanted = None  # a peer owns the cell in this robot's registry: stay this step
-            return []
-        return [Outgoing(self._stamp(claim), self.safety.claim_recipients(claim.cell))]
+            return sends
+        return [*sends, Outgoing(self._stamp(claim), self.safety.claim_recipients(claim.cell))]
 
     def retry(self, now: float) -> list[Outgoing]:
         """A second round of the tick's exchange: the claim still short of its majority, sent again if due.
@@ -236,6 +336,8 @@ class Robot(MessageEndpoint):
         sends: list[Outgoing] = []
         if not self.guarded:
             return sends  # the thesis's robots as written send their state once a step
+        if self._repeat_state is not None and not self.lossy:
+            self._repeat_state = None  # nothing was lost: the peers waiting for it heard its state this step
         if self._repeat_state is not None:
             cells = (self._repeat_state, self.present)
             self._repeat_state = None
@@ -262,6 +364,8 @@ class Robot(MessageEndpoint):
         if cell != self.present:
             self.progress += 1
             self._repeat_state = self.present
+            if self.state_refresh is not None:
+                self._behind = {index: peer.present for index, peer in self.belief.peers.items()}
         self.present = cell
         self.heading = heading
         self.moving = False
@@ -291,14 +395,35 @@ class Robot(MessageEndpoint):
 
     @handlers.on(StateMessage)
     def _take_state(self, message: StateMessage, now: float) -> list[Outgoing]:
-        self.belief.update(message, now)
+        sender = message.sender
+        was_near = self._near(sender)
+        if not self.belief.update(message, now) and self.state_refresh is not None:
+            return []
         if self.state_radius is None:
             return []
-        self._heard_since.add(message.sender)
-        if message.sender not in self._answered and owes_state(self.policy, message.sender, message.progress):
-            self._answered.add(message.sender)  # once a step: two robots waiting on each other do not ping-pong
-            return [Outgoing(self.state_message(), (message.sender,))]  # a pull answered within the step
+        self._heard_since.add(sender)
+        if sender in self._answered:
+            return []  # once a step: two robots waiting on each other do not ping-pong
+        if owes_state(self.policy, sender, message.progress):
+            if self.state_refresh is not None and self._recently_told(sender, self._fingerprint(), now):
+                return []  # it has this state already, unless it was lost: its next pull, a period on, asks again
+            self._answered.add(sender)
+            if self.state_refresh is not None:
+                self._told[sender] = (now, self._fingerprint())
+            return [Outgoing(self.state_message(), (sender,))]  # a pull answered within the step
+        if self.state_refresh is not None and not self._broadcast and not was_near and self._near(sender):
+            self._answered.add(sender)
+            return [Outgoing(self.state_message(), (sender,))]  # a peer come near, which has not heard this robot
         return []
+
+    def _near(self, peer: int) -> bool:
+        """Whether ``peer`` is last known to stand within the state radius (refresh periods only)."""
+        if self.state_refresh is None or self.state_radius is None:
+            return False
+        known = self.belief.peers.get(peer)
+        if known is None:
+            return False
+        return abs(known.present[0] - self.present[0]) + abs(known.present[1] - self.present[1]) <= self.state_radius
 
     @handlers.on(ClaimMessage)
     def _take_claim(self, message: ClaimMessage, now: float) -> list[Outgoing]:
@@ -317,7 +442,9 @@ class Robot(MessageEndpoint):
 
     @handlers.on(ReleaseMessage)
     def _take_release(self, message: ReleaseMessage, now: float) -> list[Outgoing]:
-        return self._answer_release(message)
+        answers = self._answer_release(message)
+        granted = self.safety.take_granted_on_release()
+        return [*answers, *(Outgoing(self._stamp(sent), recipients) for sent, recipients in granted)]
 
     @handlers.on(ReleaseAckMessage)
     def _take_release_ack(self, message: ReleaseAckMessage, now: float) -> list[Outgoing]:

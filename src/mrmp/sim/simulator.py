@@ -20,7 +20,11 @@ A robot whose policy has an interaction radius sends its state to the robots
 within that radius plus its knowledge lease (:func:`neighbourhood`), and the
 network delivers such a radius broadcast to the robots whose bodies stand
 there, found through a spatial index (:mod:`mrmp.sim.spatial`): no step of a
-tick scans the fleet per message.
+tick scans the fleet per message. On a perfect network the robots are *quiet*
+(the default): a state goes out when it changes (and every
+:data:`STATE_REFRESH` ticks), and a refused claim stands rather than being
+sent again every tick; their policies decide as with states every tick
+(``docs/protocol.md``, "A quiet fleet on a perfect network").
 
 Time for the safety layer's timers is counted in ticks. The run ends when every
 robot stands on its goal (never, in a lifelong run: it ends with "time up" at
@@ -86,6 +90,26 @@ LOSS_LEASE = 2
 heartbeats in a row were lost."""
 
 
+STATE_REFRESH = 8
+"""Ticks between two sends of a robot's unchanged state on a perfect network (a changed state goes at once;
+``docs/protocol.md``, "A quiet fleet on a perfect network")."""
+
+
+def state_refresh(policy: Policy, faults: NetworkFaults) -> int | None:
+    """Ticks between two sends of an unchanged state by a robot running ``policy``; None: every tick.
+
+    Only on a perfect network, for a policy with an interaction radius: a network that loses, delays,
+    duplicates or reorders messages gets a state every tick, as a heartbeat.
+
+    >>> from mrmp.policies.thesis import ThesisPolicy
+    >>> state_refresh(ThesisPolicy(), NetworkFaults()), state_refresh(ThesisPolicy(), NetworkFaults(loss=0.1))
+    (8, None)
+    """
+    if interaction_radius(policy) is None or not faults.is_perfect:
+        return None
+    return STATE_REFRESH
+
+
 def neighbourhood(policy: Policy, faults: NetworkFaults) -> tuple[int | None, int | None]:
     """The state radius and knowledge lease (ticks) of a robot running ``policy`` over a network with ``faults``.
 
@@ -132,6 +156,12 @@ class LockstepSimulator:
         robot may enter a cell its occupant leaves in the same tick, once that
         one has handed it off (``docs/protocol.md``). False keeps the rule of
         live bodies, under which a cell is entered only after its release.
+    quiet:
+        On a perfect network, send a robot's unchanged state only every
+        :data:`STATE_REFRESH` ticks, leave out the repairs of lost messages, and
+        keep refused claims standing (the default; ``docs/protocol.md``, "What it
+        costs"). False: states every tick and refused claims sent again every
+        tick, as on a faulty network (the same decisions, more messages).
     """
 
     def __init__(
@@ -143,6 +173,7 @@ class LockstepSimulator:
         record_messages: bool = False,
         on_tick: TickObserver | None = None,
         following: bool = True,
+        quiet: bool = True,
     ) -> None:
         self.scenario = scenario
         grid = scenario.grid
@@ -151,7 +182,8 @@ class LockstepSimulator:
         self.robots = []
         for index, spec in enumerate(scenario.robots):
             policy = policies[index] if policies is not None else make_policy(scenario.policy, scenario.timing)
-            state_radius, lease = neighbourhood(policy, scenario.worst_faults())
+            faults = scenario.worst_faults()
+            state_radius, lease = neighbourhood(policy, faults)
             self.robots.append(
                 Robot(
                     spec,
@@ -165,6 +197,8 @@ class LockstepSimulator:
                     state_radius=state_radius,
                     knowledge_lease=lease,
                     following=following,
+                    state_refresh=state_refresh(policy, faults) if quiet else None,
+                    lossy=not (quiet and faults.is_perfect),
                 )
             )
         self.bodies = SpatialIndex(starts)

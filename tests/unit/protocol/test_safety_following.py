@@ -6,7 +6,9 @@ majority moves at once (a committed robot always does). Robots on a small grid
 claim random neighbouring cells, occupied or not, so that they often claim the
 cell of a robot that leaves it. An adversary holds every message in a bag and
 delivers any of them, in any order, any number of times, in this tick or a
-later one, or never. Robots crash between ticks.
+later one, or never. Robots crash between ticks. With standing claims
+(``keep_refused``), a refused claim is kept over ticks until its robot gives it
+up, and its replicas grant it on a handoff or on the release of the cell.
 
 Checked after every delivery: the cells robots *cover* in the lockstep
 argument of ``docs/protocol.md`` (Present until handed off, and the cell of a
@@ -14,7 +16,8 @@ claim that won its majority) are pairwise disjoint. Checked at every tick's
 end: no two robots on one cell, no swap, no rotation. Broken variants of the
 rule (a handoff before the robot's own majority, a replica that gives its own
 cell away while it only claims another, a committed robot that stays, a
-replica that takes a stale handoff) must be caught.
+replica that takes a stale handoff, a replica that grants a standing claim on
+a release that did not free the cell) must be caught.
 """
 
 import random
@@ -39,8 +42,10 @@ def neighbours(cell):
 class Node:
     """A robot reduced to its safety layer under the lockstep rule."""
 
-    def __init__(self, index, starts):
-        self.layer = SafetyLayer(index, starts, claim_timeout=6, retry_interval=2, following=True)
+    def __init__(self, index, starts, keep_refused=False):
+        self.layer = SafetyLayer(
+            index, starts, claim_timeout=6, retry_interval=2, following=True, keep_refused=keep_refused
+        )
         self.index = index
         self.seq = 0
         self.crashed = False
@@ -95,6 +100,7 @@ class Adversary:
             self.send_all(target, layer.handle_handoff(message))
         elif isinstance(message, ReleaseMessage):
             self.send(target, layer.handle_release(message), (message.sender,))
+            self.send_all(target, layer.take_granted_on_release())
         elif isinstance(message, ReleaseAckMessage):
             layer.handle_release_ack(message)
 
@@ -112,18 +118,24 @@ def check_tick(tick, before, after):
     assert rotations_at(tick, before, after) == [], f"tick {tick}: a swap or rotation: {before} -> {after}"
 
 
-def run(seed, robots, ticks, crashes=True):
-    """One adversarial lockstep run; returns (moves, following moves)."""
+def run(seed, robots, ticks, crashes=True, keep_refused=False):
+    """One adversarial lockstep run; returns (moves, following moves).
+
+    With ``keep_refused``, a robot gives its standing claim up (for another claim, or none) half the time.
+    """
     rng = random.Random(seed)
     cells = [(x, y) for x in range(SIZE) for y in range(SIZE)]
     starts = rng.sample(cells, robots)
-    nodes = [Node(i, starts) for i in range(robots)]
+    nodes = [Node(i, starts, keep_refused) for i in range(robots)]
     adversary = Adversary(nodes, rng)
     moves = follows = 0
     for tick in range(1, ticks + 1):
         before_claims = {node.layer.present for node in nodes}
         for node in nodes:
             layer = node.layer
+            if not node.crashed and layer.standing and rng.random() < 0.5:
+                given_up = layer.give_up_claim()
+                adversary.send_all(node, layer.releases_due(tick) + given_up)
             if not node.crashed and layer.pending is None and rng.random() < 0.5:
                 occupied = [cell for cell in neighbours(layer.present) if cell in before_claims]
                 cell = rng.choice(occupied if occupied and rng.random() < 0.5 else neighbours(layer.present))
@@ -164,10 +176,66 @@ def test_no_collision_swap_or_rotation_under_the_lockstep_rule(seed, robots):
     run(seed, robots, ticks=150)
 
 
-def test_the_adversarial_runs_do_follow():
+@settings(max_examples=150, derandomize=True, deadline=None)
+@given(seed=st.integers(0, 10**9), robots=st.integers(2, 7))
+def test_no_collision_swap_or_rotation_with_standing_claims(seed, robots):
+    run(seed, robots, ticks=150, keep_refused=True)
+
+
+@pytest.mark.parametrize("keep_refused", [False, True], ids=["refused-given-up", "standing"])
+def test_the_adversarial_runs_do_follow(keep_refused):
     """The invariant is not bought by standing still: robots move, and many moves follow a leaving robot."""
-    moves, follows = map(sum, zip(*(run(seed, 4, 150) for seed in range(10))))
+    moves, follows = map(sum, zip(*(run(seed, 4, 150, keep_refused=keep_refused) for seed in range(10))))
     assert moves >= 300 and follows >= 30
+
+
+def test_standing_claims_are_granted_when_the_cell_is_given_up():
+    """Pinned, in a fleet of two (both robots replicas of every cell, 2 of 2 needed).
+
+    A and B claim (0, 2) at once; each owns it through its own claim and refuses the other's, so both claims
+    stand and nothing is sent again. A decides otherwise and gives its claim up: the cell is free in A's
+    registry, so A grants B's standing claim at once, and B has its majority.
+    """
+    starts = [(0, 0), (0, 1)]
+    a, b = (SafetyLayer(i, starts, following=True, keep_refused=True, resend_refused=False) for i in (0, 1))
+    claim_a, claim_b = a.start_claim((0, 2), 1), b.start_claim((0, 2), 1)
+    a.handle_reply(b.handle_claim(claim_a, claimant_outranks=False), 1)
+    b.handle_reply(a.handle_claim(claim_b, claimant_outranks=False), 1)
+    assert a.expire(1) == [] and b.expire(1) == []  # both claims stand: nothing is sent again
+    assert a.standing and b.standing and b.resend_claim(1) == []
+    [(grant, to_b)] = a.give_up_claim()
+    assert to_b == (1,) and grant.granted and grant.claim == claim_b.claim
+    [(handoff, _)] = b.handle_reply(grant, 2)
+    assert b.may_enter((0, 2)) and isinstance(handoff, HandoffMessage)
+
+
+def test_a_standing_claim_is_granted_when_the_claim_holding_the_cell_is_released():
+    """Pinned, in a fleet of five: replica R registered the cell to A's claim, which then won no majority; R
+    refused B's claim meanwhile. When A gives its claim up, its release frees the cell at R, and R grants B's
+    standing claim with its acknowledgement; a release that frees nothing (a stale one) grants nothing."""
+    starts = [(0, 0), (0, 2), (0, 4), (0, 6), (0, 8)]
+    layers = [SafetyLayer(i, starts, following=True, keep_refused=True, resend_refused=False) for i in range(5)]
+    cell = (3, 3)
+    first, second, _ = replicas = layers[0].replicas_of(cell)
+    a, b = (layers[i] for i in range(5) if i not in replicas)
+    r = layers[first]
+    claim_a = a.start_claim(cell, 1)
+    a.handle_reply(r.handle_claim(claim_a, claimant_outranks=False), 1)  # A's claim reaches R alone: granted
+    claim_b = b.start_claim(cell, 1)
+    b.handle_reply(r.handle_claim(claim_b, claimant_outranks=False), 1)  # refused at R: A owns the cell there
+    assert b.expire(1) == [] and b.standing
+    stale = ReleaseMessage(a.index, 9, claim_a.claim - 1, cell)
+    r.handle_release(stale)
+    assert r.take_granted_on_release() == []  # it names an older claim: A's record stands, nothing is granted
+    a.cancel_claim()
+    release = next(message for message, _ in a.releases_due(2) if message.cell == cell)
+    ack = r.handle_release(release)
+    [(grant, to_b)] = r.take_granted_on_release()
+    assert ack.claim == claim_a.claim and to_b == (b.index,) and grant.granted and grant.claim == claim_b.claim
+    b.handle_reply(grant, 2)
+    b.handle_reply(layers[second].handle_claim(claim_b, claimant_outranks=False), 2)  # its claim reaches a second replica
+    assert b.may_enter(cell)
+
 
 
 # -- broken variants the adversary must catch ---------------------------------------------------
@@ -224,6 +292,28 @@ class StaleHandoff(SafetyLayer):
         if registration is not None and registration.owner == message.sender:
             message = HandoffMessage(message.sender, message.seq, registration.claim, message.cell)
         return super().handle_handoff(message)
+
+
+class GrantsOnAnyRelease(SafetyLayer):
+    """Grants a standing claim on any release of the cell, also one that did not free it (a stale or foreign one)."""
+
+    def handle_release(self, message):
+        ack = super().handle_release(message)
+        if self.keep_refused and not self.granted_on_release and message.cell in self._deferred:
+            self._registry.pop(message.cell, None)
+            self.granted_on_release = self._grant_deferred(message.cell)
+        return ack
+
+
+def test_the_adversary_catches_a_replica_that_grants_standing_claims_on_any_release(monkeypatch):
+    monkeypatch.setattr(sys.modules[__name__], "SafetyLayer", GrantsOnAnyRelease)
+    caught = 0
+    for seed in range(30):
+        try:
+            run(seed, 5, 150, keep_refused=True)
+        except AssertionError:
+            caught += 1
+    assert caught > 0
 
 
 @pytest.mark.parametrize("variant", [EagerHandoff, GivesItsCellWhileClaiming, CommittedButStays])

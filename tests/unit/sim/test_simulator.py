@@ -82,7 +82,8 @@ def test_interrupt_returns_what_was_computed(monkeypatch):
 
 
 def test_messages_are_counted_per_datagram():
-    result = simulate(SWAP.with_changes(safety=False))
+    """Counted for the loud fleet (a state every tick: ``quiet=False``), then for the quiet one."""
+    result = LockstepSimulator(SWAP.with_changes(safety=False), quiet=False).run()
     paths = trajectories(result)
     near = sum(  # a state reaches the peer only while the two stand within two cells (the thesis rule's radius)
         1 for tick in range(result.ticks) if abs(paths[0][tick][0] - paths[1][tick][0]) + abs(paths[0][tick][1] - paths[1][tick][1]) <= 2
@@ -91,7 +92,8 @@ def test_messages_are_counted_per_datagram():
     assert result.messages == 2 * near  # each robot, each such tick, one datagram to its one peer
     assert result.network["sent"] == result.messages
     assert all(robot.bytes_sent == 52 * robot.messages_sent for robot in result.robots)
-    guarded = simulate(SWAP, record_messages=True)  # each move adds a claim, its answer, a handoff, a release, its answer
+    guarded = LockstepSimulator(SWAP, record_messages=True, quiet=False).run()  # each move adds a claim, its answer,
+    # a handoff, a release, its answer
     moves = sum(robot.steps for robot in guarded.robots)
     kinds = Counter(kind for tick in guarded.message_log for _, _, kind in tick)
     assert kinds["claim"] == kinds["reply"] == kinds["handoff"] == kinds["release"] == moves
@@ -100,6 +102,14 @@ def test_messages_are_counted_per_datagram():
     assert repeated == 1  # once: A, which has just left (1, 2), to B, whose Next (1, 2) is
     assert guarded.messages == result.messages + repeated + 5 * moves - 1
     assert guarded.network["claims"] == guarded.network["claims_granted"] == guarded.network["releases"] == moves
+    # The quiet fleet (the default on a perfect network): the same paths; both robots move every tick, so each
+    # state is new, but as they part each names the other, which it knew near the cell it left (one datagram
+    # each), and nothing is repeated in the second round.
+    quiet = simulate(SWAP.with_changes(safety=False))
+    assert trajectories(quiet) == paths
+    assert quiet.messages == 2 * near + 2
+    quiet_guarded = simulate(SWAP)
+    assert quiet_guarded.messages == guarded.messages - repeated + 2
 
 
 @pytest.mark.parametrize("policy", ["thesis", "astar"])
