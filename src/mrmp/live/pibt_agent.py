@@ -8,8 +8,11 @@ it with what a live robot adds, sans-IO (fed with the clock, never reading it):
 
 * **steps on a common clock**: step ``k`` (from 1) begins at ``t0 + (k - 1) *
   step`` seconds, ``t0`` being the moment the robot has heard every peer (the
-  fleet's start, the same moment for every robot up to a message's delay:
-  a robot answers a peer it hears of for the first time at once). The first
+  fleet's start: a robot answers a peer it hears of for the first time at once,
+  so every robot gets there at about the same moment when nothing is lost). A
+  robot that receives a PIBT message of the step after its own begins that step
+  at once, and keeps that schedule: the fleet keeps the schedule of its earliest
+  robot, each robot within a message's delay of it. The first
   ``decide`` seconds of a step are its decision phase; then every robot that
   decided for good queues its move, any other stays (an abandoned step);
 * **bodies through the safety layer**: a queued move is claimed from the
@@ -28,8 +31,9 @@ it with what a live robot adds, sans-IO (fed with the clock, never reading it):
 
 :class:`PibtAgent` is the process around it (:class:`~mrmp.live.driver.LiveDriver`):
 the receiving and client threads, the body, the fleet heartbeat
-(a :class:`~mrmp.protocol.messages.StateMessage`, for discovery and for the end
-of the run). A PIBT message sent again by its brain keeps its sequence number
+(a :class:`~mrmp.protocol.messages.StateMessage`, for discovery, for the end
+of the run, and to keep every robot's knowledge of the far robots fresh: its
+``present`` is the cell the robot stands on at the start of step ``progress``). A PIBT message sent again by its brain keeps its sequence number
 (the brain recognises second copies by it), which the envelope's replay window
 rejects; :func:`open_repeat` lets such a datagram through, once its MAC and
 session are checked, to be acknowledged again and otherwise ignored by the brain.
@@ -83,15 +87,19 @@ class PibtTiming:
     """The step's length: the decision phase and a move."""
     retry: float
     """How long the brain waits for an acknowledgement before it sends a message again."""
+    hold: float
+    """How long, from the step's start, a held robot waits for its grant before it stays."""
 
     @classmethod
-    def for_body(cls, cell_seconds: float, decide: float = 0.25, retry: float = 0.03) -> PibtTiming:
-        """Steps of ``decide`` seconds of decisions and one cell's move.
+    def for_body(cls, cell_seconds: float, decide: float = 0.2, grace: float = 0.05, retry: float = 0.03) -> PibtTiming:
+        """Steps of ``decide`` seconds of decisions, one cell's move and ``grace`` seconds for the next grant.
+
+        A held robot waits for its grant for half the decision phase.
 
         >>> PibtTiming.for_body(0.5)
-        PibtTiming(decide=0.25, step=0.75, retry=0.03)
+        PibtTiming(decide=0.2, step=0.75, retry=0.03, hold=0.1)
         """
-        return cls(decide, decide + cell_seconds, retry)
+        return cls(decide, decide + cell_seconds + grace, retry, decide / 2)
 
 
 def open_repeat(opener: Opener, data: bytes) -> Message | None:
@@ -193,6 +201,8 @@ class PibtBrain:
             return out
         robot, timing = self.robot, self.timing
         begins = self.t0 + self.step * timing.step  # when the next step begins
+        if self._deciding and now >= begins - timing.step + timing.hold:
+            robot.give_up()
         if self._deciding and now >= begins - timing.step + timing.decide:
             self._finish_step()
         if now >= begins:
@@ -259,12 +269,12 @@ class PibtBrain:
     # -- messages ---------------------------------------------------------------------------
 
     def state(self) -> StateMessage:
-        """The fleet heartbeat: where the body stands and whether the robot is settled on its goal."""
-        safety = self.safety
-        present = safety.present
-        return self._stamp(
-            StateMessage(self.index, 0, present, present, self.robot.heading, self.settled, **safety.state_fields())
-        )
+        """The fleet heartbeat: where the robot stands at the start of a step (``progress``: that step) and
+        whether it is settled on its goal."""
+        robot = self.robot
+        cell = self.flat.cells[robot.present]
+        step = self.step if self._deciding else self.step + 1  # decided: its cell is the next step's
+        return self._stamp(StateMessage(self.index, 0, cell, cell, robot.heading, self.settled, progress=step))
 
     def receive(self, message: Message, now: float) -> list[Outgoing]:
         """Take in one message; return the answers to send at once."""
@@ -274,6 +284,8 @@ class PibtBrain:
             return []
         safety = self.safety
         if isinstance(message, PibtMessage):
+            if self.t0 is not None and message.step == self.step + 1:
+                self.t0 = min(self.t0, now - self.step * self.timing.step)  # a peer began the next step: so do we
             if isinstance(message, BeaconMessage):
                 old = self.heard.get(sender)
                 self.heard[sender] = (now, old[1] if old is not None else False)
@@ -282,6 +294,8 @@ class PibtBrain:
         if isinstance(message, StateMessage):
             first = sender not in self.heard
             self.heard[sender] = (now, message.arrived)
+            if message.progress > 0:
+                self.robot.learn(sender, self.flat.index(message.present), message.progress)
             if first and self.t0 is None:
                 return [Outgoing(self.state(), (sender,))]  # so that it hears of us as soon as we heard of it
             return []

@@ -12,7 +12,8 @@ it knows instead (``docs/protocol.md``, "Local sequencing", "Live"):
   ``c`` at step ``s`` is, at the start of step ``k``, within ``k - s`` cells of
   ``c``: it can be within ``r`` cells only if ``|c - here| <= r + k - s``;
 * every broadcast of radius ``r`` goes to exactly those peers (a superset of
-  the robots truly within ``r``), and at the start of a step the robot waits
+  the robots truly within ``r``); the step's beacon goes ``lookout`` cells
+  further, so the robots about to come near stay known freshly. At the start of a step the robot waits
   for this step's beacon of every peer that can be within its radio radius
   before it starts or joins a call; the cells within 2 of those beacons are
   what a sensor would have seen;
@@ -24,10 +25,13 @@ it knows instead (``docs/protocol.md``, "Local sequencing", "Live"):
   until the robot's own step begins.
 
 A robot whose body has not yet been allowed into the cell it decided on in an
-earlier step is *held* (:meth:`LivePibtRobot.begin_step`, :meth:`release`): it
-joins no call and, at its turn, stays. So a robot leaves a cell in a step only
-when its body owns that cell already (``docs/protocol.md`` gives why this keeps
-the bodies' execution free of deadlocks). Counted: ``held`` (steps begun held)
+earlier step is *held* (:meth:`LivePibtRobot.begin_step`): it neither starts a
+call nor answers a request to leave its cell until its body is allowed in
+(:meth:`LivePibtRobot.release`: then it goes on as if nothing had happened);
+if that does not come in time (:meth:`LivePibtRobot.give_up`), it refuses the
+requests and, at its turn, stays. So a robot leaves a cell in a step only when
+its body owns that cell already (``docs/protocol.md`` gives why this keeps the
+bodies' execution free of deadlocks). Counted: ``held`` (steps begun held)
 and ``pulled`` (beacons sent again to answer a peer's).
 
 Examples
@@ -78,6 +82,10 @@ class LivePibtRobot(ReliablePibtRobot):
         Every robot's start cell (flat index), by robot index: where each
         stands at the start of step 1. Without it the robot knows nobody
         (:meth:`meet` adds what it knows).
+    lookout:
+        The step's beacon goes this many cells further than the radio radius
+        (widened by what each peer can have driven), so that the robots about
+        to come near are known freshly and seldom have to be waited for.
     """
 
     def __init__(
@@ -97,6 +105,7 @@ class LivePibtRobot(ReliablePibtRobot):
         tie_penalties: bool | None = None,
         retry: int = 1,
         starts: Sequence[int] = (),
+        lookout: int = 2,
     ) -> None:
         super().__init__(
             index, start, goal, flat, tie=tie, heading=heading, radius=radius, swap=swap,
@@ -106,18 +115,22 @@ class LivePibtRobot(ReliablePibtRobot):
         """Per peer: the cell it was last heard of, and the step at whose start it stood there."""
         self.held = False
         """Whether the robot may not leave its cell in this step (its body does not own it yet)."""
+        self.lookout = lookout
         self._unknown: set[int] = set()
         self._early: list[PibtMessage] = []
         self._beacon_to: set[int] = set()
+        self._gave_up = False
+        self._asked: list[CallInheritMessage] = []
         self.meet(starts)
 
     def meet(self, starts: Sequence[int], step: int = 1) -> None:
         """Know every robot's cell at the start of ``step`` (by robot index; this robot's own is skipped)."""
         for peer, cell in enumerate(starts):
             if peer != self.index:
-                self._learn(peer, cell, step)
+                self.learn(peer, cell, step)
 
-    def _learn(self, peer: int, cell: int, step: int) -> None:
+    def learn(self, peer: int, cell: int, step: int) -> None:
+        """Know that ``peer`` stood on ``cell`` at the start of ``step`` (older news than what is known is ignored)."""
         old = self.known.get(peer)
         if old is None or step >= old[1]:
             self.known[peer] = (cell, step)
@@ -146,10 +159,11 @@ class LivePibtRobot(ReliablePibtRobot):
         ``sensed`` is ignored: a live robot senses no other body; which cells
         hold one follows from this step's beacons of the peers that can be near.
         """
-        self.held = held
+        self.held, self._gave_up, self._asked = held, False, []
         if held:
             self.stats["held"] += 1
-        out = self._address(super().begin_step(step, (), now))
+        beacons = super().begin_step(step, (), now)
+        out = [Outgoing(item.message, tuple(self.possibly_within(self.radius + self.lookout))) for item in beacons]
         self._beacon_to = {peer for item in out for peer in item.recipients or ()}
         self._unknown = set(self.possibly_within(max(self.radius, RESERVE_RADIUS)))
         early, self._early = self._early, []
@@ -162,7 +176,9 @@ class LivePibtRobot(ReliablePibtRobot):
 
     def release(self) -> None:
         """The body now owns the cell the robot stands on (its last move was allowed): it may take part in calls."""
-        self.held = False
+        if self.held:
+            self.held = False
+            self.wake = True
 
     def on_tick(self, now: int) -> list[Outgoing]:
         """:meth:`ReliablePibtRobot.on_tick`, its broadcasts addressed to the peers that can be near."""
@@ -171,10 +187,6 @@ class LivePibtRobot(ReliablePibtRobot):
             if isinstance(item.message, BeaconMessage):
                 self._beacon_to.update(item.recipients or ())
         return out
-
-    def act(self) -> list[Outgoing]:
-        """:meth:`ReliablePibtRobot.act`, its broadcasts addressed to the peers that can be near."""
-        return self._address(super().act())
 
     def _address(self, out: list[Outgoing]) -> list[Outgoing]:
         """Turn every radius broadcast into a message to the peers that can be within the radius."""
@@ -195,7 +207,7 @@ class LivePibtRobot(ReliablePibtRobot):
         if isinstance(message, BeaconMessage) and message.sender != self.index:
             sender = message.sender
             cell = self.flat.index(message.present)
-            self._learn(sender, cell, message.step)
+            self.learn(sender, cell, message.step)
             if message.step == self.step:
                 self._take_step_beacon(sender, cell, repeated=(sender, message.seq) in self._seen)
         return super().receive(message)
@@ -223,9 +235,32 @@ class LivePibtRobot(ReliablePibtRobot):
     def _beacon_heard(self) -> bool:
         return not self._unknown and super()._beacon_heard()
 
-    # -- a held robot stays --------------------------------------------------------
+    # -- a held robot waits for its grant, then stays -----------------------------
+
+    def give_up(self) -> None:
+        """The grant did not come in time: a held robot refuses what it was asked and, at its turn, stays."""
+        if self.held and not self._gave_up:
+            self._gave_up = True
+            self.wake = True
+
+    def act(self) -> list[Outgoing]:
+        """:meth:`ReliablePibtRobot.act`, requests kept while held taken up (or refused), broadcasts addressed."""
+        out: list[Outgoing] = []
+        if self._asked and (not self.held or self._gave_up):
+            asked, self._asked = self._asked, []
+            if self.held:
+                for message in asked:
+                    self.stats["refused"] += 1
+                    out.append(Outgoing(AnswerMessage(self.index, self._seq(), self.step, False), (message.sender,)))
+                self._track(out)
+            else:
+                self._control.extend(asked)
+        return self._address(out + super().act())
 
     def _take_inherit_local(self, message: CallInheritMessage, out: list[Outgoing]) -> None:
+        if self.held and not self._gave_up:
+            self._asked.append(message)  # answered once the grant comes, or refused when it does not
+            return
         if self.held:
             self.stats["refused"] += 1  # it cannot leave its cell this step: the asker tries its next cell
             out.append(Outgoing(AnswerMessage(self.index, self._seq(), self.step, False), (message.sender,)))
@@ -235,6 +270,9 @@ class LivePibtRobot(ReliablePibtRobot):
     def _take_pull_local(self, message: PullMessage, out: list[Outgoing]) -> None:
         if not self.held:
             super()._take_pull_local(message, out)
+
+    def _may_start(self) -> bool:
+        return (not self.held or self._gave_up) and super()._may_start()
 
     def _begin_call(self, out: list[Outgoing]) -> None:
         if self.held and self._parent is None:
