@@ -31,8 +31,9 @@ call nor answers a request to leave its cell until its body is allowed in
 if that does not come in time (:meth:`LivePibtRobot.give_up`), it refuses the
 requests and, at its turn, stays. So a robot leaves a cell in a step only when
 its body owns that cell already (``docs/protocol.md`` gives why this keeps the
-bodies' execution free of deadlocks). Counted: ``held`` (steps begun held)
-and ``pulled`` (beacons sent again to answer a peer's).
+bodies' execution free of deadlocks). Counted: ``held`` (steps begun held),
+``gave_up`` (steps in which the grant did not come in time) and ``pulled``
+(beacons sent again to answer a peer's).
 
 Examples
 --------
@@ -242,6 +243,7 @@ class LivePibtRobot(ReliablePibtRobot):
         if self.held and not self._gave_up:
             self._gave_up = True
             self.wake = True
+            self.stats["gave_up"] += 1
 
     def act(self) -> list[Outgoing]:
         """:meth:`ReliablePibtRobot.act`, requests kept while held taken up (or refused), broadcasts addressed."""
