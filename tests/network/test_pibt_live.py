@@ -96,7 +96,17 @@ def test_mrmp_agent_runs_a_pibt_robot(tmp_path):
     """Two ``mrmp agent --policy pibt`` processes (the scenario says ``thesis``) trade places."""
     first, second = free_ports(2)
     results = tmp_path / "run"
-    common = [sys.executable, "-m", "mrmp", "agent", str(SWAP), "--policy=pibt", f"--results={results}", "--time-scale=10", "--timeout=60"]
+    common = [
+        sys.executable,
+        "-m",
+        "mrmp",
+        "agent",
+        str(SWAP),
+        "--policy=pibt",
+        f"--results={results}",
+        "--time-scale=10",
+        "--timeout=60",
+    ]
     agents = [
         subprocess.Popen([*common, "--robot=A", f"--bind=127.0.0.1:{first}", f"--peer=B=127.0.0.1:{second}"], stderr=subprocess.PIPE, text=True),
         subprocess.Popen([*common, "--robot=B", f"--bind=127.0.0.1:{second}", f"--peer=A=127.0.0.1:{first}"], stderr=subprocess.PIPE, text=True),

@@ -33,7 +33,8 @@ it with what a live robot adds, sans-IO (fed with the clock, never reading it):
 the receiving and client threads, the body, the fleet heartbeat
 (a :class:`~mrmp.protocol.messages.StateMessage`, for discovery, for the end
 of the run, and to keep every robot's knowledge of the far robots fresh: its
-``present`` is the cell the robot stands on at the start of step ``progress``). A PIBT message sent again by its brain keeps its sequence number
+``present`` is the cell the robot stands on at the start of step ``progress``).
+A PIBT message sent again by its brain keeps its sequence number
 (the brain recognises second copies by it), which the envelope's replay window
 rejects; :func:`open_repeat` lets such a datagram through, once its MAC and
 session are checked, to be acknowledged again and otherwise ignored by the brain.
@@ -329,7 +330,7 @@ class PibtAgent(LiveDriver):
     default :meth:`PibtTiming.for_body` of the body's cell time).
     """
 
-    robot: PibtBrain  # type: ignore[assignment]
+    robot: PibtBrain
 
     def __init__(
         self,
