@@ -10,9 +10,11 @@ it with what a live robot adds, sans-IO (fed with the clock, never reading it):
   step`` seconds, ``t0`` being the moment the robot has heard every peer (the
   fleet's start: a robot answers a peer it hears of for the first time at once,
   so every robot gets there at about the same moment when nothing is lost). A
-  robot that receives a PIBT message of the step after its own begins that step
-  at once, and keeps that schedule: the fleet keeps the schedule of its earliest
-  robot, each robot within a message's delay of it. The first
+  robot that receives a PIBT message of a later step than its own begins that
+  step at once (ending the steps in between undecided; a fleet heartbeat
+  naming step ``p`` counts as a message of step ``p - 1``), and keeps that
+  schedule: the fleet keeps the schedule of its earliest robot, each robot
+  within a message's delay of it. The first
   ``decide`` seconds of a step are its decision phase; then every robot that
   decided for good queues its move, any other stays (an abandoned step);
 * **bodies through the safety layer**: a queued move is claimed from the
@@ -285,8 +287,8 @@ class PibtBrain:
             return []
         safety = self.safety
         if isinstance(message, PibtMessage):
-            if self.t0 is not None and message.step == self.step + 1:
-                self.t0 = min(self.t0, now - self.step * self.timing.step)  # a peer began the next step: so do we
+            if self.t0 is not None and message.step > self.step:
+                self.t0 = min(self.t0, now - (message.step - 1) * self.timing.step)  # a peer is ahead: catch it up
             if isinstance(message, BeaconMessage):
                 old = self.heard.get(sender)
                 self.heard[sender] = (now, old[1] if old is not None else False)
@@ -297,6 +299,8 @@ class PibtBrain:
             self.heard[sender] = (now, message.arrived)
             if message.progress > 0:
                 self.robot.learn(sender, self.flat.index(message.present), message.progress)
+                if self.t0 is not None and message.progress - 1 > self.step:  # it is in step progress - 1 or later
+                    self.t0 = min(self.t0, now - (message.progress - 2) * self.timing.step)
             if first and self.t0 is None:
                 return [Outgoing(self.state(), (sender,))]  # so that it hears of us as soon as we heard of it
             return []
