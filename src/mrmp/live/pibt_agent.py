@@ -94,15 +94,15 @@ class PibtTiming:
     """How long, from the step's start, a held robot waits for its grant before it stays."""
 
     @classmethod
-    def for_body(cls, cell_seconds: float, decide: float = 0.2, grace: float = 0.05, retry: float = 0.03) -> PibtTiming:
+    def for_body(cls, cell_seconds: float, decide: float = 0.3, grace: float = 0.05, retry: float = 0.03) -> PibtTiming:
         """Steps of ``decide`` seconds of decisions, one cell's move and ``grace`` seconds for the next grant.
 
         A held robot waits for its grant for half the decision phase.
 
         >>> PibtTiming.for_body(0.5)
-        PibtTiming(decide=0.2, step=0.75, retry=0.03, hold=0.1)
+        PibtTiming(decide=0.3, step=0.85, retry=0.03, hold=0.15)
         """
-        return cls(decide, decide + cell_seconds + grace, retry, decide / 2)
+        return cls(decide, round(decide + cell_seconds + grace, 6), retry, decide / 2)
 
 
 def open_repeat(opener: Opener, data: bytes) -> Message | None:
