@@ -79,6 +79,10 @@ __all__ = ["PibtAgent", "PibtBrain", "PibtTiming", "open_repeat"]
 
 M = TypeVar("M", bound=Message)
 
+POLL = 0.01
+"""Seconds between two polls of a live ``pibt`` robot at least: a third of its retransmission interval
+(a process per robot, many of them on a few cores: each poll costs CPU time the others wait for)."""
+
 
 @dataclass(frozen=True)
 class PibtTiming:
@@ -349,6 +353,7 @@ class PibtAgent(LiveDriver):
         clock: Callable[[], float] = time.monotonic,
         pibt: PibtTiming | None = None,
     ) -> None:
+        timing = dataclasses.replace(timing, poll=max(timing.poll, POLL))
         super().__init__(scenario, index, transport, body, sealer, opener, timing, seed, clock)
         self.pibt_timing = pibt if pibt is not None else PibtTiming.for_body(self.cell_seconds)
         self.robot = PibtBrain(scenario, index, self.pibt_timing, claim_retry=min(timing.claim_retry, 0.05))
