@@ -9,7 +9,7 @@ moves at the end of the step; over a perfect network too. The brains sense
 nothing: each knows every start and learns the rest from beacons, as live.
 Its moves are what a live fleet on a perfect network decides when no robot is
 held (``docs/protocol.md``, "Local sequencing", "Live"; tested in
-``tests/network/test_pibt_live.py``).
+``tests/network/test_live_pibt.py``).
 
 Examples
 --------
