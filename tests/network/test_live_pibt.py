@@ -168,3 +168,13 @@ def test_a_killed_live_pibt_launcher_leaves_nothing_running(tmp_path):
         if launcher.poll() is None:
             kill(launcher)
         time.sleep(0)  # nothing to wait for: every process is gone or killed
+
+
+def test_a_killed_robot_is_taken_for_crashed_and_the_robots_it_does_not_block_arrive(tmp_path):
+    """``--kill``: robot c, far from the others' way, dies; a and b stop waiting for it and trade places."""
+    robots = (RobotSpec("a", (0, 0), (0, 4)), RobotSpec("b", (0, 4), (0, 0)), RobotSpec("c", (4, 0), (4, 2)))
+    scenario = Scenario(Grid(5, 5), robots, timing=Timing(1.0, 0.5), policy=PolicyOptions(name="pibt"), name="pibt-kill")
+    result = run_live(scenario, LiveOptions(results=tmp_path / "run", time_scale=4, kill={"c": 0.3}, seed=0))
+    assert result.collisions == []
+    assert [robot.arrived for robot in result.robots] == [True, True, False]
+    assert pibt_counts(result)["crashed"] >= 2  # a and b each took c for crashed

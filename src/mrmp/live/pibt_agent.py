@@ -29,6 +29,8 @@ it with what a live robot adds, sans-IO (fed with the clock, never reading it):
   stays at its turn (``LivePibtRobot.held``): a robot leaves a cell only once its
   body owns it, which keeps the execution free of deadlocks (``docs/protocol.md``,
   "Local sequencing", "Live");
+* a peer silent for ``crash_after`` seconds is taken for crashed (an obstacle
+  on its last known cell, no longer waited for), until it is heard again;
 * the brain's timers run in whole milliseconds since ``t0``.
 
 :class:`PibtAgent` is the process around it (:class:`~mrmp.live.driver.LiveDriver`):
@@ -152,9 +154,13 @@ class PibtBrain:
         The step's timing.
     claim_retry:
         Seconds between two sends of a claim or a release.
+    crash_after:
+        A peer silent for this long is taken for crashed (an obstacle where it was last known), until heard again.
     """
 
-    def __init__(self, scenario: Scenario, index: int, timing: PibtTiming, claim_retry: float = 0.05) -> None:
+    def __init__(
+        self, scenario: Scenario, index: int, timing: PibtTiming, claim_retry: float = 0.05, crash_after: float = 6.0
+    ) -> None:
         spec = scenario.robots[index]
         flat = self.flat = FlatMap(scenario.grid)
         goal, start = flat.index(spec.goal), flat.index(spec.start)
@@ -190,6 +196,7 @@ class PibtBrain:
         self._deciding = False
         self._act = False
         self._claimed_at = -math.inf
+        self.crash_after = crash_after
 
     # -- time -------------------------------------------------------------------------------
 
@@ -219,6 +226,9 @@ class PibtBrain:
             out.extend(robot.begin_step(self.step, now=self._ms(now), held=bool(self.queue)))
             self._deciding = True
             self._act = True
+        for peer, (heard_at, _) in self.heard.items():
+            if now - heard_at > self.crash_after and peer not in robot.crashed:
+                robot.crash(peer)
         if self._deciding:
             resent = robot.on_tick(self._ms(now))
             out.extend(resent)
@@ -290,6 +300,8 @@ class PibtBrain:
             self.dropped["own" if sender == self.index else "unknown_sender"] += 1
             return []
         safety = self.safety
+        if sender in self.robot.crashed:
+            self.robot.revive(sender)
         if isinstance(message, PibtMessage):
             if self.t0 is not None and message.step > self.step:
                 self.t0 = min(self.t0, now - (message.step - 1) * self.timing.step)  # a peer is ahead: catch it up
@@ -356,7 +368,10 @@ class PibtAgent(LiveDriver):
         timing = dataclasses.replace(timing, poll=max(timing.poll, POLL))
         super().__init__(scenario, index, transport, body, sealer, opener, timing, seed, clock)
         self.pibt_timing = pibt if pibt is not None else PibtTiming.for_body(self.cell_seconds)
-        self.robot = PibtBrain(scenario, index, self.pibt_timing, claim_retry=min(timing.claim_retry, 0.05))
+        self.robot = PibtBrain(
+            scenario, index, self.pibt_timing, claim_retry=min(timing.claim_retry, 0.05),
+            crash_after=2 * timing.give_up_after,
+        )  # fmt: skip
 
     # -- what the driver reads of the brain --------------------------------------------------
 

@@ -31,7 +31,8 @@ call nor answers a request to leave its cell until its body is allowed in
 if that does not come in time (:meth:`LivePibtRobot.give_up`), it refuses the
 requests and, at its turn, stays. So a robot leaves a cell in a step only when
 its body owns that cell already (``docs/protocol.md`` gives why this keeps the
-bodies' execution free of deadlocks). Counted: ``held`` (steps begun held),
+bodies' execution free of deadlocks). A peer silent for long is taken for crashed (:meth:`LivePibtRobot.crash`): an
+obstacle on its last known cell, no longer waited for. Counted: ``crashed``, ``held`` (steps begun held),
 ``gave_up`` (steps in which the grant did not come in time) and ``pulled``
 (beacons sent again to answer a peer's).
 
@@ -122,6 +123,8 @@ class LivePibtRobot(ReliablePibtRobot):
         self._beacon_to: set[int] = set()
         self._gave_up = False
         self._asked: list[CallInheritMessage] = []
+        self.crashed: dict[int, int] = {}
+        """Peers taken for crashed (:meth:`crash`), by the cell each was last known on."""
         self.meet(starts)
 
     def meet(self, starts: Sequence[int], step: int = 1) -> None:
@@ -142,6 +145,8 @@ class LivePibtRobot(ReliablePibtRobot):
         x, y = cells[self.present]
         near = []
         for peer, (cell, heard) in self.known.items():
+            if peer in self.crashed:
+                continue
             px, py = cells[cell]
             if abs(px - x) + abs(py - y) <= radius + max(0, step - heard):
                 near.append(peer)
@@ -167,6 +172,8 @@ class LivePibtRobot(ReliablePibtRobot):
         out = [Outgoing(item.message, tuple(self.possibly_within(self.radius + self.lookout))) for item in beacons]
         self._beacon_to = {peer for item in out for peer in item.recipients or ()}
         self._unknown = set(self.possibly_within(max(self.radius, RESERVE_RADIUS)))
+        for peer, cell in self.crashed.items():
+            self._obstacle(peer, cell)
         early, self._early = self._early, []
         for message in early:
             if message.step == step:
@@ -174,6 +181,35 @@ class LivePibtRobot(ReliablePibtRobot):
             else:
                 self.dropped["stale"] += 1
         return out
+
+    def crash(self, peer: int) -> None:
+        """Take ``peer`` for crashed: an obstacle on the cell it was last known on, waited for and addressed no more."""
+        known = self.known.get(peer)
+        if known is None or peer in self.crashed:
+            return
+        self.crashed[peer] = known[0]
+        self.stats["crashed"] += 1
+        self._unknown.discard(peer)
+        for entry in self._unacknowledged.values():
+            entry.pending.discard(peer)
+        self._obstacle(peer, known[0])
+        self.wake = True
+
+    def revive(self, peer: int) -> None:
+        """``peer``, taken for crashed, was heard again: from the next step on it is a robot like the others."""
+        self.crashed.pop(peer, None)
+
+    def _obstacle(self, peer: int, cell: int) -> None:
+        """``peer`` stands on ``cell`` for good this step: occupied, reserved by it, decided, settled there."""
+        self._occupants[cell] = peer
+        self._goals[peer] = cell
+        self._settled.add(cell)
+        self._reserved[cell] = peer
+        self._targets[peer] = cell
+        self._final.add(peer)
+
+    def _known_within(self, radius: int) -> set[int]:
+        return super()._known_within(radius) - self.crashed.keys()
 
     def release(self) -> None:
         """The body now owns the cell the robot stands on (its last move was allowed): it may take part in calls."""
