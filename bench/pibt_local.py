@@ -19,8 +19,17 @@ network: the sequenced driver's link layer retransmits until every message
 arrives; the robots of local sequencing acknowledge, retransmit and abandon
 steps themselves.
 
-Usage: python bench/pibt_local.py [--maps DIR] [--only random-32-32-20:100,empty-32-32:400] [--limit TICKS]
-       [--radius R] [--loss P] [--duplicate P] [--delay-max TICKS]
+``--scale`` runs every map and N of ``bench/pibt_scale.py`` (every instance:
+each ``-random-*.scen``, or its seeded random instances; the thesis
+scenarios first) instead of ``--only``. ``--reach-cap`` and ``--stall-slack``
+set how far a stalled robot's reach grows over a perfect network
+(:attr:`~mrmp.robot.pibt_local.LocalPibtRobot.reach_cap`,
+:attr:`~mrmp.robot.pibt_local.LocalPibtRobot.stall_slack`); ``--order``
+runs one order only.
+
+Usage: python bench/pibt_local.py [--maps DIR] [--only random-32-32-20:100,empty-32-32:400 | --scale] [--limit TICKS]
+       [--radius R] [--loss P] [--duplicate P] [--delay-max TICKS] [--reach-cap R] [--stall-slack S]
+       [--order driver|local]
 """
 
 from __future__ import annotations
@@ -29,14 +38,32 @@ import argparse
 import sys
 from pathlib import Path
 
-from mrmp.core import NetworkFaults, PolicyOptions
-from mrmp.io import load_movingai_scenario
+from mrmp.core import NetworkFaults, PolicyOptions, Scenario
+from mrmp.io import load_movingai_scenario, load_scenario
+from mrmp.robot.pibt_local import LocalPibtRobot
 from mrmp.sim.local_rounds import LocalRoundsSimulator
 from mrmp.sim.rounds import RoundsSimulator
+from pibt_scale import AGENTS, instances
 
 ROOT = Path(__file__).resolve().parents[1]
 CASES = ("random-32-32-20:100", "random-32-32-20:200", "empty-32-32:400", "random-64-64-10:1000")
-SIMULATORS = (("driver", RoundsSimulator), ("local", LocalRoundsSimulator))
+
+
+def cases(arguments: argparse.Namespace) -> list[tuple[str, Scenario]]:
+    """The (label, scenario) pairs to run: ``--only``'s first N agents of ``-random-1.scen``, or ``--scale``'s."""
+    if not arguments.scale:
+        chosen = []
+        for case in arguments.only.split(","):
+            name, _, agents = case.partition(":")
+            scen = arguments.maps / f"{name}-random-1.scen"
+            chosen.append((name, load_movingai_scenario(arguments.maps / f"{name}.map", scen, int(agents))))
+        return chosen
+    chosen = [(path.stem, load_scenario(path)) for path in sorted((ROOT / "examples").glob("thesis-*.yaml"))]
+    for name, counts in AGENTS.items():
+        if (arguments.maps / f"{name}.map").exists():
+            for agents in counts:
+                chosen.extend((scenario.name, scenario) for scenario in instances(arguments.maps, name, agents))
+    return chosen
 
 
 def main() -> int:
@@ -48,24 +75,36 @@ def main() -> int:
     parser.add_argument("--loss", type=float, default=0.0, help="loss probability of every datagram")
     parser.add_argument("--duplicate", type=float, default=0.0, help="duplication probability of every datagram")
     parser.add_argument("--delay-max", type=int, default=0, help="largest delay of a datagram, in ticks")
+    parser.add_argument("--scale", action="store_true", help="every map and N of bench/pibt_scale.py instead of --only")
+    parser.add_argument("--reach-cap", type=int, default=LocalPibtRobot.reach_cap, help="largest reach of a stalled robot")
+    parser.add_argument("--stall-slack", type=int, default=LocalPibtRobot.stall_slack, help="stalled steps before reach grows")
+    parser.add_argument("--order", choices=("driver", "local"), default=None, help="run one order only")
     arguments = parser.parse_args()
+
+    class Robot(LocalPibtRobot):
+        reach_cap = arguments.reach_cap
+        stall_slack = arguments.stall_slack
+
+    class Local(LocalRoundsSimulator):
+        robot_type = Robot
+
+    simulators = [(label, simulator) for label, simulator in (("driver", RoundsSimulator), ("local", Local))]
+    simulators = [(label, simulator) for label, simulator in simulators if arguments.order in (None, label)]
     print(
-        f"{'map':<18} {'N':>5} {'order':>6} {'success':>7} {'SoC/LB':>7} {'mksp':>5} {'ms/step':>8} {'rnd/step':>8}"
+        f"{'map':<30} {'N':>5} {'order':>6} {'success':>7} {'SoC/LB':>7} {'mksp':>5} {'ms/step':>8} {'rnd/step':>8}"
         f" {'msg/r/s':>7} {'wait':>6} {'withdr':>7} {'refuse':>7} {'passed':>7} {'aband':>6} {'retrans':>7}"
     )
-    for case in arguments.only.split(","):
-        name, _, agents_text = case.partition(":")
-        agents = int(agents_text)
-        scenario = load_movingai_scenario(
-            arguments.maps / f"{name}.map", arguments.maps / f"{name}-random-1.scen", agents
-        ).with_changes(
+    for name, scenario in cases(arguments):
+        agents = len(scenario.robots)
+        case = f"{name}:{agents}"
+        scenario = scenario.with_changes(
             policy=PolicyOptions(name="pibt", radius=arguments.radius),
-            seed=0,
+            seed=scenario.seed if arguments.scale else 0,
             network=NetworkFaults(loss=arguments.loss, duplicate=arguments.duplicate, delay_max=arguments.delay_max),
         )
         if arguments.limit:
             scenario = scenario.with_changes(max_ticks=arguments.limit)
-        for label, simulator in SIMULATORS:
+        for label, simulator in simulators:
             result = simulator(scenario).run()
             if result.collisions:
                 raise SystemExit(f"{case} {label}: the referee found collisions: {result.collisions[:3]}")
@@ -86,7 +125,7 @@ def main() -> int:
                 )
             )
             print(
-                f"{name:<18} {agents:>5} {label:>6} {100 * result.success:>6.0f}% {soc:>7} {mksp:>5}"
+                f"{name:<30} {agents:>5} {label:>6} {100 * result.success:>6.0f}% {soc:>7} {mksp:>5}"
                 f" {1000 * result.wall_time_s / steps:>8.2f} {network['rounds'] / steps:>8.1f}"
                 f" {network['messages'] / per:>7.2f} {counts}",
                 flush=True,

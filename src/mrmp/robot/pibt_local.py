@@ -12,14 +12,20 @@ then acts):
 1. every robot broadcasts its beacon (cell, goal, priority) to the robots
    within its radio radius (at least 2 cells);
 2. a robot that has not decided and was not asked to decide *starts its own
-   call* (it becomes a *root*) in the first round in which every robot within
-   its radio radius that has a higher priority has decided for good (its final
-   reservation reaches that far), and no robot within 2 cells is in the middle
-   of a call (it holds a provisional reservation). Everything a call reads
-   lies within 2 cells of the robots it reaches, and a call reaches robots
-   only through their neighbours, so this is the local form of "the
-   highest-priority robot that has not decided starts" (exactly that when the
-   radius covers the map);
+   call* (it becomes a *root*) in the first round in which every robot whose
+   beacon it heard and that has a higher priority has decided for good (its
+   final reservation reaches as far as its beacon), and no robot within 2
+   cells is in the middle of a call (it holds a provisional reservation).
+   Everything a call reads lies within 2 cells of the robots it reaches, and a
+   call reaches robots only through their neighbours, so this is the local form
+   of "the highest-priority robot that has not decided starts" (exactly that
+   when the radius covers the map). A beacon reaches the robot's *reach*: the
+   radio radius, grown by one cell for every step beyond ``stall_slack`` that
+   the robot has *stalled* (ended a step no nearer its goal, away from it), up
+   to ``reach_cap`` cells. So the robots around a robot that is stuck wait for
+   its call, which then pushes them in the order central PIBT would, farther
+   than 2 cells; a robot that advances keeps the radio radius. The cap bounds
+   what one robot sends in a step independently of the number of robots;
 3. an asked robot (priority inheritance, :class:`CallInheritMessage`) decides
    at once, within the call of the robot that asked (its *root*), as in PIBT;
 4. a reservation (:class:`CallReserveMessage`, to every robot within 2
@@ -41,7 +47,8 @@ Counted by the robot itself (:attr:`LocalPibtRobot.stats`): ``waits`` (rounds
 in which it could not start yet), ``withdrawn`` (reservations lost to a call
 of higher priority), ``refused`` (requests refused because it was busy),
 ``passed_busy`` (cells passed by because their occupant was busy in another
-call) and ``abandoned`` (steps it ended undecided).
+call) and ``abandoned`` (steps it ended undecided); :attr:`LocalPibtRobot.stalled`
+and :attr:`LocalPibtRobot.reach` are its stall count and this step's reach.
 
 Examples
 --------
@@ -126,12 +133,20 @@ class LocalPibtRobot(PibtRobot):
         self._finishing: bool | None = None
         self._lost = False
         self._done = False
+        self.stalled = 0
+        self.reach = radius
+        self._y_size = flat.y_size
+        self._before = 0.0  # distance to the goal at the start of the step
 
     # -- the step ------------------------------------------------------------------
 
     def begin_step(self, step: int) -> list[Outgoing]:
         """Start step ``step``: forget the last step's view, announce cell, goal and priority; act next round."""
         out = super().begin_step(step)
+        self._before = self.flat.distances(self.goal)[self.present]
+        reach = self.reach = min(self.radius + max(0, self.stalled - self.stall_slack), max(self.radius, self.reach_cap))
+        if reach != self.radius:
+            out = [Outgoing(item.message, None, reach) for item in out]
         self._ranks = {}
         self._near = []
         self._final = set()
@@ -158,12 +173,16 @@ class LocalPibtRobot(PibtRobot):
     def receive_beacons(self, beacons: list[BeaconMessage]) -> None:
         """Take in beacons: cells, goals and priorities; note the robots within 2 cells."""
         super().receive_beacons(beacons)
-        x, y = self.flat.cells[self.present]
+        ranks, near = self._ranks, self._near
         for message in beacons:
-            self._ranks[message.sender] = (message.elapsed, message.tie, -message.sender)
-            px, py = message.present
-            if abs(px - x) + abs(py - y) <= self.radius:
-                self._near.append(message.sender)
+            sender = message.sender
+            ranks[sender] = (message.elapsed, message.tie, -sender)
+            near.append(sender)  # the radio brings a beacon only within its sender's reach
+
+    reach_cap = 8
+    """The largest reach a stalled robot's beacon and final reservation grow to (cells)."""
+    stall_slack = 2
+    """Steps a robot may stall before its reach grows beyond ``radius`` (one cell per further step)."""
 
     rotations = True
     """Take the cell of a robot busy in the robot's own call (PIBT's rotations): safe when every call ends in its step."""
@@ -177,21 +196,24 @@ class LocalPibtRobot(PibtRobot):
 
     @informing.on(CallReserveMessage)
     def _take_call_reservation(self, message: CallReserveMessage) -> bool:
+        if self._done:
+            return False  # decided for good: nothing it hears can change its cell, and the next step forgets it all
         sender = message.sender
-        cell = self.flat.index(message.cell)
+        x, y = message.cell
+        cell = x * self._y_size + y  # the flat index (FlatGrid.index), inlined: this runs for every reservation heard
         reserved, targets = self._reserved, self._targets
         old = targets.get(sender)
         if old is not None and old != cell and reserved.get(old) == sender:
             del reserved[old]  # a reservation replaced (after a lost conflict or backtracking)
         targets[sender] = cell
-        self._claims[sender] = message.rank
+        rank = self._claims[sender] = (message.root_elapsed, message.root_tie, -message.root)
         if message.final:
             self._final.add(sender)
             self._calls.pop(sender, None)
         else:
             self._calls[sender] = message.root
         if cell == self.target and not self._confirmed and sender != self.index:
-            if cell != self.present and (message.final or message.rank > self._rank):
+            if cell != self.present and (message.final or rank > self._rank):
                 self._lost = True  # a call of higher priority reserved it in the same round: withdraw
                 reserved[cell] = sender
             else:
@@ -200,7 +222,9 @@ class LocalPibtRobot(PibtRobot):
         holder = reserved.get(cell)
         if holder is None or holder == sender or targets.get(holder) != cell or self._outranks(sender, holder, cell):
             reserved[cell] = sender  # two claims of one cell in one round: the winner holds it, as the robots decide
-        return self.target is None  # a robot waiting to start reconsiders
+        # a robot waiting to start reconsiders when a robot it may have waited for decided for good (a provisional
+        # reservation, or the final one of a robot it did not wait for, cannot let it start)
+        return self.target is None and message.final and (old is not None or self._ranks.get(sender, (-1, 0, 0)) > self.priority)
 
     def _outranks(self, claimant: int, holder: int, cell: int) -> bool:
         """Whether ``claimant``'s claim of ``cell`` beats ``holder``'s: staying on one's cell first, then the call's rank."""
@@ -292,7 +316,10 @@ class LocalPibtRobot(PibtRobot):
         if not self._done:
             self.stats["abandoned"] += 1
             self.target = None
-        return super().finish_step()
+        cell = super().finish_step()
+        distance = self.flat.distances(self.goal)[cell]
+        self.stalled = 0 if cell == self.goal or distance < self._before else self.stalled + 1
+        return cell
 
     # -- PIBT's call, by messages -------------------------------------------------------
 
@@ -307,7 +334,7 @@ class LocalPibtRobot(PibtRobot):
         self.seq += 1
         root, (elapsed, tie, _) = self._root, self._rank
         message = CallReserveMessage(self.index, self.seq, self.step, self.flat.cells[cell], root, elapsed, tie, final)
-        out.append(Outgoing(message, None, self.radius if final else RESERVE_RADIUS))
+        out.append(Outgoing(message, None, self.reach if final else RESERVE_RADIUS))
 
     def _continue(self, out: list[Outgoing]) -> None:
         here = self.present

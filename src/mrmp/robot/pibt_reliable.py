@@ -25,7 +25,9 @@ acknowledged its messages):
   lower priority withdraws, as in synchronous rounds;
 * a call never takes the cell of a robot busy in the same call (no
   rotations): a step can end before such a call has finished, and the robot
-  whose cell was taken would then stay.
+  whose cell was taken would then stay;
+* the reach of a stalled robot does not grow (``reach_cap`` 0): the beacon
+  and the final reservation go to the radio radius only.
 
 The step ends at a tick the driver's clock fixes for everyone; a robot that
 has decided for good moves, any other stays (an abandoned step, counted).
@@ -98,6 +100,11 @@ class ReliablePibtRobot(LocalPibtRobot):
 
     rotations = False
 
+    reach_cap = 0
+    """The reach stays the radio radius: only robots within 2 cells acknowledge a final reservation, so a robot
+    farther away that waited for it could wait in vain for the rest of the step (and an abandoned step, counted
+    as a stall, would widen the reach further)."""
+
     def __init__(
         self,
         index: int,
@@ -157,7 +164,7 @@ class ReliablePibtRobot(LocalPibtRobot):
         if not self._beacon_heard() and now - self._beacon_sent_at >= self.retry:
             self._beacon_sent_at = now
             self.stats["retransmissions"] += 1
-            out.append(Outgoing(self._beacon(), None, self.radius))
+            out.append(Outgoing(self._beacon(), None, self.reach))
         for entry in self._unacknowledged.values():
             if entry.pending and now - entry.sent_at >= self.retry:
                 entry.sent_at = now

@@ -19,10 +19,14 @@ radio, a network and a clock:
 
 Nobody sorts the robots, finds their groups or waits for them to finish: the
 order of calls is the robots' own (``docs/protocol.md``, "Local sequencing").
-Only a perfect network is run: the one-round provisional reservation rests on
-every round's messages arriving in that round (a lossy or slow network is
-refused with a one-line error; ``pibt``'s default, sequenced driver,
-:mod:`mrmp.sim.rounds`, runs those).
+
+Over a network that loses, delays, duplicates or reorders, the one-round
+provisional reservation no longer holds (a round's messages may not arrive in
+that round), so the robots are :class:`~mrmp.robot.pibt_reliable.ReliablePibtRobot`
+brains, which acknowledge and retransmit themselves; the clock then gives every
+step ``step_ticks`` ticks (by default :data:`STEP_RETRIES` retry intervals of
+``2 * delay_max + 1`` ticks), after which the robots that decided for good move
+(``docs/protocol.md``, "Over a faulty network").
 
 Deterministic for a seed.
 
@@ -41,12 +45,14 @@ Examples
 from __future__ import annotations
 
 from collections import Counter
+from collections.abc import Callable, Sequence
+from typing import Any
 
 from mrmp.core.errors import InputError
 from mrmp.core.result import RunResult
 from mrmp.core.scenario import Scenario
 from mrmp.protocol.codec import decode, encode
-from mrmp.protocol.messages import Message, PibtMessage
+from mrmp.protocol.messages import BeaconMessage, Message, PibtMessage
 from mrmp.robot.messaging import Outgoing
 from mrmp.robot.pibt_local import LocalPibtRobot
 from mrmp.robot.pibt_reliable import ReliablePibtRobot
@@ -64,15 +70,33 @@ ROBOT_COUNTS = ("waits", "withdrawn", "refused", "passed_busy", "abandoned", "ac
 """What the robots count themselves, reported in the result's ``network``."""
 
 
+def _take_in(batch: list[tuple[int, int, bytes]], receivers: Sequence[Callable[[Any], bool]], acting: dict[int, None]) -> None:
+    """Decode every datagram of ``batch`` (once per payload) and hand it to its recipient's receiver.
+
+    The recipients whose receiver asks to act (returns True) are added to ``acting``, in order.
+    """
+    decoded: dict[int, Message] = {}
+    for _, recipient, payload in batch:
+        message = decoded.get(id(payload))
+        if message is None:
+            message = decoded[id(payload)] = decode(payload)
+            assert isinstance(message, PibtMessage), "a PIBT robot sends PIBT messages"
+        if receivers[recipient](message):
+            acting[recipient] = None
+
+
 class LocalRoundsSimulator(RoundsSimulator):
     """Runs a scenario with robots that sequence their PIBT calls themselves (module docstring).
 
     Parameters are those of :class:`~mrmp.sim.rounds.RoundsSimulator`.
 
+    ``step_ticks`` (faulty networks only; None for the default) is the length
+    of a step in ticks.
+
     Raises
     ------
     InputError
-        If the scenario's network is not perfect.
+        If ``step_ticks`` is below 1.
     """
 
     robot_type = LocalPibtRobot
@@ -112,6 +136,9 @@ class LocalRoundsSimulator(RoundsSimulator):
         ticks = default_max_ticks(self.scenario.with_changes(safety=False), self.lengths) * self.step_ticks
         return ticks if self.perfect else 2 * ticks
 
+    encode_perfect = False
+    """Send every message through the codec and the network on a perfect network too (slower; same decisions)."""
+
     def step(self) -> None:
         """One PIBT step: beacons, rounds until nothing is due and no timer is set, then the moves."""
         if not self.perfect:
@@ -120,10 +147,83 @@ class LocalRoundsSimulator(RoundsSimulator):
         self.step_count += 1
         step = self.step_count
         robots = self.robots
+        self._place_bodies()
+        if self.encode_perfect:
+            self._encoded_rounds(step)
+            return
+        receivers = self._receivers  # a perfect network: every message once, in the next round, unchanged
+        address = self._address
+        results = self._results
+        sizes = self._sizes
+        sent = sent_bytes = 0
+        due: list[tuple[tuple[int, ...], Message]] = []
+        for robot in robots:
+            index = robot.index
+            for item in robot.begin_step(step):
+                hearers = address(index, item)
+                count = len(hearers)
+                size = sizes[type(item.message)] * count
+                results[index].messages_sent += count
+                results[index].bytes_sent += size
+                sent += count
+                sent_bytes += size
+                if hearers:
+                    due.append((hearers, item.message))
+        if due and all(type(message) is BeaconMessage for _, message in due):
+            heard: list[list[BeaconMessage]] = [[] for _ in robots]  # the beacon round, one call per recipient
+            for hearers, message in due:
+                for recipient in hearers:
+                    heard[recipient].append(message)  # type: ignore[arg-type]
+            for robot, beacons in zip(robots, heard):
+                if beacons:
+                    robot.receive_beacons(beacons)
+            due = []
+        woken = [robot.index for robot in robots if robot.wake]
+        rounds = 0
+        while due or woken:
+            rounds += 1
+            acting = dict.fromkeys(woken)
+            for hearers, message in due:
+                for recipient in hearers:
+                    if receivers[recipient](message):
+                        acting[recipient] = None
+            due = []
+            woken = []
+            for index in acting:
+                robot = robots[index]
+                out = robot.act()
+                if out:
+                    result = results[index]
+                    for item in out:
+                        hearers = address(index, item)
+                        count = len(hearers)
+                        size = sizes[type(item.message)] * count
+                        result.messages_sent += count
+                        result.bytes_sent += size
+                        sent += count
+                        sent_bytes += size
+                        if hearers:
+                            due.append((hearers, item.message))
+                if robot.wake:
+                    woken.append(index)
+        stats = self.network.stats
+        stats.sent += sent
+        stats.delivered += sent
+        stats.bytes_sent += sent_bytes
+        stats.bytes_delivered += sent_bytes
+        self.stats["rounds"] += rounds
+        self._advance(moves=True)
+
+    def _place_bodies(self) -> None:
+        """Note which robot's body stands on every cell this step (the radio's physical world)."""
         occupant = self._occupant = [NO_ROBOT] * len(self.flat.neighbours)
         self._hearers = {}
-        for robot in robots:
+        for robot in self.robots:
             occupant[robot.present] = robot.index
+
+    def _encoded_rounds(self, step: int) -> None:
+        """:meth:`step` with every message encoded, sent through the network and decoded by its recipient."""
+        robots = self.robots
         now = self.tick
         send = self._send
         for robot in robots:
@@ -139,13 +239,7 @@ class LocalRoundsSimulator(RoundsSimulator):
                 break
             rounds += 1
             acting = dict.fromkeys(woken)
-            decoded: dict[int, Message] = {}
-            for _, recipient, payload in batch:
-                message = decoded.get(id(payload))
-                if message is None:
-                    message = decoded[id(payload)] = decode(payload)
-                if receivers[recipient](message):
-                    acting[recipient] = None
+            _take_in(batch, receivers, acting)
             woken = []
             for index in acting:
                 robot = robots[index]
@@ -161,23 +255,21 @@ class LocalRoundsSimulator(RoundsSimulator):
         self.step_count += 1
         step = self.step_count
         robots = self.robots
-        occupant = self._occupant = [NO_ROBOT] * len(self.flat.neighbours)
-        self._hearers = {}
-        for robot in robots:
-            occupant[robot.present] = robot.index
+        self._place_bodies()
+        occupant = self._occupant
         send = self._send
         within = self._within
         reliable = [robot for robot in robots if isinstance(robot, ReliablePibtRobot)]
-        for robot in reliable:
-            sensed = [cell for cell in within(robot.present, RESERVE_RADIUS) if occupant[cell] != NO_ROBOT]
-            for item in robot.begin_step(step, sensed, self.tick):
-                send(robot.index, item, self.tick)
+        for brain in reliable:
+            sensed = [cell for cell in within(brain.present, RESERVE_RADIUS) if occupant[cell] != NO_ROBOT]
+            for item in brain.begin_step(step, sensed, self.tick):
+                send(brain.index, item, self.tick)
         for tick_of_step in range(self.step_ticks):
             now = self.tick
             if tick_of_step:
-                for robot in reliable:
-                    for item in robot.on_tick(now):
-                        send(robot.index, item, now)
+                for brain in reliable:
+                    for item in brain.on_tick(now):
+                        send(brain.index, item, now)
             for robot in robots:
                 for item in robot.act():
                     send(robot.index, item, now)
@@ -191,35 +283,35 @@ class LocalRoundsSimulator(RoundsSimulator):
         robots = self.robots
         network = self.network
         send = self._send
+        receivers = [robot.receive for robot in robots]  # checks for stale messages and second copies
         while True:
             batch = network.deliver(now)
             if not batch:
                 return
             self.stats["rounds"] += 1
             acting: dict[int, None] = {}
-            decoded: dict[int, Message] = {}
-            for _, recipient, payload in batch:
-                message = decoded.get(id(payload))
-                if message is None:
-                    message = decoded[id(payload)] = decode(payload)
-                assert isinstance(message, PibtMessage), "a PIBT robot sends PIBT messages"
-                if robots[recipient].receive(message):
-                    acting[recipient] = None
+            _take_in(batch, receivers, acting)
             for index in acting:
                 for item in robots[index].act():
                     send(index, item, now)
 
-    def _send(self, sender: int, item: Outgoing, now: int) -> None:
-        """Hand ``item`` to the network: to its named recipients, or by radio to the bodies within its radius."""
+    def _address(self, sender: int, item: Outgoing) -> tuple[int, ...]:
+        """The recipients of ``item``: its named ones, or by radio the bodies within its radius of the sender's."""
         recipients = item.recipients
-        if recipients is None:
-            assert item.radius is not None, "a PIBT robot broadcasts within a radius"
-            key = (sender, item.radius)
-            recipients = self._hearers.get(key)
-            if recipients is None:  # the bodies stand still during a step: who hears whom is found once
-                occupant = self._occupant
-                cells = self._within(self.robots[sender].present, item.radius)
-                recipients = self._hearers[key] = tuple(other for cell in cells if (other := occupant[cell]) != NO_ROBOT)
+        if recipients is not None:
+            return recipients
+        assert item.radius is not None, "a PIBT robot broadcasts within a radius"
+        key = (sender, item.radius)
+        hearers = self._hearers.get(key)
+        if hearers is None:  # the bodies stand still during a step: who hears whom is found once
+            occupant = self._occupant
+            cells = self._within(self.robots[sender].present, item.radius)
+            hearers = self._hearers[key] = tuple(other for cell in cells if (other := occupant[cell]) != NO_ROBOT)
+        return hearers
+
+    def _send(self, sender: int, item: Outgoing, now: int) -> None:
+        """Hand ``item``, encoded, to the network for its recipients (:meth:`_address`)."""
+        recipients = self._address(sender, item)
         payload = encode(item.message)
         network_send = self.network.send
         for recipient in recipients:

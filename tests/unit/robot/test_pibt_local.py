@@ -11,6 +11,7 @@ from mrmp.core.grid import connected_regions
 from mrmp.robot.pibt_local import LocalPibtRobot
 from mrmp.robot.pibt_reliable import ReliablePibtRobot
 from mrmp.sim.local_rounds import LocalRoundsSimulator
+from mrmp.sim.rounds import RoundsSimulator
 
 
 def random_scenario(seed, swap, radius=2, faults=None):
@@ -83,7 +84,7 @@ def test_decisions_stay_close_to_central_pibt():
                 decisions += len(got)
                 moved_otherwise += sum(a != b for a, b in zip(got, expected))
             assert simulator.referee.collisions == []
-    # measured: 72 of 2,400 steps, 213 of 19,020 decisions (docs/protocol.md, "Local sequencing")
+    # measured: 56 of 2,400 steps, 167 of 19,020 decisions (docs/protocol.md, "Local sequencing")
     assert differ <= 0.05 * steps
     assert moved_otherwise <= 0.02 * decisions
 
@@ -256,3 +257,65 @@ def test_each_broken_variant_collides_over_a_faulty_network(variant):
         assert LocalRoundsSimulator(scenario).run().collisions == []
         collided += len(Simulator(scenario).run().collisions)
     assert collided > 0
+
+
+# -- progress on maps with dead ends: a stalled robot's reach grows ------------------------------------
+
+
+def dead_ends(seed, density, blocked, max_ticks=120):
+    """A random map with a third of its cells blocked (corridors, dead ends), ``density`` of its region holding robots."""
+    rng = random.Random(seed)
+    x_size, y_size = rng.randint(6, 12), rng.randint(6, 12)
+    cells = [(x, y) for x in range(x_size) for y in range(y_size)]
+    grid = Grid(x_size, y_size, set(rng.sample(cells, k=int(len(cells) * blocked))))
+    free = sorted(max(connected_regions(grid, grid.free_cells())[1], key=len))
+    count = max(2, int(len(free) * density))
+    starts, goals = rng.sample(free, count), rng.sample(free, count)
+    robots = tuple(RobotSpec(f"r{i}", s, g) for i, (s, g) in enumerate(zip(starts, goals)))
+    return Scenario(grid, robots, policy=PolicyOptions(name="pibt"), seed=seed, max_ticks=max_ticks)
+
+
+DEAD_ENDS = [(21, 0.3, 0.35), (57, 0.3, 0.35), (40, 0.3, 0.35), (55, 0.4, 0.3)]
+
+
+class Confined(LocalPibtRobot):
+    """Broken: a stalled robot's reach never grows (robots beyond 2 cells start before its call reaches them)."""
+
+    reach_cap = 0
+
+
+@pytest.mark.parametrize("case", DEAD_ENDS)
+def test_a_growing_reach_gets_robots_out_of_dead_ends_where_a_fixed_one_deadlocks(case):
+    class Fixed(LocalRoundsSimulator):
+        robot_type = Confined
+
+    scenario = dead_ends(*case)
+    assert RoundsSimulator(scenario).run().success  # the sequenced order arrives
+    grown = LocalRoundsSimulator(scenario).run()
+    assert grown.success and grown.collisions == [] and grown.network["abandoned"] == 0
+    fixed = Fixed(scenario).run()
+    assert not fixed.success and fixed.collisions == []
+
+
+def test_the_reach_grows_one_cell_per_stalled_step_after_the_slack_up_to_the_cap():
+    simulator = LocalRoundsSimulator(dead_ends(*DEAD_ENDS[0]))
+    seen = set()
+    for _ in range(40):
+        stalled = [robot.stalled for robot in simulator.robots]
+        simulator.step()
+        for robot, before in zip(simulator.robots, stalled):
+            assert robot.reach == min(robot.radius + max(0, before - robot.stall_slack), robot.reach_cap)
+            seen.add(robot.reach)
+    assert {2, 3, LocalPibtRobot.reach_cap} <= seen
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_handing_messages_over_equals_sending_them_encoded_through_the_network(seed):
+    class Encoded(LocalRoundsSimulator):
+        encode_perfect = True
+
+    for scenario in (crowd(seed), dead_ends(*DEAD_ENDS[seed % len(DEAD_ENDS)], max_ticks=40)):
+        handed, encoded = LocalRoundsSimulator(scenario).run(), Encoded(scenario).run()
+        assert [robot.path for robot in handed.robots] == [robot.path for robot in encoded.robots]
+        assert [robot.bytes_sent for robot in handed.robots] == [robot.bytes_sent for robot in encoded.robots]
+        assert handed.network == encoded.network
