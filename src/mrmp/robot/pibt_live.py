@@ -266,6 +266,18 @@ class LivePibtRobot(ReliablePibtRobot):
             self._beacon_to.add(sender)
             self._replies.append(Outgoing(self._beacon(), (sender,)))
 
+    def receive_beacons(self, beacons: list[BeaconMessage]) -> None:
+        """As the parent, but only the robots within the radio radius count as near (the start rule waits for them):
+        a beacon that looks further (``lookout``) comes from robots whose final reservation may not reach this one."""
+        before = len(self._near)
+        super().receive_beacons(beacons)
+        x, y = self.flat.cells[self.present]
+        self._near[before:] = [
+            message.sender
+            for message in beacons
+            if abs(message.present[0] - x) + abs(message.present[1] - y) <= self.radius
+        ]
+
     def _complete(self) -> bool:
         return not self._unknown and super()._complete()
 
