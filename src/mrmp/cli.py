@@ -915,6 +915,7 @@ def validate(
 def agent(
     scenario_path: Annotated[Path | None, typer.Argument(metavar="SCENARIO", help="The fleet's scenario (the same file on every robot).", show_default=False)] = None,
     robot: Annotated[str | None, typer.Option(help="Which robot of the scenario this process is (required).", metavar="ID")] = None,
+    policy: Annotated[str | None, typer.Option(help="The decision rule (the same on every robot of the fleet).", metavar=choices(policy_names()), show_default=SCENARIO_DEFAULT, autocompletion=policy_names)] = None,
     transport: Annotated[str, typer.Option(help="How the robots talk.", metavar=choices(TRANSPORTS.names), autocompletion=lambda: list(TRANSPORTS.names))] = "udp",
     bind: Annotated[str, typer.Option(help="UDP: address to receive on.", metavar="HOST:PORT")] = "127.0.0.1:9001",
     peer: Annotated[list[str] | None, typer.Option(help="UDP: a peer (repeat for each).", metavar="ID=HOST:PORT", show_default=False)] = None,
@@ -954,7 +955,10 @@ def agent(
         scenario_path = _scenario_argument(scenario_path, scenario_option)
         if robot is None:
             raise InputError(Problem("--robot", "give the id of the robot this process is"))
-        scenario = load_scenario(scenario_path, known_policies=policy_names())
+        scenario = apply_run_options(load_scenario(scenario_path, known_policies=policy_names()), policy, names=FLAG_NAMES)
+        entry = policy_entry(scenario.policy.name)
+        if entry.live_driver is None:
+            raise InputError(Problem("--policy", f"{entry.name} {entry.not_live}"))
         ids = [spec.id for spec in scenario.robots]
         if robot not in ids:
             raise InputError(Problem("--robot", f"no robot has the id {robot!r} in {scenario_path}"))

@@ -44,6 +44,7 @@ from mrmp.live.results import ideal_makespan, live_result
 from mrmp.live.transport import LiveFaults
 from mrmp.live.transport_entry import FleetLayout
 from mrmp.live.transport_table import FAULTS, TRANSPORTS
+from mrmp.sim.policy_table import policy_entry
 
 
 @dataclass(frozen=True)
@@ -132,6 +133,9 @@ def run_live(
     timeout = min(timeout, MAX_RUN_SECONDS)  # what mrmp agent --timeout accepts
     fleet = _start_fleet(options, files, layout, session, timeout)
     say(f"live: {len(ids)} robot processes and a referee over {options.transport} on loopback; results in {files.results}")
+    note = policy_entry(scenario.policy.name).live_note if options.plan is None else ""
+    if note:
+        say(f"live: {note}")
     stop_reason = _watch(fleet, options.kill, say, on_progress)
     wall_time = time.monotonic() - fleet.started
     reports = [_read_if_there(files.results / f"agent-{index}.json") for index in range(len(ids))]

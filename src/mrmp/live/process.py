@@ -26,6 +26,7 @@ from mrmp.io.plans import read_share, read_share_dependents
 from mrmp.live.agent import Agent, AgentReport, AgentTiming
 from mrmp.live.body import OccupancyRecorder, SimulatedBody
 from mrmp.live.causal_agent import CausalAgent
+from mrmp.live.pibt_agent import PibtAgent
 from mrmp.live.referee import IntervalReferee
 from mrmp.live.transport import ConnectedTransport, LiveFaults, Transport, is_loopback
 from mrmp.live.transport_table import FAULTS, TransportSpec
@@ -140,11 +141,26 @@ def _causal_agent(
     return CausalAgent(scenario, index, transport, body, sealer, opener, timing=options.timing, seed=options.seed)
 
 
+def _pibt_agent(
+    scenario: Scenario,
+    index: int,
+    transport: Transport,
+    body: SimulatedBody,
+    sealer: Sealer,
+    opener: Opener,
+    options: AgentOptions,
+    policy: PlanFollowingPolicy | None,
+) -> PibtAgent:
+    """The live driver of ``pibt``: locally sequenced, in steps on a common clock, always through the safety layer."""
+    return PibtAgent(scenario, index, transport, body, sealer, opener, timing=options.timing, seed=options.seed)
+
+
 LiveDriver = Callable[
-    [Scenario, int, Transport, SimulatedBody, Sealer, Opener, "AgentOptions", "PlanFollowingPolicy | None"], "Agent | CausalAgent"
+    [Scenario, int, Transport, SimulatedBody, Sealer, Opener, "AgentOptions", "PlanFollowingPolicy | None"],
+    "Agent | CausalAgent | PibtAgent",
 ]
 
-LIVE_DRIVERS: dict[str, LiveDriver] = {"agent": _per_robot_agent, "causal": _causal_agent}
+LIVE_DRIVERS: dict[str, LiveDriver] = {"agent": _per_robot_agent, "causal": _causal_agent, "pibt": _pibt_agent}
 """The live drivers by the kind a policy-table entry names (:attr:`mrmp.sim.policy_table.PolicyEntry.live_driver`)."""
 
 

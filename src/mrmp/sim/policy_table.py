@@ -28,7 +28,7 @@ Examples
 >>> policy_names()
 ('thesis', 'astar', 'pibt', 'causal')
 >>> policy_entry("pibt").simulator.__name__, policy_entry("pibt").live_driver
-('pibt_simulator', None)
+('pibt_simulator', 'pibt')
 >>> make_policy(PolicyOptions(name="thesis", resolve="wait")).resolve
 'wait'
 """
@@ -96,7 +96,10 @@ class PolicyEntry:
     live_driver:
         The kind of live driver that runs it in ``mrmp agent`` (``"agent"``:
         the per-robot :class:`~mrmp.live.agent.Agent`; ``"causal"``:
-        :class:`~mrmp.live.causal_agent.CausalAgent`), or None when it is simulated only.
+        :class:`~mrmp.live.causal_agent.CausalAgent`; ``"pibt"``:
+        :class:`~mrmp.live.pibt_agent.PibtAgent`), or None when it is simulated only.
+    live_note:
+        What a live run of it says first about how it runs live (empty: nothing).
     runs:
         Message-based policies: how they run, for the error of asking them for a per-robot rule.
     not_live:
@@ -115,6 +118,7 @@ class PolicyEntry:
     live_driver: str | None = None
     runs: str = ""
     not_live: str = ""
+    live_note: str = ""
     always_guarded: bool = False
     records_messages: bool = False
 
@@ -188,7 +192,11 @@ POLICY_TABLE: dict[str, PolicyEntry] = {
         PibtRobot,
         simulator=pibt_simulator,
         runs="runs in synchronous rounds (mrmp.sim.rounds)",
-        not_live="runs in the simulator's synchronous rounds only; its live, asynchronous form is --policy causal",
+        live_driver="pibt",
+        live_note=(
+            "pibt runs live with local sequencing, whatever policy.sequencing says"
+            " (no driver can order live processes; sequencing: driver is the simulator's)"
+        ),
     ),
     "causal": PolicyEntry(
         "causal",

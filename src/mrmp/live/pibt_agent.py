@@ -1,0 +1,434 @@
+"""The live driver of one ``pibt`` robot: locally sequenced PIBT in steps on a common clock, bodies guarded.
+
+No driver can order live processes, so a live ``pibt`` robot sequences its
+PIBT calls itself: its brain is :class:`~mrmp.robot.pibt_live.LivePibtRobot`
+(local sequencing over a faulty network, with acknowledgements and timers,
+knowing instead of sensing which robots can be near). :class:`PibtBrain` wraps
+it with what a live robot adds, sans-IO (fed with the clock, never reading it):
+
+* **steps on a common clock**: step ``k`` (from 1) begins at ``t0 + (k - 1) *
+  step`` seconds, ``t0`` being the moment the robot has heard every peer (the
+  fleet's start: a robot answers a peer it hears of for the first time at once,
+  so every robot gets there at about the same moment when nothing is lost). A
+  robot that receives a PIBT message of a later step than its own begins that
+  step at once (ending the steps in between undecided; a fleet heartbeat
+  naming step ``p`` counts as a message of step ``p - 1``), and keeps that
+  schedule: the fleet keeps the schedule of its earliest robot, each robot
+  within a message's delay of it. The first
+  ``decide`` seconds of a step are its decision phase; then every robot that
+  decided for good queues its move, any other stays (an abandoned step);
+* **bodies through the safety layer**: a queued move is claimed from the
+  cell's replicas (:class:`~mrmp.protocol.safety.SafetyLayer`); the body starts
+  only once a majority registered the cell to it, and its old cell is
+  released once the body has left it. Live bodies cover both cells while they
+  move, so a robot following another into its cell enters only once the
+  leader has cleared it: a chain of followers moves one after the other, and
+  its tail may still be moving when the next step begins;
+* **held robots**: a robot whose queued move has not been granted when a step
+  begins takes part in no call in that step, until the grant arrives, and
+  stays at its turn (``LivePibtRobot.held``): a robot leaves a cell only once its
+  body owns it, which keeps the execution free of deadlocks (``docs/protocol.md``,
+  "Local sequencing", "Live");
+* a peer silent for ``crash_after`` seconds is taken for crashed (an obstacle
+  on its last known cell, no longer waited for), until it is heard again;
+* the brain's timers run in whole milliseconds since ``t0``.
+
+:class:`PibtAgent` is the process around it (:class:`~mrmp.live.driver.LiveDriver`):
+the receiving and client threads, the body, the fleet heartbeat
+(a :class:`~mrmp.protocol.messages.StateMessage`, for discovery, for the end
+of the run, and to keep every robot's knowledge of the far robots fresh: its
+``present`` is the cell the robot stands on at the start of step ``progress``).
+A PIBT message sent again by its brain keeps its sequence number
+(the brain recognises second copies by it), which the envelope's replay window
+rejects; :func:`open_repeat` lets such a datagram through, once its MAC and
+session are checked, to be acknowledged again and otherwise ignored by the brain.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from collections.abc import Callable
+from dataclasses import dataclass
+from typing import TypeVar
+
+from mrmp.core.cell import Cell
+from mrmp.core.scenario import Scenario
+from mrmp.core.seeds import Stream, stream_random
+from mrmp.live.body import Body
+from mrmp.live.driver import AgentTiming, LiveDriver, fleet_wide
+from mrmp.live.transport import Transport
+from mrmp.protocol.auth import OVERHEAD, TAG_BYTES, Opener, Sealer
+from mrmp.protocol.codec import DecodeError, decode
+from mrmp.protocol.messages import (
+    BeaconMessage,
+    ClaimMessage,
+    Message,
+    PibtMessage,
+    ReleaseAckMessage,
+    ReleaseMessage,
+    ReplyMessage,
+    StateMessage,
+)
+from mrmp.protocol.pibt_local import CallAckMessage
+from mrmp.protocol.safety import SafetyLayer
+from mrmp.robot.messaging import Outgoing
+from mrmp.robot.pibt_live import LivePibtRobot
+from mrmp.search.flat_map import FlatMap
+
+__all__ = ["PibtAgent", "PibtBrain", "PibtTiming", "open_repeat"]
+
+M = TypeVar("M", bound=Message)
+
+POLL = 0.01
+"""Seconds between two polls of a live ``pibt`` robot at least: a third of its retransmission interval
+(a process per robot, many of them on a few cores: each poll costs CPU time the others wait for)."""
+
+
+@dataclass(frozen=True)
+class PibtTiming:
+    """A live ``pibt`` robot's step, in seconds of wall-clock time (module docstring)."""
+
+    decide: float
+    """The decision phase at the start of every step."""
+    step: float
+    """The step's length: the decision phase and a move."""
+    retry: float
+    """How long the brain waits for an acknowledgement before it sends a message again."""
+    hold: float
+    """How long, from the step's start, a held robot waits for its grant before it stays."""
+
+    @classmethod
+    def for_body(cls, cell_seconds: float, decide: float = 0.3, grace: float = 0.05, retry: float = 0.03) -> PibtTiming:
+        """Steps of ``decide`` seconds of decisions, one cell's move and ``grace`` seconds for the next grant.
+
+        A held robot waits for its grant for half the decision phase.
+
+        >>> PibtTiming.for_body(0.5)
+        PibtTiming(decide=0.3, step=0.85, retry=0.03, hold=0.15)
+        """
+        return cls(decide, round(decide + cell_seconds + grace, 6), retry, decide / 2)
+
+
+def open_repeat(opener: Opener, data: bytes) -> Message | None:
+    """Open ``data``; a PIBT message (not an acknowledgement) the replay window rejects as replayed is returned too.
+
+    Its MAC and session were checked before the replay window
+    (:mod:`mrmp.protocol.auth`); a repeat of a brain's message reaches the
+    brain, which acknowledges it again and takes nothing else from it.
+
+    >>> from mrmp.protocol.messages import BeaconMessage
+    >>> sealer, opener = Sealer(b"k", 1), Opener(b"k", 1)
+    >>> data = sealer.seal(BeaconMessage(0, 5, 1, (0, 0), (1, 0), 0, 1))
+    >>> open_repeat(opener, data).seq, open_repeat(opener, data).seq, dict(opener.rejected)
+    (5, 5, {'replayed': 1})
+    >>> open_repeat(opener, sealer.seal(StateMessage(0, 5, (0, 0), (0, 0)))) is None   # a state is no repeat
+    True
+    """
+    replayed = opener.rejected["replayed"]
+    message = opener.open(data)
+    if message is not None or opener.rejected["replayed"] == replayed:
+        return message
+    try:
+        repeat = decode(data[OVERHEAD - TAG_BYTES : -TAG_BYTES])
+    except DecodeError:
+        return None
+    if isinstance(repeat, PibtMessage) and not isinstance(repeat, CallAckMessage):
+        return repeat
+    return None
+
+
+class PibtBrain:
+    """One live ``pibt`` robot's decisions: the PIBT brain, the step clock, the move queue, the safety layer.
+
+    Sans-IO: fed with messages and the time (seconds, the driver's clock).
+
+    Parameters
+    ----------
+    scenario:
+        The whole scenario (every robot loads the same one).
+    index:
+        Which robot this is.
+    timing:
+        The step's timing.
+    claim_retry:
+        Seconds between two sends of a claim or a release.
+    crash_after:
+        A peer silent for this long is taken for crashed (an obstacle where it was last known), until heard again.
+    """
+
+    def __init__(
+        self, scenario: Scenario, index: int, timing: PibtTiming, claim_retry: float = 0.05, crash_after: float = 6.0
+    ) -> None:
+        spec = scenario.robots[index]
+        flat = self.flat = FlatMap(scenario.grid)
+        goal, start = flat.index(spec.goal), flat.index(spec.start)
+        distance = flat.distances(goal)[start]
+        options = scenario.policy
+        self.index = index
+        self.timing = timing
+        self.robot = LivePibtRobot(
+            index, start, goal, flat,
+            tie=int(distance) if distance != math.inf else 0,
+            heading=spec.heading,
+            radius=options.radius,
+            swap=options.swap,
+            heading_aware=options.heading_aware,
+            turn_cost=scenario.timing.turn_time / scenario.timing.cell_time,
+            rng=stream_random(scenario.seed, Stream.TIES, index),
+            retry=max(1, round(timing.retry * 1000)),
+            starts=[flat.index(robot.start) for robot in scenario.robots],
+        )  # fmt: skip
+        self.safety = SafetyLayer(
+            index, [robot.start for robot in scenario.robots], claim_timeout=math.inf, retry_interval=claim_retry
+        )
+        self.dropped = self.robot.dropped
+        self.queue: list[Cell] = []
+        """Cells decided and not yet entered, in order (the first is claimed once the body stands still)."""
+        self.moving = False
+        self.moves: list[tuple[int, Cell]] = []
+        """Every step's decided cell, as ``(step, cell)`` (the brain's path)."""
+        self.heard: dict[int, tuple[float, bool]] = {}
+        """Per peer: when it was last heard, and whether it said it stood on its goal."""
+        self.t0: float | None = None
+        self.step = 0
+        self._deciding = False
+        self._act = False
+        self._claimed_at = -math.inf
+        self.crash_after = crash_after
+
+    # -- time -------------------------------------------------------------------------------
+
+    def start(self, t0: float) -> None:
+        """The fleet starts at ``t0`` (step 1 begins)."""
+        self.t0 = t0
+
+    def _ms(self, now: float) -> int:
+        assert self.t0 is not None
+        return round((now - self.t0) * 1000)
+
+    def expire(self, now: float) -> list[Outgoing]:
+        """Run the step clock and every timer: begin and end steps, act, resend, claim; return what to send."""
+        out: list[Outgoing] = []
+        if self.t0 is None:
+            return out
+        robot, timing = self.robot, self.timing
+        begins = self.t0 + self.step * timing.step  # when the next step begins
+        if self._deciding and now >= begins - timing.step + timing.hold:
+            robot.give_up()
+        if self._deciding and now >= begins - timing.step + timing.decide:
+            self._finish_step()
+        if now >= begins:
+            if self._deciding:
+                self._finish_step()
+            self.step += 1
+            out.extend(robot.begin_step(self.step, now=self._ms(now), held=bool(self.queue)))
+            self._deciding = True
+            self._act = True
+        for peer, (heard_at, _) in self.heard.items():
+            if now - heard_at > self.crash_after and peer not in robot.crashed:
+                robot.crash(peer)
+        if self._deciding:
+            resent = robot.on_tick(self._ms(now))
+            out.extend(resent)
+            if self._act or robot.wake or resent:
+                self._act = False
+                out.extend(robot.act())
+        out.extend(self._stamped(self.safety.expire(now)))
+        return out
+
+    def _finish_step(self) -> None:
+        self._deciding = False
+        robot = self.robot
+        before = robot.present
+        after = robot.finish_step()
+        if after != before:
+            cell = self.flat.cells[after]
+            self.queue.append(cell)
+            self.moves.append((self.step, cell))
+
+    # -- the body ---------------------------------------------------------------------------
+
+    def motion(self, now: float) -> tuple[Cell | None, list[Outgoing]]:
+        """The cell the standing body may start entering now (its claim won), if any, and the claims to send."""
+        if self.moving or not self.queue:
+            return None, []
+        safety, cell = self.safety, self.queue[0]
+        if safety.pending is None or safety.pending.cell != cell:
+            if now - self._claimed_at < safety.retry_interval:
+                return None, []  # refused a moment ago: claim again after the retry interval
+            self._claimed_at = now
+            claim = safety.start_claim(cell, now)
+            if claim is None:
+                return None, []  # a peer still owns it here: claim again later
+            return None, [Outgoing(self._stamp(claim), safety.claim_recipients(cell))]
+        if not safety.may_enter(cell):
+            return None, []
+        safety.begin_move(cell)
+        self.queue.pop(0)
+        self.moving = True
+        if not self.queue:
+            self.robot.release()
+            self._act = True
+        return cell, []
+
+    def arrived_at(self, cell: Cell) -> None:
+        """The body stands on ``cell``: the cell it left is released."""
+        self.safety.end_move(cell)
+        self.moving = False
+
+    @property
+    def settled(self) -> bool:
+        """On its goal, decided and there in body."""
+        return self.robot.at_goal and not self.queue and not self.moving
+
+    # -- messages ---------------------------------------------------------------------------
+
+    def state(self) -> StateMessage:
+        """The fleet heartbeat: where the robot stands at the start of a step (``progress``: that step) and
+        whether it is settled on its goal."""
+        robot = self.robot
+        cell = self.flat.cells[robot.present]
+        step = self.step if self._deciding else self.step + 1  # decided: its cell is the next step's
+        return self._stamp(StateMessage(self.index, 0, cell, cell, robot.heading, self.settled, progress=step))
+
+    def receive(self, message: Message, now: float) -> list[Outgoing]:
+        """Take in one message; return the answers to send at once."""
+        sender = message.sender
+        if sender == self.index or not 0 <= sender < self.safety.fleet_size:
+            self.dropped["own" if sender == self.index else "unknown_sender"] += 1
+            return []
+        safety = self.safety
+        if sender in self.robot.crashed:
+            self.robot.revive(sender)
+        if isinstance(message, PibtMessage):
+            if self.t0 is not None and message.step > self.step:
+                self.t0 = min(self.t0, now - (message.step - 1) * self.timing.step)  # a peer is ahead: catch it up
+            if isinstance(message, BeaconMessage):
+                old = self.heard.get(sender)
+                self.heard[sender] = (now, old[1] if old is not None else False)
+            self._act = self.robot.receive(message) or self._act
+            return []
+        if isinstance(message, StateMessage):
+            first = sender not in self.heard
+            self.heard[sender] = (now, message.arrived)
+            if message.progress > 0:
+                self.robot.learn(sender, self.flat.index(message.present), message.progress)
+                if self.t0 is not None and message.progress - 1 > self.step:  # it is in step progress - 1 or later
+                    self.t0 = min(self.t0, now - (message.progress - 2) * self.timing.step)
+            if first and self.t0 is None:
+                return [Outgoing(self.state(), (sender,))]  # so that it hears of us as soon as we heard of it
+            return []
+        if isinstance(message, ClaimMessage):
+            reply = safety.handle_claim(message, claimant_outranks=False)
+            return [] if reply is None else [Outgoing(self._stamp(reply), (sender,))]
+        if isinstance(message, ReplyMessage):
+            return self._stamped(safety.handle_reply(message, now))
+        if isinstance(message, ReleaseMessage):
+            return [Outgoing(self._stamp(safety.handle_release(message)), (sender,))]
+        if isinstance(message, ReleaseAckMessage):
+            safety.handle_release_ack(message)
+            return []
+        self.dropped["other_type"] += 1
+        return []
+
+    def _stamp(self, message: M) -> M:
+        """``message`` numbered in the robot's sequence (the safety layer leaves it 0)."""
+        return dataclasses.replace(message, seq=self.robot._seq())  # type: ignore[type-var]
+
+    def _stamped(self, sends: list[tuple[Message, tuple[int, ...]]]) -> list[Outgoing]:
+        return [Outgoing(self._stamp(message), recipients) for message, recipients in sends]
+
+
+class PibtAgent(LiveDriver):
+    """Runs one ``pibt`` robot in real time (see the module docstring).
+
+    The parameters ``scenario``, ``index``, ``transport``, ``body``,
+    ``sealer``, ``opener``, ``timing``, ``seed`` and ``clock`` are those of
+    :class:`~mrmp.live.driver.LiveDriver`; ``pibt``: the step's timing (by
+    default :meth:`PibtTiming.for_body` of the body's cell time).
+    """
+
+    robot: PibtBrain
+
+    def __init__(
+        self,
+        scenario: Scenario,
+        index: int,
+        transport: Transport,
+        body: Body,
+        sealer: Sealer,
+        opener: Opener,
+        timing: AgentTiming = AgentTiming(),
+        seed: int = 0,
+        clock: Callable[[], float] = time.monotonic,
+        pibt: PibtTiming | None = None,
+    ) -> None:
+        timing = dataclasses.replace(timing, poll=max(timing.poll, POLL))
+        super().__init__(scenario, index, transport, body, sealer, opener, timing, seed, clock)
+        self.pibt_timing = pibt if pibt is not None else PibtTiming.for_body(self.cell_seconds)
+        self.robot = PibtBrain(
+            scenario, index, self.pibt_timing, claim_retry=min(timing.claim_retry, 0.05),
+            crash_after=2 * timing.give_up_after,
+        )  # fmt: skip
+
+    # -- what the driver reads of the brain --------------------------------------------------
+
+    def _present(self) -> Cell:
+        return self.body.cell
+
+    def _arrived(self) -> bool:
+        return self.robot.settled
+
+    def _peers_heard(self) -> int:
+        return len(self.robot.heard)
+
+    def _peer_news(self, index: int) -> tuple[float, bool] | None:
+        return self.robot.heard.get(index)
+
+    def _state_messages(self, now: float) -> list[Outgoing]:
+        return [Outgoing(self.robot.state(), ())]  # beacons tell the near peers; the fleet heartbeat tells everyone
+
+    def _fleet_wait_messages(self) -> list[Outgoing]:
+        return fleet_wide([Outgoing(self.robot.state())])
+
+    def _believed_within(self, radius: int) -> list[int]:
+        return self.robot.robot.possibly_within(radius)
+
+    def _safety_counts(self) -> dict[str, int]:
+        brain = self.robot
+        counts = {**brain.safety.stats.__dict__, **{f"pibt_{name}": count for name, count in brain.robot.stats.items()}}
+        counts["pibt_steps"] = brain.step
+        return counts
+
+    # -- the receiving thread: repeats of PIBT messages pass --------------------------------
+
+    def _receive_loop(self) -> None:
+        while self._receiving.is_set():
+            data = self.transport.receive(0.05)
+            if data is None:
+                continue
+            with self._lock:
+                message = open_repeat(self.opener, data)
+            if message is not None:
+                self._inbox.put(message)
+
+    # -- the step ----------------------------------------------------------------------------
+
+    def _begin(self, started: float) -> None:
+        self.robot.start(started)
+
+    def _step(self, now: float, started: float) -> bool:
+        """Finish or start the body's move (the brain's clock runs in ``expire``)."""
+        brain, body = self.robot, self.body
+        if body.moving:
+            if body.poll(now):
+                brain.arrived_at(body.cell)
+                self._record_move(now, started, brain.settled)
+        else:
+            target, out = brain.motion(now)
+            self._send(out)
+            if target is not None:
+                body.start_move(target, now)
+        return False

@@ -1,0 +1,180 @@
+"""Live ``pibt``: one OS process per robot, locally sequenced PIBT in steps on a common clock, bodies guarded.
+
+Judged by the referee process (ground truth); the decisions compared with the
+simulator running the same brain (:class:`~mrmp.sim.live_rounds.LiveRoundsSimulator`).
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import signal
+import subprocess
+import sys
+import time
+from pathlib import Path
+
+from polling import PATIENCE
+from test_live_interrupt import fleet_started, processes_mentioning
+from test_orphans import children, kill, left_running, wait_for
+
+from mrmp.core import Grid, PolicyOptions, RobotSpec, Scenario, Timing
+from mrmp.live.launcher import LiveOptions, run_live
+from mrmp.live.transport import LiveFaults
+from mrmp.live.transport_entry import free_ports
+from mrmp.sim.live_rounds import LiveRoundsSimulator
+
+EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
+SWAP = EXAMPLES / "thesis-swap.yaml"
+
+CROSS = (
+    RobotSpec("a", (0, 2), (4, 2)),
+    RobotSpec("b", (4, 2), (0, 2)),
+    RobotSpec("c", (2, 0), (2, 4)),
+    RobotSpec("d", (2, 4), (2, 0)),
+)
+"""Two head-on pairs crossing a 5x5 grid around a pillar."""
+
+
+def crossing(radius: int = 2, robots: tuple[RobotSpec, ...] = CROSS) -> Scenario:
+    return Scenario(
+        Grid(5, 5, [(2, 2)]), robots, timing=Timing(1.0, 0.5), policy=PolicyOptions(name="pibt", radius=radius),
+        name="pibt-cross",
+    )  # fmt: skip
+
+
+def pibt_counts(result) -> dict[str, int]:
+    """The live robots' own counts (held, gave_up, abandoned, ...), summed over the fleet."""
+    return {name[len("safety_pibt_") :]: count for name, count in result.network.items() if name.startswith("safety_pibt_")}
+
+
+def test_four_robots_cross_over_udp_without_collision(tmp_path):
+    result = run_live(crossing(), LiveOptions(results=tmp_path / "run", time_scale=10, seed=1))
+    assert result.collisions == [] and result.success, result.stop_reason
+    assert result.policy == "pibt" and all(robot.arrived for robot in result.robots)
+    assert result.network["safety_granted"] == result.network["moves"]  # every move entered through the safety layer
+
+
+def test_five_robots_over_lossy_udp(tmp_path):
+    """20% of the datagrams lost, some late and some duplicated: acknowledgements and timers repair it."""
+    robots = (*CROSS, RobotSpec("e", (0, 0), (4, 4)))
+    faults = LiveFaults(loss=0.2, delay_min=0.0, delay_max=0.01, duplicate=0.1)
+    result = run_live(crossing(robots=robots), LiveOptions(results=tmp_path / "run", time_scale=10, faults=faults, seed=2))
+    assert result.collisions == [] and result.success, result.stop_reason
+    assert result.network["injected_lost"] > 0 and pibt_counts(result)["retransmissions"] > 0
+
+
+def distinct(cells) -> list[tuple[int, int]]:
+    """``cells`` without repeats of the cell before (a path's cells, in the order they were entered)."""
+    out: list[tuple[int, int]] = []
+    for cell in map(tuple, cells):
+        if not out or out[-1] != cell:
+            out.append(cell)
+    return out
+
+
+def test_a_live_fleet_moves_as_the_simulator_running_the_same_brain(tmp_path):
+    """Perfect network, a radius that covers the map (the calls run in priority order): the same moves.
+
+    The live robots' own counts say that no step was abandoned and no held
+    robot gave up (the only ways a live fleet's decisions leave the simulator's).
+    """
+    scenario = crossing(radius=8)
+    simulated = LiveRoundsSimulator(scenario, step_ticks=4).run()
+    assert simulated.success
+    results = tmp_path / "run"
+    live = run_live(scenario, LiveOptions(results=results, time_scale=10, seed=0))
+    assert live.collisions == [] and live.success, live.stop_reason
+    counts = pibt_counts(live)
+    assert counts.get("abandoned", 0) == 0 and counts.get("gave_up", 0) == 0, counts
+    for index, robot in enumerate(simulated.robots):
+        report = json.loads((results / f"agent-{index}.json").read_text())
+        assert distinct(cell for _, cell in report["believed_path"]) == distinct(robot.path), robot.robot_id
+
+
+def test_mrmp_agent_runs_a_pibt_robot(tmp_path):
+    """Two ``mrmp agent --policy pibt`` processes (the scenario says ``thesis``) trade places."""
+    first, second = free_ports(2)
+    results = tmp_path / "run"
+    common = [
+        sys.executable,
+        "-m",
+        "mrmp",
+        "agent",
+        str(SWAP),
+        "--policy=pibt",
+        f"--results={results}",
+        "--time-scale=10",
+        "--timeout=60",
+    ]
+    agents = [
+        subprocess.Popen([*common, "--robot=A", f"--bind=127.0.0.1:{first}", f"--peer=B=127.0.0.1:{second}"], stderr=subprocess.PIPE, text=True),
+        subprocess.Popen([*common, "--robot=B", f"--bind=127.0.0.1:{second}", f"--peer=A=127.0.0.1:{first}"], stderr=subprocess.PIPE, text=True),
+    ]  # fmt: skip
+    for agent in agents:
+        agent.wait(timeout=4 * PATIENCE)  # a bound on a hang only: they end when both have arrived
+    assert [agent.returncode for agent in agents] == [0, 0], [agent.stderr.read() for agent in agents if agent.stderr]
+    for index in range(2):
+        report = json.loads((results / f"agent-{index}.json").read_text())
+        assert report["arrived"] and report["stop_reason"] == "all arrived" and report["safety"]["pibt_steps"] > 0
+
+
+def test_mrmp_agent_refuses_an_unknown_policy_in_one_line(tmp_path):
+    command = [sys.executable, "-m", "mrmp", "agent", str(SWAP), "--robot=A", "--policy=greedy", f"--results={tmp_path}"]
+    finished = subprocess.run(command, capture_output=True, text=True, timeout=4 * PATIENCE)
+    assert finished.returncode == 2 and finished.stderr.strip() == (
+        "error: --policy: unknown policy 'greedy'; known: thesis, astar, pibt, causal"
+    )
+
+
+def live_pibt_launcher(results: Path) -> subprocess.Popen[bytes]:
+    command = [
+        sys.executable, "-m", "mrmp", "run", str(SWAP), "--policy", "pibt", "--live", "--time-scale", "0.5",
+        "--results", str(results), "--json", str(results.parent / "result.json"),
+    ]  # fmt: skip
+    return subprocess.Popen(command, stdout=subprocess.PIPE, stderr=subprocess.STDOUT, start_new_session=True)
+
+
+def test_ctrl_c_on_a_live_pibt_run_stops_everything_and_writes_results(tmp_path):
+    results = tmp_path / "run"
+    launcher = live_pibt_launcher(results)
+    assert wait_for(lambda: fleet_started(results, 2)), "the fleet did not start"
+    os.killpg(launcher.pid, signal.SIGINT)  # what the terminal does on Ctrl-C
+    output, _ = launcher.communicate(timeout=4 * PATIENCE)
+    text = output.decode()
+    assert launcher.returncode == 1 and "interrupted" in text, text
+    assert "pibt runs live with local sequencing" in text
+    assert processes_mentioning(str(results)) == [], "robot or referee processes were left running"
+    data = json.loads((tmp_path / "result.json").read_text())
+    assert data["success"] is False and data["mode"] == "live" and (results / "referee.json").exists()
+    for index in range(2):
+        assert json.loads((results / f"agent-{index}.json").read_text())["stop_reason"] == "interrupted"
+
+
+def test_a_killed_live_pibt_launcher_leaves_nothing_running(tmp_path):
+    results = tmp_path / "run"
+    launcher = live_pibt_launcher(results)
+    try:
+        assert wait_for(lambda: fleet_started(results, 2)), "the fleet did not start"
+        started = children(launcher.pid)
+        assert len(started) == 3
+        kill(launcher)  # SIGKILL: it cleans nothing up; its children notice their parent is gone
+        assert left_running(started) == []
+        for index in range(2):
+            assert json.loads((results / f"agent-{index}.json").read_text())["stop_reason"] == "interrupted"
+    finally:
+        for pid in processes_mentioning(str(results)):
+            os.kill(pid, signal.SIGKILL)
+        if launcher.poll() is None:
+            kill(launcher)
+        time.sleep(0)  # nothing to wait for: every process is gone or killed
+
+
+def test_a_killed_robot_is_taken_for_crashed_and_the_robots_it_does_not_block_arrive(tmp_path):
+    """``--kill``: robot c, far from the others' way, dies; a and b stop waiting for it and trade places."""
+    robots = (RobotSpec("a", (0, 0), (0, 4)), RobotSpec("b", (0, 4), (0, 0)), RobotSpec("c", (4, 0), (4, 2)))
+    scenario = Scenario(Grid(5, 5), robots, timing=Timing(1.0, 0.5), policy=PolicyOptions(name="pibt"), name="pibt-kill")
+    result = run_live(scenario, LiveOptions(results=tmp_path / "run", time_scale=4, kill={"c": 0.3}, seed=0))
+    assert result.collisions == []
+    assert [robot.arrived for robot in result.robots] == [True, True, False]
+    assert pibt_counts(result)["crashed"] >= 2  # a and b each took c for crashed

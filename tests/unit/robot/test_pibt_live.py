@@ -1,0 +1,103 @@
+"""``pibt``'s live brain: it knows, instead of sensing, which robots can be near; safe in crowds; what it answers."""
+
+import pytest
+from test_pibt_local import FAULTS, crowd
+
+from mrmp.core import Grid, NetworkFaults
+from mrmp.protocol.messages import BeaconMessage
+from mrmp.protocol.pibt_local import CallInheritMessage
+from mrmp.robot.pibt_live import LivePibtRobot
+from mrmp.search.flat_map import FlatMap
+from mrmp.sim.live_rounds import LiveRoundsSimulator
+
+
+@pytest.mark.parametrize("faults", ["perfect", *FAULTS])
+@pytest.mark.parametrize("seed", range(8))
+def test_crowds_never_collide(seed, faults):
+    network = FAULTS.get(faults, NetworkFaults())
+    scenario = crowd(seed, density=0.5, max_ticks=200).with_changes(network=network)
+    result = LiveRoundsSimulator(scenario, step_ticks=8 * (2 * network.delay_max + 1)).run()
+    assert result.collisions == []
+
+
+def test_on_a_perfect_network_every_robot_arrives_and_no_step_is_abandoned():
+    for seed in range(6):
+        result = LiveRoundsSimulator(crowd(seed, density=0.3, max_ticks=2000), step_ticks=2).run()
+        assert result.success and result.network["abandoned"] == 0
+
+
+class Forgetful(LivePibtRobot):
+    """Broken: a peer is taken to be where it was last heard of, as if it had not moved since."""
+
+    def possibly_within(self, radius):
+        cells = self.flat.cells
+        x, y = cells[self.present]
+        return sorted(
+            peer for peer, (cell, _) in self.known.items() if abs(cells[cell][0] - x) + abs(cells[cell][1] - y) <= radius
+        )
+
+
+def test_a_robot_that_forgets_that_peers_move_collides():
+    class Simulator(LiveRoundsSimulator):
+        robot_type = reliable_type = Forgetful
+
+    collided = 0
+    for seed in range(12):
+        scenario = crowd(seed, density=0.5, max_ticks=60)
+        assert LiveRoundsSimulator(scenario, step_ticks=2).run().collisions == []
+        collided += len(Simulator(scenario, step_ticks=2).run().collisions)
+    assert collided > 0
+
+
+def line(length):
+    flat = FlatMap(Grid(length, 1))
+    return flat, [flat.index((x, 0)) for x in range(length)]
+
+
+def test_a_peer_not_heard_of_for_steps_is_waited_for_and_its_beacon_pulled():
+    flat, cells = line(8)
+    a = LivePibtRobot(0, cells[0], cells[1], flat, starts=[cells[0], cells[6]])
+    b = LivePibtRobot(1, cells[6], cells[7], flat, starts=[cells[0], cells[6]])
+    a.step = b.step = 4  # three steps without news: b can be anywhere within 4 + 2 of a's cell
+    sent = a.begin_step(5)
+    assert [item.recipients for item in sent] == [(1,)] and not a.complete
+    b.learn(0, cells[0], 5)  # b knows a freshly: it did not address a, and answers a's beacon with its own
+    assert b.begin_step(5)[0].recipients == ()
+    b.receive(sent[0].message)
+    answers = [item for item in b.act() if isinstance(item.message, BeaconMessage)]
+    assert [item.recipients for item in answers] == [(0,)] and b.stats["pulled"] == 1
+    a.receive(answers[0].message)
+    assert a.complete and a.known[1] == (cells[6], 5)
+
+
+def test_a_message_of_the_next_step_waits_for_that_step():
+    flat, cells = line(4)
+    starts = [cells[0], cells[1]]
+    a, b = LivePibtRobot(0, cells[0], cells[3], flat, starts=starts), LivePibtRobot(1, cells[1], cells[2], flat, starts=starts)
+    a.begin_step(1)
+    beacon = b.begin_step(1)[0].message
+    b.finish_step()
+    early = b.begin_step(2)[0].message
+    assert a.receive(early) is False and not a.complete
+    a.receive(beacon)
+    a.finish_step()
+    a.begin_step(2)
+    assert a.complete and a.known[1] == (cells[1], 2)
+
+
+def test_a_held_robot_answers_a_request_once_its_move_is_allowed_or_refuses_it_when_it_gives_up():
+    flat, cells = line(5)
+    starts = [cells[0], cells[1]]
+    for allowed in (True, False):
+        b = LivePibtRobot(1, cells[1], cells[4], flat, starts=starts)
+        b.begin_step(3, held=True)
+        b.receive(BeaconMessage(0, 1, 3, (0, 0), (4, 0), 9, 9))
+        b.receive(CallInheritMessage(0, 2, 3, (1, 0), 0, 9, 9))
+        assert not [item for item in b.act() if type(item.message).__name__ == "AnswerMessage"]  # it waits
+        b.release() if allowed else b.give_up()
+        sent = b.act()
+        answers = [item.message for item in sent if type(item.message).__name__ == "AnswerMessage"]
+        if allowed:
+            assert answers == [] and flat.cell(b.target) == (2, 0)  # it took the request up: it leaves for (2, 0)
+        else:
+            assert [answer.moved for answer in answers] == [False] and b.stats["gave_up"] == 1
