@@ -156,6 +156,18 @@ class Agent(LiveDriver):
     def _begin(self, started: float) -> None:
         self._phase, self._next_decision, self._decided_at = Phase.LISTEN, started + self.timing.listen_time, started
 
+    def _timers_idle(self) -> bool:
+        """No claim pending and no release unacknowledged: the safety layer's timers have nothing to do."""
+        robot = self.robot
+        return not robot.guarded or (robot.safety.pending is None and robot.safety.unacknowledged_releases == 0)
+
+    def _due(self) -> float:
+        """The body's next event, and the end of the listening or the pause (the driver sleeps until then)."""
+        due = super()._due()
+        if self._phase is Phase.LISTEN or self._phase is Phase.PAUSE:
+            due = min(due, self._next_decision)
+        return due
+
     def _step(self, now: float, started: float) -> bool:
         """Announce, listen, decide (and claim), move, or pause (module docstring)."""
         robot, body, timing, report = self.robot, self.body, self.timing, self.report

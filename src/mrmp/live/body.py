@@ -4,7 +4,9 @@ A :class:`Body` moves its robot one cell at a time: it turns right as often as
 needed (thesis section 3.3: the robot only turns right), drives forward, and
 reports the cell it believes it stands on, as the Khepera III does by counting
 the black grid lines its infrared floor sensor crosses (section 2.3). Bodies
-are polled by the live driver with the current time; they never sleep.
+are polled by the live driver with the current time; they never sleep. A
+body that knows when its move next changes says so (``next_event``), so that
+the driver can sleep until then instead of polling.
 
 * :class:`SimulatedBody` takes ``cell_time`` per cell and ``turn_time`` per
   right turn, divided by a time scale, with optional jitter (robots running at
@@ -66,6 +68,10 @@ class Body(Protocol):
 
     def poll(self, now: float) -> bool:
         """Advance to ``now``; True exactly once, when the move in progress ends."""
+        ...
+
+    def next_event(self) -> float | None:
+        """When ``poll`` next has something to do (an entry, the move's end); None: poll it as often as possible."""
         ...
 
 
@@ -162,6 +168,25 @@ class SimulatedBody:
         self._target = target
         self.moving = True
         self._entered = 0
+
+    def next_event(self) -> float | None:
+        """When the next cell is entered or the move ends (``inf`` when not moving): poll then, not before.
+
+        >>> from mrmp.core.grid import Grid
+        >>> from mrmp.core.heading import Heading
+        >>> from mrmp.core.scenario import Timing
+        >>> body = SimulatedBody((0, 0), Heading.NORTH, Grid(3, 3), Timing(cell_time=1.0, turn_time=0.5))
+        >>> body.next_event()
+        inf
+        >>> body.start_move((1, 0), now=10.0)
+        >>> body.next_event(), body.poll(10.2), body.next_event()
+        (10.0, False, 11.0)
+        """
+        if not self.moving:
+            return float("inf")
+        if self._entered < len(self._segments):
+            return self._segments[self._entered].enter_at
+        return self._segments[-1].end
 
     def poll(self, now: float) -> bool:
         """Record entries and exits due by ``now``; True when the whole move is over."""
@@ -278,6 +303,24 @@ class LineCountingBody:
             self._phase = "driving"
             self._on_line = self.driver.line_detected()
             self.driver.set_speeds(self.speed, self.speed)
+
+    def next_event(self) -> float | None:
+        """When a timed turn or the settling ends; None while driving (the line sensor is read on every poll).
+
+        >>> class Still:
+        ...     def set_speeds(self, left, right): pass
+        ...     def line_detected(self): return False
+        ...     def stop(self): pass
+        >>> body = LineCountingBody(Still(), (0, 0), Heading.NORTH, turn_seconds=1.0)
+        >>> body.next_event()
+        inf
+        >>> body.start_move((0, 1), now=5.0)  # east of a robot facing north: one right turn first
+        >>> body.next_event()
+        6.0
+        """
+        if self._phase == "idle":
+            return float("inf")
+        return None if self._phase == "driving" else self._until
 
     def poll(self, now: float) -> bool:
         """Run the control loop one step; True when the robot has reached the next cell's middle."""

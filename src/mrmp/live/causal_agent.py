@@ -4,7 +4,7 @@ The brain is :class:`mrmp.robot.causal_pibt.CausalRobot` (Okumura, Tamura and
 Défago, AAAI 2021), the same object the asynchronous simulator runs. As in
 :mod:`mrmp.live.agent`, a receiving thread queues what the transport delivers
 and the brain runs in the main thread only, fed with those messages and the
-clock. Every ``poll``:
+clock. Every turn of the driver's loop (:mod:`mrmp.live.driver`):
 
 * hand the brain the queued messages and send its answers (lock grants,
   acknowledgements, claim replies);
@@ -133,6 +133,10 @@ class CausalAgent(LiveDriver):
     def _begin(self, started: float) -> None:
         self._next_activation = started + self.timing.listen_time * self.random.random()
         self._extended_at = None
+
+    def _due(self) -> float:
+        """The body's next event and the next activation (the driver sleeps until then)."""
+        return min(super()._due(), self._next_activation)
 
     def _step(self, now: float, started: float) -> bool:
         """Finish or start the body's move, and activate the robot when due (module docstring)."""

@@ -9,9 +9,16 @@ only, fed with those messages and with the clock. :class:`LiveDriver` holds that
 policy's driver (:class:`mrmp.live.agent.Agent`,
 :class:`mrmp.live.causal_agent.CausalAgent`) supplies its brain and its step.
 
-Every ``poll`` the loop hands the brain the queued messages (queueing its
+Every turn of the loop hands the brain the queued messages (queueing its
 answers for the client thread), runs the policy's step, runs the brain's timers, and sends the state
-when nothing was sent for ``heartbeat`` seconds. UDP unicast has no radio, so a
+when nothing was sent for ``heartbeat`` seconds. Between two turns the main
+thread sleeps until the first of: a message arriving (the receiving thread
+wakes it, :class:`Mailbox`), the next thing the step or the body has scheduled
+(``_due``), a heartbeat, the progress report, the end of the linger, or, at the
+latest, ``poll`` seconds, so that the brain's own timers (resending a claim, a
+lock request) run at most ``poll`` late; a brain whose timers are idle (no claim
+pending, no release unacknowledged) is not woken for them. A robot waiting, arrived or not,
+therefore costs little CPU time: dozens of robot processes share a few cores. UDP unicast has no radio, so a
 radius broadcast (an :class:`~mrmp.robot.messaging.Outgoing` with ``radius``)
 goes to the peers the brain believes within the radius; for discovery, the
 state goes to every peer once every ``fleet_heartbeat`` seconds. A peer is
@@ -63,9 +70,14 @@ class AgentTiming:
     silence_timeout: float = 1.5
     give_up_after: float = 3.0
     linger: float = 0.6
-    poll: float = 0.004
+    poll: float = 0.01
+    """The longest sleep of the main loop: the brain's timers run at most this late (messages wake it at once)."""
     timeout: float = 120.0
     start_wait: float = 15.0
+
+
+SENSOR_POLL = 0.004
+"""Seconds between two polls of a moving body that cannot tell when it next changes (a line sensor to read)."""
 
 
 LIVE_SLACK = 2
@@ -100,6 +112,50 @@ def believed_near(
         for index, (cx, cy), heard_at in peers
         if abs(cx - x) + abs(cy - y) <= radius + math.ceil(max(0.0, now - heard_at) / cell_seconds)
     ]
+
+
+class Mailbox:
+    """The messages the receiving thread opened, queued for the main loop, which can sleep until one arrives.
+
+    >>> mailbox = Mailbox()
+    >>> mailbox.wait(0.0), mailbox.take()
+    (False, [])
+    >>> mailbox.put("a"); mailbox.put("b")
+    >>> mailbox.wait(10.0), mailbox.take(), mailbox.wait(0.0)
+    (True, ['a', 'b'], False)
+    """
+
+    def __init__(self) -> None:
+        self._queue: queue.SimpleQueue[Any] = queue.SimpleQueue()
+        self._arrived = threading.Event()
+
+    def put(self, message: Any) -> None:
+        """Queue ``message`` and wake a :meth:`wait` (from any thread)."""
+        self._queue.put(message)
+        self._arrived.set()
+
+    def wake(self) -> None:
+        """End a :meth:`wait` at once, with nothing queued (a stop request)."""
+        self._arrived.set()
+
+    def wait(self, timeout: float) -> bool:
+        """Sleep until something was put (or :meth:`wake`) since the last wait, for at most ``timeout`` seconds.
+
+        Whether anything came. What comes after this returns wakes the next
+        wait: the event is cleared before :meth:`take` empties the queue.
+        """
+        arrived = self._arrived.wait(timeout) if timeout > 0 else self._arrived.is_set()
+        self._arrived.clear()
+        return arrived
+
+    def take(self) -> list[Any]:
+        """Everything queued, oldest first."""
+        taken = []
+        while True:
+            try:
+                taken.append(self._queue.get_nowait())
+            except queue.Empty:
+                return taken
 
 
 @dataclass
@@ -203,10 +259,12 @@ class LiveDriver:
         self.random = stream_random(seed, Stream.SCHEDULE, index)
         self.report = AgentReport(spec.id, index, spec.start, spec.goal)
         self.stop_requested = threading.Event()
-        self._inbox: queue.SimpleQueue[Message] = queue.SimpleQueue()
+        self._inbox = Mailbox()
         self._receiving = threading.Event()
         self._lock = threading.Lock()
         self._peers = len(scenario.robots) - 1
+        self._waiting_on: int | None = None
+        """The peer that kept :meth:`_everyone_done` False last time (asked first next time)."""
         self._client = ClientThread(transport, name=f"robot-{index}-client")
         self.cell_seconds = scenario.timing.cell_time / getattr(body, "time_scale", 1.0)
         """Seconds the body takes for a cell (a body without a time scale runs in real time)."""
@@ -257,6 +315,31 @@ class LiveDriver:
         """The report's ``safety`` counts."""
         raise NotImplementedError
 
+    def _due(self) -> float:
+        """When the step next has something to do by the clock alone, besides the brain's timers (``inf``: nothing).
+
+        By default: when the moving body next enters a cell or ends its move
+        (a body that cannot tell is polled every :data:`SENSOR_POLL` seconds). A driver with
+        timers of its own (a pause, the next activation) adds them.
+        """
+        body = self.body
+        if not body.moving:
+            return math.inf
+        event = getattr(body, "next_event", lambda: None)()
+        return self.clock() + SENSOR_POLL if event is None else event
+
+    def _timers_idle(self) -> bool:
+        """Whether the brain's timers have nothing to do until a message comes (then the loop need not wake every ``poll``).
+
+        By default False: the brain may have a timer due at any moment.
+        """
+        return False
+
+    def request_stop(self) -> None:
+        """Ask the run to stop (from a signal handler or another thread); the main loop wakes at once."""
+        self.stop_requested.set()
+        self._inbox.wake()
+
     def _record_move(self, now: float, started: float, on_goal: bool) -> None:
         """The body ended a move, on the goal or not: count it, log the cell, keep the arrival time."""
         report = self.report
@@ -281,13 +364,17 @@ class LiveDriver:
 
     def _drain_inbox(self, now: float) -> None:
         """Hand the brain every message the receiving thread queued, and send its answers."""
-        while True:
-            try:
-                message = self._inbox.get_nowait()
-            except queue.Empty:
-                return
+        for message in self._inbox.take():
             self.report.messages_received += 1
             self._send(self.robot.receive(message, now))
+
+    def _sleep(self, until: float) -> None:
+        """Sleep until the clock reads ``until``, a message arrives or a stop is requested.
+
+        At most ``poll`` seconds, unless the brain's timers are idle (:meth:`_timers_idle`).
+        """
+        longest = math.inf if self._timers_idle() else self.timing.poll
+        self._inbox.wait(max(0.0, min(until - self.clock(), longest)))
 
     # -- sending ---------------------------------------------------------------------------
 
@@ -362,7 +449,16 @@ class LiveDriver:
                     last_progress = now
                     self._fill_report(now)
                     on_progress(report)
-                time.sleep(timing.poll)
+                self._sleep(
+                    min(
+                        self._due(),
+                        last_state + timing.heartbeat,
+                        last_fleet_state + timing.fleet_heartbeat,
+                        started + timing.timeout,
+                        math.inf if everyone_done_since is None else everyone_done_since + linger,
+                        math.inf if on_progress is None else last_progress + progress_every,
+                    )
+                )
             else:
                 report.stop_reason = "interrupted"
         finally:
@@ -385,26 +481,41 @@ class LiveDriver:
             if now - last_state >= self.timing.heartbeat:
                 self._send(self._fleet_wait_messages())
                 last_state = now
-            time.sleep(self.timing.poll)
+            self._sleep(min(last_state + self.timing.heartbeat, deadline))
 
     def _everyone_done(self, now: float) -> bool:
-        """This robot and every peer arrived (peers silent for ``give_up_after`` are given up on)."""
+        """This robot and every peer arrived (peers silent for ``give_up_after`` are given up on).
+
+        The peer that kept the answer False last time is asked first: while it
+        still does, one peer is looked at, not the whole fleet.
+        """
         if not self._settled():
             return False
-        horizon = now - self.timing.give_up_after
+        waiting_on = self._waiting_on
+        if waiting_on is not None and self._peer_state(waiting_on, now) == "running":
+            return False
         silent = []
         for index in range(len(self.scenario.robots)):
             if index == self.index:
                 continue
-            news = self._peer_news(index)
-            if news is not None and news[1] and news[0] >= now - 2 * self.timing.silence_timeout:
-                continue
-            if news is None or news[0] < horizon:
+            state = self._peer_state(index, now)
+            if state == "silent":
                 silent.append(index)
-                continue
-            return False
+            elif state == "running":
+                self._waiting_on = index
+                return False
+        self._waiting_on = None
         self.report.silent_peers = silent
         return True
+
+    def _peer_state(self, index: int, now: float) -> str:
+        """``"done"`` (arrived, heard lately), ``"silent"`` (not heard for ``give_up_after``) or ``"running"``."""
+        news = self._peer_news(index)
+        if news is not None and news[1] and news[0] >= now - 2 * self.timing.silence_timeout:
+            return "done"
+        if news is None or news[0] < now - self.timing.give_up_after:
+            return "silent"
+        return "running"
 
     def _fill_report(self, now: float) -> None:
         report, robot = self.report, self.robot

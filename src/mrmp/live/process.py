@@ -9,11 +9,14 @@ them ends, however it ends (:mod:`mrmp.io.lifetime`).
 
 from __future__ import annotations
 
+import contextlib
+import cProfile
+import os
 import signal
 import sys
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
 
@@ -213,11 +216,12 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
         agent = LIVE_DRIVERS[driver_kind(scenario, following_plan=policy is not None)](
             scenario, index, transport, body, sealer, opener, options, policy
         )
-        _on_stop_signals(agent.stop_requested.set)
-        watch_parent(agent.stop_requested.set)
+        _on_stop_signals(agent.request_stop)
+        watch_parent(agent.request_stop)
         if isinstance(opened, ConnectedTransport):
             _wait_for_peers(opened, len(scenario.robots) - 1, agent.stop_requested)
-        report = agent.run(on_progress=lambda report: write_json(report_path, report.as_dict()))
+        with profiled(options.results / f"profile-{index}.prof"):
+            report = agent.run(on_progress=lambda report: write_json(report_path, report.as_dict()))
     finally:
         if transport is not None:
             transport.close()
@@ -226,12 +230,51 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
     return report
 
 
+PROFILE_VARIABLE = "MRMP_PROFILE"
+"""Set (to anything but empty) in a robot process's environment, it profiles the process's main thread (:func:`profiled`)."""
+
+
+@contextlib.contextmanager
+def profiled(path: Path, environment: Mapping[str, str] = os.environ) -> Iterator[None]:
+    """Profile the CPU time of this thread over the block into ``path`` (``pstats`` format) when ``MRMP_PROFILE`` is set.
+
+    The CPU time of the thread only (:func:`time.thread_time`): what the
+    robot's main loop costs, not the time it sleeps. Read the file with
+    ``python -m pstats``.
+
+    >>> import pstats, tempfile
+    >>> path = Path(tempfile.mkdtemp()) / "profile-0.prof"
+    >>> with profiled(path, environment={}):
+    ...     pass
+    >>> path.exists()
+    False
+    >>> with profiled(path, environment={PROFILE_VARIABLE: "1"}):
+    ...     _ = sorted(range(1000), key=str)
+    >>> pstats.Stats(str(path)).total_calls > 0
+    True
+    """
+    if not environment.get(PROFILE_VARIABLE):
+        yield
+        return
+    profile = cProfile.Profile(time.thread_time)
+    profile.enable()
+    try:
+        yield
+    finally:
+        profile.disable()
+        profile.dump_stats(str(path))
+
+
 def _wait_for_peers(transport: ConnectedTransport, count: int, stop: threading.Event) -> None:
     """Wait up to :data:`PEER_WAIT_SECONDS` for ``count`` peers to connect, or until ``stop`` is set."""
     deadline = time.monotonic() + PEER_WAIT_SECONDS
     while not stop.is_set() and (remaining := deadline - time.monotonic()) > 0:
         if transport.wait_for_peers(count, timeout=min(remaining, 0.1)):
             return
+
+
+REFEREE_PERIOD = 0.25
+"""Seconds between two readings of the traces by a referee following a run (a collision is reported this late at most)."""
 
 
 def run_referee(
@@ -262,21 +305,22 @@ def run_referee(
     referee = IntervalReferee(scenario.grid, ids, starts, start_time)
     reported = 0
     finishing = False
+    collisions = referee.collisions()
     while True:
         finishing = finishing or stop.is_set() or done_file is None or done_file.exists()
         for reader in readers:
             pending.extend(reader.read_new())
-        for robot, event, cell, t in pending:
-            referee.feed(robot, event, cell, t)
-        pending = []
-        collisions = referee.collisions()
+        if pending:  # the collisions change only with new events: no new events, no new judgement
+            for robot, event, cell, t in pending:
+                referee.feed(robot, event, cell, t)
+            pending = []
+            collisions = referee.collisions()
         for collision in collisions[reported:]:
             report(f"referee: {collision.describe()} (tick = milliseconds since the start)")
         reported = max(reported, len(collisions))
         if finishing:
             break
-        time.sleep(0.05)
-    collisions = referee.collisions()
+        stop.wait(REFEREE_PERIOD)
     write_json(
         results / "referee.json",
         {
