@@ -41,7 +41,6 @@ from __future__ import annotations
 import math
 import queue
 import threading
-import time
 from collections import Counter
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
