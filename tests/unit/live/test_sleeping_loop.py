@@ -1,0 +1,129 @@
+"""The live driver's main loop sleeps until something is due instead of polling: fewer turns, the same messages.
+
+The driver runs on a clock of the test's own (:class:`FakeClock`) and its
+mailbox's wait moves that clock on instead of sleeping, so the loop's turns
+are counted, not timed. A driver that polls every ``poll`` seconds whatever
+happens (the loop as it was, :class:`PollingAgent`) is the reference: the
+sleeping loop must send the same messages in the same order, in far fewer turns.
+"""
+
+from __future__ import annotations
+
+import threading
+import time
+
+from mrmp.core import Grid, RobotSpec, Scenario, Timing
+from mrmp.core.heading import Heading
+from mrmp.live.agent import Agent
+from mrmp.live.body import SimulatedBody
+from mrmp.live.driver import AgentTiming, Mailbox
+from mrmp.protocol.auth import Opener, Sealer
+from mrmp.protocol.messages import StateMessage
+
+KEY = b"k" * 32
+TIMING = AgentTiming(start_wait=1.0, timeout=30.0, poll=0.004)
+
+
+class FakeClock:
+    """A clock that only moves when told."""
+
+    def __init__(self) -> None:
+        self.now = 100.0
+
+    def __call__(self) -> float:
+        return self.now
+
+
+class CountingMailbox(Mailbox):
+    """A mailbox whose wait moves the fake clock on by its timeout (at least a microsecond) and counts the waits."""
+
+    def __init__(self, clock: FakeClock) -> None:
+        super().__init__()
+        self.clock = clock
+        self.waits = 0
+
+    def wait(self, timeout: float) -> bool:
+        self.waits += 1
+        self.clock.now += max(timeout, 1e-6)
+        return super().wait(0.0)
+
+
+class Recording:
+    """Keeps every datagram sent; receives nothing."""
+
+    def __init__(self) -> None:
+        self.sent: list[tuple[bytes, int | None]] = []
+        self.lock = threading.Lock()
+
+    def send(self, data: bytes, recipient: int | None = None) -> None:
+        with self.lock:
+            self.sent.append((data, recipient))
+
+    def receive(self, timeout: float) -> bytes | None:
+        time.sleep(min(timeout, 0.005))
+        return None
+
+    def close(self) -> None:
+        pass
+
+
+class PollingAgent(Agent):
+    """The loop as it was: whatever is due, sleep ``poll`` seconds between two turns."""
+
+    def _sleep(self, until: float) -> None:
+        self._inbox.wait(self.timing.poll)
+
+
+def scenario(goal: tuple[int, int] = (0, 0), silent_peer: bool = True) -> Scenario:
+    """Robot A (the one run), and B, a peer that never speaks."""
+    robots = (RobotSpec("A", (0, 0), goal, Heading.NORTH), RobotSpec("B", (3, 3), (3, 3)))
+    return Scenario(Grid(4, 4), robots if silent_peer else robots[:1], timing=Timing(cell_time=0.4, turn_time=0.2))
+
+
+def run(kind: type[Agent], scene: Scenario) -> tuple[int, list[tuple[str, int | None]], str, list]:
+    """Run robot A on the fake clock: the loop's turns, what it sent (message kind and recipient), why it stopped,
+    and the cells its body entered and left (ground truth)."""
+    clock = FakeClock()
+    transport = Recording()
+    spec = scene.robots[0]
+    body = SimulatedBody(spec.start, spec.heading, scene.grid, scene.timing)
+    agent = kind(scene, 0, transport, body, Sealer(KEY, 1), Opener(KEY, 1), timing=TIMING, clock=clock)
+    agent._inbox = mailbox = CountingMailbox(clock)
+    report = agent.run()
+    opener = Opener(KEY, 1)
+    sent = []
+    for data, recipient in transport.sent:
+        message = opener.open(data)
+        assert message is not None
+        sent.append((type(message).__name__, recipient))
+    return mailbox.waits, sent, report.stop_reason, [(event, cell) for event, cell, _ in body.recorder.events]
+
+
+def test_an_arrived_robot_waiting_for_a_silent_peer_sends_the_same_messages_in_far_fewer_turns():
+    polled_turns, polled_sent, polled_stop, _ = run(PollingAgent, scenario())
+    turns, sent, stop, _ = run(Agent, scenario())
+    assert stop == polled_stop == "arrived; peers silent"
+    assert sent == polled_sent
+    assert sent and all(kind == StateMessage.__name__ for kind, _ in sent)
+    assert polled_turns > 400  # 1 s of fleet wait and 1.2 s of linger, every 4 ms
+    assert turns * 10 < polled_turns
+
+
+def test_a_moving_robot_makes_the_same_moves_and_sends_the_same_messages_in_fewer_turns():
+    polled_turns, polled_sent, _, polled_moves = run(PollingAgent, scenario(goal=(2, 3), silent_peer=False))
+    turns, sent, stop, moves = run(Agent, scenario(goal=(2, 3), silent_peer=False))
+    assert stop == "all arrived"
+    assert len(moves) == 2 * 5 and moves == polled_moves
+    assert sent == polled_sent
+    assert turns * 3 < polled_turns
+
+
+def test_a_message_wakes_the_mailbox_and_a_stop_request_wakes_the_loop():
+    mailbox = Mailbox()
+    threading.Thread(target=mailbox.put, args=("state",)).start()
+    assert mailbox.wait(60.0) is True
+    assert mailbox.take() == ["state"]
+    assert mailbox.wait(0.0) is False
+    mailbox.wake()
+    assert mailbox.wait(60.0) is True
+    assert mailbox.take() == []
