@@ -16,8 +16,10 @@ prints, per run: robots arrived, collisions, wall time; each agent's CPU
 seconds per wall second during the fleet's run (from the moment the last robot
 began to the moment the first one stopped; mean and maximum over the agents),
 the referee's, the CPU seconds an agent spent before the fleet began (start-up:
-imports, reading the files, waiting for its peers), and the one-minute load
-average at the end. Times are ratios of one machine: compare runs made side by side.
+imports, reading the files, waiting for its peers), an agent's wake-ups per
+second (voluntary context switches of all its threads, which do not depend on
+the machine's load), all the children's CPU seconds per wall second, and the
+one-minute load average at the end. Times are ratios of one machine: compare runs made side by side.
 
 Usage: python bench/live_cpu.py [--robots 16,32] [--drivers lacam,pibt,causal] [--fleets moving,idle]
 """
@@ -53,6 +55,7 @@ class Samples:
 
     times: list[float] = field(default_factory=list)
     cpu: dict[int, list[tuple[float, float]]] = field(default_factory=dict)
+    wakeups: dict[int, list[tuple[float, float]]] = field(default_factory=dict)
     kind: dict[int, str] = field(default_factory=dict)
     robot: dict[int, int] = field(default_factory=dict)
 
@@ -71,6 +74,19 @@ def children_of(parent: int) -> list[int]:
         if int(fields[1]) == parent:
             found.append(int(entry))
     return found
+
+
+def wakeups(pid: int) -> int | None:
+    """Voluntary context switches of every thread of ``pid`` so far (each is a wake-up after a sleep), or None."""
+    total = 0
+    try:
+        for task in os.listdir(f"/proc/{pid}/task"):
+            for line in Path(f"/proc/{pid}/task/{task}/status").read_text().splitlines():
+                if line.startswith("voluntary_ctxt_switches:"):
+                    total += int(line.split()[1])
+    except (OSError, ValueError):
+        return None
+    return total
 
 
 def cpu_seconds(pid: int) -> float | None:
@@ -107,9 +123,10 @@ def sample(scenario: Scenario, samples: Samples, period: float, done: threading.
         for pid in children_of(me):
             if pid not in samples.kind:
                 describe(pid, scenario, samples)
-            seconds = cpu_seconds(pid)
-            if seconds is not None and pid in samples.kind:
+            seconds, woken = cpu_seconds(pid), wakeups(pid)
+            if seconds is not None and woken is not None and pid in samples.kind:
                 samples.cpu.setdefault(pid, []).append((now, seconds))
+                samples.wakeups.setdefault(pid, []).append((now, woken))
         samples.times.append(now)
         done.wait(period)
 
@@ -167,23 +184,24 @@ def measure(driver: str, robots: int, kind: str, arguments: argparse.Namespace) 
     agents = [pid for pid, what in samples.kind.items() if what == "agent"]
     referee = [pid for pid, what in samples.kind.items() if what == "referee"]
     running = [r for pid in agents if (r := rate(samples.cpu[pid], fleet_start, fleet_end)) is not None]
+    woken = [r for pid in agents if (r := rate(samples.wakeups[pid], fleet_start, fleet_end)) is not None]
     startup = [s for pid in agents if (s := before(samples.cpu[pid], fleet_start)) is not None]
     referee_rate = rate(samples.cpu[referee[0]], fleet_start, fleet_end) if referee and referee[0] in samples.cpu else None
     arrived = sum(robot.arrived for robot in result.robots)
     print(
         f"{driver:>6} {kind:>6} {robots:>4} {arrived:>4}/{robots:<4} {len(result.collisions):>4} {wall:>7.1f}"
         f" {fleet_end - fleet_start:>7.1f} {_mean(running):>8} {_max(running):>8} {_fmt(referee_rate):>8}"
-        f" {_mean(startup):>8} {total / wall:>8.2f} {os.getloadavg()[0]:>6.1f}  {result.stop_reason}",
+        f" {_mean(startup):>8} {_mean(woken, 0):>7} {total / wall:>8.2f} {os.getloadavg()[0]:>6.1f}  {result.stop_reason}",
         flush=True,
     )
 
 
-def _fmt(value: float | None) -> str:
-    return "-" if value is None else f"{value:.3f}"
+def _fmt(value: float | None, digits: int = 3) -> str:
+    return "-" if value is None else f"{value:.{digits}f}"
 
 
-def _mean(values: list[float]) -> str:
-    return _fmt(statistics.fmean(values) if values else None)
+def _mean(values: list[float], digits: int = 3) -> str:
+    return _fmt(statistics.fmean(values) if values else None, digits)
 
 
 def _max(values: list[float]) -> str:
@@ -201,11 +219,11 @@ def main() -> int:
     arguments = parser.parse_args()
     print(
         f"{'driver':>6} {'fleet':>6} {'N':>4} {'arrived':>9} {'coll':>4} {'wall s':>7} {'run s':>7}"
-        f" {'agent':>8} {'max':>8} {'referee':>8} {'start-up':>8} {'all/wall':>8} {'load':>6}  stop"
+        f" {'agent':>8} {'max':>8} {'referee':>8} {'start-up':>8} {'wakeups':>7} {'all/wall':>8} {'load':>6}  stop"
     )
     print(
         f"{'':>6} {'':>6} {'':>4} {'':>9} {'':>4} {'':>7} {'':>7} {'CPU s/s':>8} {'CPU s/s':>8} {'CPU s/s':>8}"
-        f" {'CPU s':>8} {'CPU s/s':>8}"
+        f" {'CPU s':>8} {'/s':>7} {'CPU s/s':>8}"
     )
     for robots in [int(text) for text in arguments.robots.split(",")]:
         for driver in arguments.drivers.split(","):

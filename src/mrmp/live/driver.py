@@ -28,7 +28,9 @@ near is addressed before it is within the interaction radius
 (``docs/protocol.md``, "Neighbourhoods"). Before its first step a robot
 waits (at most ``start_wait`` seconds) until it has heard from every peer, so
 that a fleet whose processes start one by one begins together; its clock starts
-then. The run ends when this robot and every peer have arrived (and a short
+then. While it waits it sends its state every heartbeat to the peers it has not
+heard from, at once to a peer it hears from for the first time, and every fleet
+heartbeat to every peer. The run ends when this robot and every peer have arrived (and a short
 linger has passed so that late requests are still answered, at least a fleet
 heartbeat, so that a far peer that has left its goal again is heard of; the
 robot then sends its state to every peer), when every peer
@@ -470,17 +472,38 @@ class LiveDriver:
         return report
 
     def _wait_for_fleet(self) -> None:
-        """Send the state every heartbeat, and answer, until every peer has been heard (or ``start_wait`` passes)."""
+        """Send the state, and answer, until every peer has been heard (or ``start_wait`` passes).
+
+        The state goes every heartbeat to the peers not heard from yet, at once
+        to a peer heard from for the first time (it is up: now it hears this
+        robot too), and every fleet heartbeat to every peer (in case that answer
+        was lost): a fleet whose processes start one by one does not flood the
+        robots already up with a state from each of them every heartbeat.
+        """
         clock = self.clock
         deadline = clock() + self.timing.start_wait
-        last_state = -float("inf")
+        last_state = last_fleet_state = -math.inf
+        unheard = self._unheard_peers()
         while not self.stop_requested.is_set() and self._peers_heard() < self._peers and clock() < deadline:
             now = clock()
             self._drain_inbox(now)
-            if now - last_state >= self.timing.heartbeat:
-                self._send(self._fleet_wait_messages())
+            still_unheard = self._unheard_peers()
+            newly_heard = tuple(sorted(set(unheard) - set(still_unheard)))
+            unheard = still_unheard
+            if newly_heard and now - last_fleet_state < self.timing.fleet_heartbeat:  # answered at once
+                self._send([item._replace(recipients=newly_heard, radius=None) for item in self._fleet_wait_messages()])
+            if now - last_fleet_state >= self.timing.fleet_heartbeat:
+                self._send(fleet_wide(self._fleet_wait_messages()))
+                last_state = last_fleet_state = now
+            elif now - last_state >= self.timing.heartbeat and unheard:
+                self._send([item._replace(recipients=unheard, radius=None) for item in self._fleet_wait_messages()])
                 last_state = now
-            self._sleep(min(last_state + self.timing.heartbeat, deadline))
+            self._sleep(min(last_state + self.timing.heartbeat, last_fleet_state + self.timing.fleet_heartbeat, deadline))
+
+    def _unheard_peers(self) -> tuple[int, ...]:
+        """The peers not heard from yet."""
+        fleet = range(len(self.scenario.robots))
+        return tuple(index for index in fleet if index != self.index and self._peer_news(index) is None)
 
     def _everyone_done(self, now: float) -> bool:
         """This robot and every peer arrived (peers silent for ``give_up_after`` are given up on).

@@ -127,3 +127,48 @@ def test_a_message_wakes_the_mailbox_and_a_stop_request_wakes_the_loop():
     mailbox.wake()
     assert mailbox.wait(60.0) is True
     assert mailbox.take() == []
+
+
+class InjectingMailbox(CountingMailbox):
+    """A counting mailbox that receives ``message`` at its ``at``-th wait."""
+
+    def __init__(self, clock: FakeClock, message: StateMessage, at: int) -> None:
+        super().__init__(clock)
+        self.message, self.at = message, at
+
+    def wait(self, timeout: float) -> bool:
+        if self.waits + 1 == self.at:
+            self.put(self.message)
+        return super().wait(timeout)
+
+
+def fleet_wait(heard_at_wait: int) -> list[tuple[float, int | None]]:
+    """Robot A waits for B and C (C never speaks; B's state comes at A's ``heard_at_wait``-th wait):
+    when A sent its state, and to whom (None: every peer)."""
+    robots = (RobotSpec("A", (0, 0), (0, 0)), RobotSpec("B", (3, 3), (3, 3)), RobotSpec("C", (0, 3), (0, 3)))
+    scene = Scenario(Grid(4, 4), robots)
+    clock, transport = FakeClock(), Recording()
+    spec = scene.robots[0]
+    body = SimulatedBody(spec.start, spec.heading, scene.grid, scene.timing)
+    timing = AgentTiming(start_wait=2.5, heartbeat=0.2, fleet_heartbeat=1.0)
+    agent = Agent(scene, 0, transport, body, Sealer(KEY, 1), Opener(KEY, 1), timing=timing, clock=clock)
+    sent: list[tuple[float, int | None]] = []
+    agent._client.send = lambda data, recipient: sent.append((round(clock.now - 100.0, 3), recipient))  # type: ignore[method-assign]
+    agent._inbox = InjectingMailbox(clock, StateMessage(1, 1, (3, 3), (3, 3)), at=heard_at_wait)
+    agent._wait_for_fleet()
+    assert agent._peers_heard() == 1  # C never spoke: the wait ended at start_wait
+    return sent
+
+
+def test_waiting_for_the_fleet_a_robot_tells_unheard_peers_every_heartbeat_and_everyone_every_fleet_heartbeat():
+    sent = fleet_wait(heard_at_wait=3)  # B's state comes during the third wait: it is heard at 0.6 s
+    assert sent == [
+        (0.0, None),  # every peer
+        (0.2, 1), (0.2, 2), (0.4, 1), (0.4, 2),  # the peers not heard from, every heartbeat
+        (0.6, 1),  # B, heard for the first time, is answered at once
+        (0.6, 2), (0.8, 2),  # then only C, every heartbeat
+        (1.0, None),  # and every peer every fleet heartbeat
+        (1.2, 2), (1.4, 2), (1.6, 2), (1.8, 2),
+        (2.0, None),
+        (2.2, 2), (2.4, 2),
+    ]  # fmt: skip
