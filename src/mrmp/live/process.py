@@ -17,7 +17,7 @@ import sys
 import threading
 import time
 from collections.abc import Callable, Iterator, Mapping
-from dataclasses import dataclass, field
+from dataclasses import dataclass, field, replace
 from pathlib import Path
 
 from mrmp.core.errors import InputError, Problem
@@ -77,6 +77,22 @@ CRASH_SILENCES = 2
 
 PEER_WAIT_SECONDS = 10.0
 """How long a robot whose transport connects first waits for its peers before it starts anyway."""
+
+
+START_WAIT_PER_ROBOT = 0.5
+"""Seconds a robot process waits for its peers before it starts anyway, per robot of the fleet (at least
+``AgentTiming.start_wait``): a fleet's processes started at once on one machine share its cores while
+they start (each imports Python modules for a good part of a CPU second), so the last one is up long after
+the first; a first robot that started without the last would take it for crashed."""
+
+
+def fleet_timing(timing: AgentTiming, robots: int) -> AgentTiming:
+    """``timing`` with a start wait of at least :data:`START_WAIT_PER_ROBOT` seconds per robot of a fleet of ``robots``.
+
+    >>> fleet_timing(AgentTiming(), 8).start_wait, fleet_timing(AgentTiming(), 100).start_wait
+    (15.0, 50.0)
+    """
+    return replace(timing, start_wait=max(timing.start_wait, START_WAIT_PER_ROBOT * robots))
 
 
 def stop_on_signals() -> threading.Event:
@@ -185,6 +201,7 @@ def driver_kind(scenario: Scenario, following_plan: bool) -> str:
 
 def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
     """Run one robot until it is done, writing ``agent-<i>.json`` and ``trace-<i>.jsonl`` in ``options.results``."""
+    options = replace(options, timing=fleet_timing(options.timing, len(scenario.robots)))
     index = options.index
     options.results.mkdir(parents=True, exist_ok=True)
     policy = None
