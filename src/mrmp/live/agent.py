@@ -33,6 +33,7 @@ ground truth) to the results folder, including on interruption.
 
 from __future__ import annotations
 
+import math
 import time
 from collections.abc import Callable
 from enum import Enum
@@ -162,10 +163,12 @@ class Agent(LiveDriver):
         return not robot.guarded or (robot.safety.pending is None and robot.safety.unacknowledged_releases == 0)
 
     def _due(self) -> float:
-        """The body's next event, and the end of the listening or the pause (the driver sleeps until then)."""
+        """The body's next event, the end of the listening or the pause, or at once when a claim is over."""
         due = super()._due()
         if self._phase is Phase.LISTEN or self._phase is Phase.PAUSE:
             due = min(due, self._next_decision)
+        elif self._phase is Phase.CLAIM and self.robot.wanted is None and self.robot.safety.pending is None:
+            due = -math.inf  # the claim is over: the next turn pauses
         return due
 
     def _step(self, now: float, started: float) -> bool:
