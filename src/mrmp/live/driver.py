@@ -11,14 +11,14 @@ policy's driver (:class:`mrmp.live.agent.Agent`,
 
 Every turn of the loop hands the brain the queued messages (queueing its
 answers for the client thread), runs the policy's step, runs the brain's timers, and sends the state
-when nothing was sent for ``heartbeat`` seconds. Between two turns the main
-thread sleeps until the first of: a message arriving (the receiving thread
-wakes it, :class:`Mailbox`), the next thing the step or the body has scheduled
-(``_due``), a heartbeat, the progress report, the end of the linger, or, at the
-latest, ``poll`` seconds, so that the brain's own timers (resending a claim, a
-lock request) run at most ``poll`` late; a brain whose timers are idle (no claim
-pending, no release unacknowledged) is not woken for them. A robot waiting, arrived or not,
-therefore costs little CPU time: dozens of robot processes share a few cores. UDP unicast has no radio, so a
+when nothing was sent for ``heartbeat`` seconds. While the brain's own timers may
+be due (resending a claim, a lock request), turns come every ``poll`` seconds.
+A brain whose timers are idle (no claim pending, no release unacknowledged) is
+not polled: the main thread sleeps until the first of a message arriving (the
+receiving thread wakes it, :class:`Mailbox`), the next thing the step or the
+body has scheduled (``_due``), a heartbeat, the progress report or the end of
+the linger. A robot waiting, arrived or not, therefore costs little CPU time:
+dozens of robot processes share a few cores. UDP unicast has no radio, so a
 radius broadcast (an :class:`~mrmp.robot.messaging.Outgoing` with ``radius``)
 goes to the peers the brain believes within the radius; for discovery, the
 state goes to every peer once every ``fleet_heartbeat`` seconds. A peer is
@@ -43,6 +43,7 @@ from __future__ import annotations
 import math
 import queue
 import threading
+import time
 from collections import Counter
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass, field
@@ -71,8 +72,8 @@ class AgentTiming:
     silence_timeout: float = 1.5
     give_up_after: float = 3.0
     linger: float = 0.6
-    poll: float = 0.01
-    """The longest sleep of the main loop: the brain's timers run at most this late (messages wake it at once)."""
+    poll: float = 0.004
+    """The longest sleep of the main loop while the brain's timers may be due (they run at most this late)."""
     timeout: float = 120.0
     start_wait: float = 15.0
 
@@ -369,13 +370,24 @@ class LiveDriver:
             self.report.messages_received += 1
             self._send(self.robot.receive(message, now))
 
-    def _sleep(self, until: float) -> None:
-        """Sleep until the clock reads ``until``, a message arrives or a stop is requested.
+    def _sleep(self, until: float, timers: bool = True) -> None:
+        """Sleep until the clock reads ``until`` (or a stop is requested), waking for the brain's timers.
 
-        At most ``poll`` seconds, unless the brain's timers are idle (:meth:`_timers_idle`).
+        While the brain's ``timers`` may be due (they are not idle,
+        :meth:`_timers_idle`), the loop polls as it always did: it sleeps at
+        most ``poll`` seconds, and what arrives meanwhile waits for the next
+        turn. Otherwise it sleeps until ``until``, and the first message to
+        arrive wakes it at once.
         """
-        longest = math.inf if self._timers_idle() else self.timing.poll
-        self._inbox.wait(max(0.0, min(until - self.clock(), longest)))
+        timeout = until - self.clock()
+        if timers and not self._timers_idle():
+            self._nap(max(0.0, min(timeout, self.timing.poll)))
+        else:
+            self._inbox.wait(max(0.0, timeout))
+
+    def _nap(self, seconds: float) -> None:
+        """Sleep ``seconds`` whatever arrives (a poll's sleep)."""
+        time.sleep(seconds)
 
     # -- sending ---------------------------------------------------------------------------
 
@@ -498,7 +510,8 @@ class LiveDriver:
             elif now - last_state >= self.timing.heartbeat and unheard:
                 self._send([item._replace(recipients=unheard, radius=None) for item in self._fleet_wait_messages()])
                 last_state = now
-            self._sleep(min(last_state + self.timing.heartbeat, last_fleet_state + self.timing.fleet_heartbeat, deadline))
+            next_state = min(last_state + self.timing.heartbeat, last_fleet_state + self.timing.fleet_heartbeat)
+            self._sleep(min(next_state, deadline), timers=False)  # no brain timers run before the start
 
     def _unheard_peers(self) -> tuple[int, ...]:
         """The peers not heard from yet."""

@@ -70,8 +70,14 @@ class Recording:
 class PollingAgent(Agent):
     """The loop as it was: whatever is due, sleep ``poll`` seconds between two turns."""
 
-    def _sleep(self, until: float) -> None:
+    def _sleep(self, until: float, timers: bool = True) -> None:
         self._inbox.wait(self.timing.poll)
+
+
+def on_fake_clock(agent: Agent, mailbox: CountingMailbox) -> None:
+    """Make ``agent`` sleep on the fake clock: through ``mailbox``, a poll's sleep too."""
+    agent._inbox = mailbox
+    agent._nap = lambda seconds: mailbox.wait(seconds) and None  # type: ignore[method-assign]
 
 
 def scenario(goal: tuple[int, int] = (0, 0), silent_peer: bool = True) -> Scenario:
@@ -88,7 +94,8 @@ def run(kind: type[Agent], scene: Scenario) -> tuple[int, list[tuple[str, int | 
     spec = scene.robots[0]
     body = SimulatedBody(spec.start, spec.heading, scene.grid, scene.timing)
     agent = kind(scene, 0, transport, body, Sealer(KEY, 1), Opener(KEY, 1), timing=TIMING, clock=clock)
-    agent._inbox = mailbox = CountingMailbox(clock)
+    mailbox = CountingMailbox(clock)
+    on_fake_clock(agent, mailbox)
     report = agent.run()
     opener = Opener(KEY, 1)
     sent = []
@@ -154,7 +161,7 @@ def fleet_wait(heard_at_wait: int) -> list[tuple[float, int | None]]:
     agent = Agent(scene, 0, transport, body, Sealer(KEY, 1), Opener(KEY, 1), timing=timing, clock=clock)
     sent: list[tuple[float, int | None]] = []
     agent._client.send = lambda data, recipient: sent.append((round(clock.now - 100.0, 3), recipient))  # type: ignore[method-assign]
-    agent._inbox = InjectingMailbox(clock, StateMessage(1, 1, (3, 3), (3, 3)), at=heard_at_wait)
+    on_fake_clock(agent, InjectingMailbox(clock, StateMessage(1, 1, (3, 3), (3, 3)), at=heard_at_wait))
     agent._wait_for_fleet()
     assert agent._peers_heard() == 1  # C never spoke: the wait ended at start_wait
     return sent
