@@ -17,8 +17,8 @@ seconds per wall second during the fleet's run (from the moment the last robot
 began to the moment the first one stopped; mean and maximum over the agents),
 the referee's, the CPU seconds an agent spent before the fleet began (start-up:
 imports, reading the files, waiting for its peers), an agent's wake-ups per
-second (voluntary context switches of all its threads, which do not depend on
-the machine's load), all the children's CPU seconds per wall second, and the
+second (voluntary context switches of all its threads, which depend less on
+the machine's load than CPU seconds), all the children's CPU seconds per wall second, and the
 one-minute load average at the end. Times are ratios of one machine: compare runs made side by side.
 
 Usage: python bench/live_cpu.py [--robots 16,32] [--drivers lacam,pibt,causal] [--fleets moving,idle]
