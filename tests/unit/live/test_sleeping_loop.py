@@ -179,3 +179,29 @@ def test_waiting_for_the_fleet_a_robot_tells_unheard_peers_every_heartbeat_and_e
         (2.0, None),
         (2.2, 2), (2.4, 2),
     ]  # fmt: skip
+
+
+def test_the_end_of_the_run_is_seen_as_by_a_scan_of_every_peer():
+    """The end check asks first the peer that kept it open: its answers are those of a scan of every peer."""
+    robots = tuple(RobotSpec(name, (0, index), (0, index)) for index, name in enumerate("ABCD"))
+    scene = Scenario(Grid(1, 4), robots)
+    spec = scene.robots[0]
+    body = SimulatedBody(spec.start, spec.heading, scene.grid, scene.timing)
+    agent = Agent(scene, 0, Recording(), body, Sealer(KEY, 1), Opener(KEY, 1), timing=AgentTiming(give_up_after=3.0))
+    news: dict[int, tuple[float, bool] | None] = {}
+    agent._peer_news = news.get  # type: ignore[method-assign]
+    now = 10.0
+    running, done, silent = (now - 1.0, False), (now - 1.0, True), (now - 5.0, False)
+    steps = [
+        ({1: done, 2: running, 3: running}, False, None),
+        ({1: done, 2: done, 3: running}, False, None),  # the peer that kept it open is done: the others are asked
+        ({1: done, 2: done, 3: silent}, True, [3]),
+        ({1: running, 2: done, 3: silent}, False, None),
+        ({1: done, 2: done, 3: None}, True, [3]),  # never heard: silent
+    ]
+    for peers, finished, silent_peers in steps:
+        news.clear()
+        news.update(peers)
+        assert agent._everyone_done(now) is finished
+        if finished:
+            assert agent.report.silent_peers == silent_peers
