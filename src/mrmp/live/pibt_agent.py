@@ -91,24 +91,31 @@ class PibtTiming:
     """A live ``pibt`` robot's step, in seconds of wall-clock time (module docstring)."""
 
     decide: float
-    """The decision phase at the start of every step."""
+    """The decision phase at the start of every step (the step's moves are queued at its end)."""
     step: float
-    """The step's length: the decision phase and a move."""
+    """The step's length: the longer of the decision phase and a move, and a grace (the two overlap)."""
     retry: float
     """How long the brain waits for an acknowledgement before it sends a message again."""
     hold: float
     """How long, from the step's start, a held robot waits for its grant before it stays."""
 
     @classmethod
-    def for_body(cls, cell_seconds: float, decide: float = 0.3, grace: float = 0.05, retry: float = 0.03) -> PibtTiming:
-        """Steps of ``decide`` seconds of decisions, one cell's move and ``grace`` seconds for the next grant.
+    def for_body(
+        cls, cell_seconds: float, decide: float = 0.3, grace: float = 0.05, retry: float = 0.03, hold: float = 0.5
+    ) -> PibtTiming:
+        """Steps of ``max(decide, cell_seconds) + grace`` seconds: step ``k + 1``'s decisions overlap step ``k``'s move.
 
-        A held robot waits for its grant for half the decision phase.
+        A move is queued at the end of its step's decision phase, so it takes
+        the body from then until the next step's decision phase ends, or
+        ``grace`` seconds more than the step's move. A held robot waits for
+        its grant for the fraction ``hold`` of the decision phase.
 
         >>> PibtTiming.for_body(0.5)
-        PibtTiming(decide=0.3, step=0.85, retry=0.03, hold=0.15)
+        PibtTiming(decide=0.3, step=0.55, retry=0.03, hold=0.15)
+        >>> PibtTiming.for_body(0.1).step   # moves shorter than the decisions: the decisions set the pace
+        0.35
         """
-        return cls(decide, round(decide + cell_seconds + grace, 6), retry, decide / 2)
+        return cls(decide, round(max(decide, cell_seconds) + grace, 6), retry, round(decide * hold, 6))
 
 
 def open_repeat(opener: Opener, data: bytes) -> Message | None:
@@ -194,6 +201,8 @@ class PibtBrain:
         self.t0: float | None = None
         self.step = 0
         self._deciding = False
+        self._decided: int | None = None
+        """The cell the robot decided for good on in this step (its move queued already), if it has."""
         self._act = False
         self._claimed_at = -math.inf
         self.crash_after = crash_after
@@ -235,15 +244,29 @@ class PibtBrain:
             if self._act or robot.wake or resent:
                 self._act = False
                 out.extend(robot.act())
+            if robot.final and self._decided is None:
+                self._queue_decided()
         out.extend(self._stamped(self.safety.expire(now)))
         return out
+
+    def _queue_decided(self) -> None:
+        """The robot decided for good: its move is queued now, before the decision phase ends (it cannot change)."""
+        robot = self.robot
+        assert robot.target is not None
+        self._decided = robot.target
+        if robot.target != robot.present:
+            cell = self.flat.cells[robot.target]
+            self.queue.append(cell)
+            self.moves.append((self.step, cell))
 
     def _finish_step(self) -> None:
         self._deciding = False
         robot = self.robot
+        decided, self._decided = self._decided, None
         before = robot.present
         after = robot.finish_step()
-        if after != before:
+        assert decided is None or decided == after, "a robot's decision for good changed"
+        if decided is None and after != before:
             cell = self.flat.cells[after]
             self.queue.append(cell)
             self.moves.append((self.step, cell))

@@ -1,11 +1,19 @@
 """``pibt``'s live brain: it knows, instead of sensing, which robots can be near; safe in crowds; what it answers."""
 
+import heapq
+import itertools
+import math
+import random
+
 import pytest
 from test_pibt_local import FAULTS, crowd
 
 from mrmp.core import Grid, NetworkFaults
+from mrmp.live.body import OccupancyRecorder, SimulatedBody
+from mrmp.live.pibt_agent import PibtBrain, PibtTiming
 from mrmp.protocol.messages import BeaconMessage
 from mrmp.protocol.pibt_local import CallInheritMessage
+from mrmp.robot.messaging import Outgoing
 from mrmp.robot.pibt_live import LivePibtRobot
 from mrmp.search.flat_map import FlatMap
 from mrmp.sim.live_rounds import LiveRoundsSimulator
@@ -101,3 +109,101 @@ def test_a_held_robot_answers_a_request_once_its_move_is_allowed_or_refuses_it_w
             assert answers == [] and flat.cell(b.target) == (2, 0)  # it took the request up: it leaves for (2, 0)
         else:
             assert [answer.moved for answer in answers] == [False] and b.stats["gave_up"] == 1
+
+
+# -- the live brain (PibtBrain) in steps on a clock, its bodies in simulated real time -------------------------
+
+
+class BrainFleet:
+    """``PibtBrain`` robots and simulated bodies on an in-memory network, driven as ``PibtAgent`` drives them.
+
+    Sans-IO: time is a number advanced by ``tick`` seconds; a message arrives
+    ``delay`` seconds after it is sent (lost with probability ``loss``); every
+    ``fleet_heartbeat`` seconds each robot sends its state to every peer. Each
+    robot's loop is the driver's: messages in, the body (``PibtAgent._step``),
+    then the brain's timers.
+    """
+
+    def __init__(
+        self, scenario, timing=None, brain_type=PibtBrain, tick=0.005, delay=0.002, loss=0.0, seed=0, time_scale=1.0
+    ):
+        self.timing = timing or PibtTiming.for_body(scenario.timing.cell_time / time_scale)
+        self.scenario, self.tick, self.delay, self.loss = scenario, tick, delay, loss
+        self.rng = random.Random(seed)
+        self.brains = [brain_type(scenario, index, self.timing) for index in range(len(scenario.robots))]
+        self.recorders = [OccupancyRecorder() for _ in scenario.robots]
+        self.bodies = [
+            SimulatedBody(spec.start, spec.heading, scenario.grid, scenario.timing, time_scale, recorder=recorder)
+            for spec, recorder in zip(scenario.robots, self.recorders, strict=True)
+        ]
+        self.inbox: list[tuple[float, int, int, object]] = []
+        self.sent = 0
+        self.pending_at_step_start: list[int] = []
+        """Per robot and step begun: the moves decided and not yet granted then (what the deadlock argument counts)."""
+        self.arrivals: list[float | None] = [None] * len(self.brains)
+        self.now = 0.0
+
+    def send(self, sender, outgoing):
+        for item in outgoing:
+            recipients = item.recipients
+            if item.radius is not None:
+                recipients = (*self.brains[sender].robot.possibly_within(item.radius), *(recipients or ()))
+            if recipients is None:
+                recipients = [peer for peer in range(len(self.brains)) if peer != sender]
+            for peer in dict.fromkeys(recipients):
+                self.sent += 1
+                if self.rng.random() >= self.loss:
+                    heapq.heappush(self.inbox, (self.now + self.delay, self.sent, peer, item.message))
+
+    def run(self, until=120.0):
+        """Run until every robot is settled (or ``until`` seconds); return the time the last body arrived."""
+        for brain in self.brains:
+            brain.start(0.0)
+        heartbeat = 0.0
+        while self.now < until and not all(brain.settled for brain in self.brains):
+            while self.inbox and self.inbox[0][0] <= self.now:
+                _, _, peer, message = heapq.heappop(self.inbox)
+                self.send(peer, self.brains[peer].receive(message, self.now))
+            for index, (brain, body) in enumerate(zip(self.brains, self.bodies, strict=True)):
+                if body.moving:
+                    if body.poll(self.now):
+                        brain.arrived_at(body.cell)
+                        self.arrivals[index] = self.now
+                else:
+                    target, out = brain.motion(self.now)
+                    self.send(index, out)
+                    if target is not None:
+                        body.start_move(target, self.now)
+                step = brain.step
+                self.send(index, brain.expire(self.now))
+                if brain.step > step:
+                    self.pending_at_step_start.append(len(brain.queue))
+            if self.now >= heartbeat:
+                heartbeat += 1.0
+                for index, brain in enumerate(self.brains):
+                    self.send(index, [Outgoing(brain.state(), None)])
+            self.now = round(self.now + self.tick, 6)
+        return max((t for t in self.arrivals if t is not None), default=0.0)
+
+    def collisions(self):
+        """Pairs of robots whose bodies covered one cell at once (ground truth, as the referee sees it)."""
+        covering: dict = {}
+        for index, (spec, recorder) in enumerate(zip(self.scenario.robots, self.recorders, strict=True)):
+            since = {spec.start: -1.0}
+            for event, cell, t in recorder.events:
+                if event == "enter":
+                    since[cell] = t
+                else:
+                    covering.setdefault(cell, []).append((since.pop(cell), t, index))
+            for cell, t in since.items():
+                covering.setdefault(cell, []).append((t, math.inf, index))
+        clashes = set()
+        for intervals in covering.values():
+            for a, b in itertools.combinations(intervals, 2):
+                if a[2] != b[2] and a[0] < b[1] and b[0] < a[1]:
+                    clashes.add((min(a[2], b[2]), max(a[2], b[2])))
+        return sorted(clashes)
+
+    def decided_paths(self):
+        """Every robot's decided cells, from its start, in order."""
+        return [[spec.start, *(cell for _, cell in brain.moves)] for spec, brain in zip(self.scenario.robots, self.brains, strict=True)]
