@@ -15,8 +15,16 @@ it with what a live robot adds, sans-IO (fed with the clock, never reading it):
   naming step ``p`` counts as a message of step ``p - 1``), and keeps that
   schedule: the fleet keeps the schedule of its earliest robot, each robot
   within a message's delay of it. The first
-  ``decide`` seconds of a step are its decision phase; then every robot that
-  decided for good queues its move, any other stays (an abandoned step);
+  ``decide`` seconds of a step are its decision phase, at whose end a robot
+  that has not decided for good stays (an abandoned step);
+* **moves queued as soon as decided, decisions overlapping moves**: a robot
+  queues its move the moment it decides for good (a decision for good never
+  changes), not at the end of the decision phase, and the next step begins
+  while the body still performs it: the step lasts a move with one right turn
+  (:meth:`PibtTiming.for_body`), not the decision phase and a move one after
+  the other. Step ``k + 1`` is decided from the cells the fleet decided in step
+  ``k``, whether the bodies have reached them or not (the decisions never
+  depended on the bodies);
 * **bodies through the safety layer**: a queued move is claimed from the
   cell's replicas (:class:`~mrmp.protocol.safety.SafetyLayer`); the body starts
   only once a majority registered the cell to it, and its old cell is
@@ -34,7 +42,8 @@ it with what a live robot adds, sans-IO (fed with the clock, never reading it):
 * the brain's timers run in whole milliseconds since ``t0``.
 
 :class:`PibtAgent` is the process around it (:class:`~mrmp.live.driver.LiveDriver`):
-the receiving and client threads, the body, the fleet heartbeat
+the receiving and client threads, the body (its step timing by default
+:meth:`PibtTiming.for_body` of the body's cell and turn times), the fleet heartbeat
 (a :class:`~mrmp.protocol.messages.StateMessage`, for discovery, for the end
 of the run, and to keep every robot's knowledge of the far robots fresh: its
 ``present`` is the cell the robot stands on at the start of step ``progress``).
@@ -91,9 +100,9 @@ class PibtTiming:
     """A live ``pibt`` robot's step, in seconds of wall-clock time (module docstring)."""
 
     decide: float
-    """The decision phase at the start of every step (the step's moves are queued at its end)."""
+    """The decision phase at the start of every step (a robot not decided for good by its end stays)."""
     step: float
-    """The step's length: the longer of the decision phase and a move, and a grace (the two overlap)."""
+    """The step's length (a step's decisions overlap the moves of the step before)."""
     retry: float
     """How long the brain waits for an acknowledgement before it sends a message again."""
     hold: float
@@ -101,21 +110,25 @@ class PibtTiming:
 
     @classmethod
     def for_body(
-        cls, cell_seconds: float, decide: float = 0.3, grace: float = 0.05, retry: float = 0.03, hold: float = 0.5
+        cls,
+        cell_seconds: float,
+        turn_seconds: float = 0.0,
+        decide: float = 0.3,
+        grace: float = 0.05,
+        retry: float = 0.03,
+        hold: float = 0.8,
     ) -> PibtTiming:
-        """Steps of ``max(decide, cell_seconds) + grace`` seconds: step ``k + 1``'s decisions overlap step ``k``'s move.
+        """Steps as long as a move with one right turn (the next step's decisions overlap it), or as the decisions
+        and a ``grace`` for the grant when they take longer; a held robot waits for its grant for the fraction
+        ``hold`` of the decision phase.
 
-        A move is queued at the end of its step's decision phase, so it takes
-        the body from then until the next step's decision phase ends, or
-        ``grace`` seconds more than the step's move. A held robot waits for
-        its grant for the fraction ``hold`` of the decision phase.
-
-        >>> PibtTiming.for_body(0.5)
-        PibtTiming(decide=0.3, step=0.55, retry=0.03, hold=0.15)
-        >>> PibtTiming.for_body(0.1).step   # moves shorter than the decisions: the decisions set the pace
+        >>> PibtTiming.for_body(0.5, 0.25)
+        PibtTiming(decide=0.3, step=0.75, retry=0.03, hold=0.24)
+        >>> PibtTiming.for_body(0.1, 0.05).step   # moves shorter than the decisions: the decisions set the pace
         0.35
         """
-        return cls(decide, round(max(decide, cell_seconds) + grace, 6), retry, round(decide * hold, 6))
+        step = max(decide + grace, cell_seconds + turn_seconds)
+        return cls(decide, round(step, 6), retry, round(decide * hold, 6))
 
 
 def open_repeat(opener: Opener, data: bytes) -> Message | None:
@@ -390,7 +403,8 @@ class PibtAgent(LiveDriver):
     ) -> None:
         timing = dataclasses.replace(timing, poll=max(timing.poll, POLL))
         super().__init__(scenario, index, transport, body, sealer, opener, timing, seed, clock)
-        self.pibt_timing = pibt if pibt is not None else PibtTiming.for_body(self.cell_seconds)
+        turn_seconds = scenario.timing.turn_time / scenario.timing.cell_time * self.cell_seconds
+        self.pibt_timing = pibt if pibt is not None else PibtTiming.for_body(self.cell_seconds, turn_seconds)
         self.robot = PibtBrain(
             scenario, index, self.pibt_timing, claim_retry=min(timing.claim_retry, 0.05),
             crash_after=2 * timing.give_up_after,
