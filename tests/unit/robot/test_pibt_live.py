@@ -125,9 +125,7 @@ class BrainFleet:
     then the brain's timers.
     """
 
-    def __init__(
-        self, scenario, timing=None, brain_type=PibtBrain, tick=0.005, delay=0.002, loss=0.0, seed=0, time_scale=1.0
-    ):
+    def __init__(self, scenario, timing=None, brain_type=PibtBrain, tick=0.005, delay=0.002, loss=0.0, seed=0, time_scale=1.0):
         self.timing = timing or PibtTiming.for_body(
             scenario.timing.cell_time / time_scale, scenario.timing.turn_time / time_scale
         )
@@ -211,7 +209,10 @@ class BrainFleet:
 
     def decided_paths(self):
         """Every robot's decided cells, from its start, in order."""
-        return [[spec.start, *(cell for _, cell in brain.moves)] for spec, brain in zip(self.scenario.robots, self.brains, strict=True)]
+        return [
+            [spec.start, *(cell for _, cell in brain.moves)]
+            for spec, brain in zip(self.scenario.robots, self.brains, strict=True)
+        ]
 
 
 def corridor(robots=3, length=9):
@@ -299,7 +300,12 @@ def test_live_brains_in_crowds_over_a_lossy_network_arrive_and_their_bodies_neve
 def test_on_a_perfect_network_live_brains_make_the_simulators_decisions():
     """Radius covering the map (the calls run in priority order), moves short beside the decisions: no robot gives
     up a step, and every robot's decided cells are the simulator's."""
-    robots = (RobotSpec("a", (0, 2), (4, 2)), RobotSpec("b", (4, 2), (0, 2)), RobotSpec("c", (2, 0), (2, 4)), RobotSpec("d", (2, 4), (2, 0)))
+    robots = (
+        RobotSpec("a", (0, 2), (4, 2)),
+        RobotSpec("b", (4, 2), (0, 2)),
+        RobotSpec("c", (2, 0), (2, 4)),
+        RobotSpec("d", (2, 4), (2, 0)),
+    )
     scenario = Scenario(Grid(5, 5, [(2, 2)]), robots, timing=Timing(1.0, 0.5), policy=PolicyOptions(name="pibt", radius=8))
     simulated = LiveRoundsSimulator(scenario, step_ticks=4).run()
     fleet = BrainFleet(scenario, time_scale=10)
