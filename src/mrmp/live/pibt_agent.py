@@ -116,19 +116,23 @@ class PibtTiming:
         decide: float = 0.3,
         grace: float = 0.05,
         retry: float = 0.03,
-        hold: float = 0.8,
+        hold: float = 0.4,
     ) -> PibtTiming:
-        """Steps as long as a move with one right turn (the next step's decisions overlap it), or as the decisions
-        and a ``grace`` for the grant when they take longer; a held robot waits for its grant for the fraction
-        ``hold`` of the decision phase.
+        """Steps as long as a move with one right turn (the next step's decisions overlap it), or as ``decide``
+        seconds of decisions and a ``grace`` for the grant when the moves are shorter.
+
+        The decision phase is all of the step but the grace: a robot's move is
+        queued the moment it decides for good, so a long phase costs nothing to
+        the robots that decided and gives the others time. A held robot waits
+        for its grant for the fraction ``hold`` of the decision phase.
 
         >>> PibtTiming.for_body(0.5, 0.25)
-        PibtTiming(decide=0.3, step=0.75, retry=0.03, hold=0.24)
-        >>> PibtTiming.for_body(0.1, 0.05).step   # moves shorter than the decisions: the decisions set the pace
-        0.35
+        PibtTiming(decide=0.7, step=0.75, retry=0.03, hold=0.28)
+        >>> PibtTiming.for_body(0.1, 0.05)   # moves shorter than the decisions: the decisions set the pace
+        PibtTiming(decide=0.3, step=0.35, retry=0.03, hold=0.12)
         """
-        step = max(decide + grace, cell_seconds + turn_seconds)
-        return cls(decide, round(step, 6), retry, round(decide * hold, 6))
+        phase = max(decide, cell_seconds + turn_seconds - grace)
+        return cls(round(phase, 6), round(phase + grace, 6), retry, round(phase * hold, 6))
 
 
 def open_repeat(opener: Opener, data: bytes) -> Message | None:

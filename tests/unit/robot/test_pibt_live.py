@@ -227,9 +227,9 @@ def test_a_move_decided_for_good_is_queued_and_started_before_the_decision_phase
     brain.start(0.0)
     for now in (0.01, 0.02, 0.03):
         brain.expire(now)
-    assert brain.robot.final and brain.queue == [(1, 0)] and brain.step == 1  # 0.27 s before the phase ends
+    assert brain.robot.final and brain.queue == [(1, 0)] and brain.step == 1  # its decision phase lasts 0.7 s
     brain.motion(0.04)  # the claim: its only replica is itself, which registers the cell at once
-    assert brain.motion(0.05) == ((1, 0), [])  # the body goes, 0.25 s before the decision phase ends
+    assert brain.motion(0.05) == ((1, 0), [])  # the body goes, 0.65 s before the decision phase ends
 
 
 def test_a_convoy_decides_its_next_steps_while_its_bodies_move_and_arrives_sooner_than_with_steps_in_series():
