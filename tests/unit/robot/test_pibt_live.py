@@ -120,7 +120,7 @@ class BrainFleet:
 
     Sans-IO: time is a number advanced by ``tick`` seconds; a message arrives
     ``delay`` seconds after it is sent (lost with probability ``loss``); every
-    ``fleet_heartbeat`` seconds each robot sends its state to every peer. Each
+    second each robot sends its state to every peer (the fleet heartbeat). Each
     robot's loop is the driver's: messages in, the body (``PibtAgent._step``),
     then the brain's timers.
     """
@@ -276,7 +276,9 @@ class UnheldBrain(PibtBrain):
 
 
 def test_bodies_that_start_before_their_grant_collide():
-    assert BrainFleet(corridor()).run() and BrainFleet(corridor()).collisions() == []
+    guarded = BrainFleet(corridor())
+    guarded.run()
+    assert guarded.collisions() == [] and all(brain.settled for brain in guarded.brains)
     eager = BrainFleet(corridor(), brain_type=EagerBrain)
     eager.run(until=20)
     assert eager.collisions() != []
