@@ -387,7 +387,7 @@ class PibtAgent(LiveDriver):
     The parameters ``scenario``, ``index``, ``transport``, ``body``,
     ``sealer``, ``opener``, ``timing``, ``seed`` and ``clock`` are those of
     :class:`~mrmp.live.driver.LiveDriver`; ``pibt``: the step's timing (by
-    default :meth:`PibtTiming.for_body` of the body's cell time).
+    default :meth:`PibtTiming.for_body` of the body's cell and turn times).
     """
 
     robot: PibtBrain
