@@ -4,7 +4,9 @@ For each case: run the scenario live (``mrmp run --live``'s launcher, loopback)
 and in the simulator, and print whether every robot arrived, the referee's
 collisions, the wall-clock makespan, the simulator's makespan in ticks times
 the cell time (at the run's time scale) and their ratio (the target: at most
-1.5), the live run's ideal (the longest single-robot path at that speed), moves,
+1.5), the execution bound (:func:`execution_bound`: the simulator's decisions
+carried out by live bodies, with no time for messages) and its ratio, the live
+run's ideal (the longest single-robot path at that speed), moves,
 messages per move, and the live robots' own counts (steps begun held, steps
 abandoned, retransmissions). The machine's load (1-minute load average before
 and after each run, and the number of cores) is printed with every row: times
@@ -22,7 +24,13 @@ Cases (``--cases``, comma-separated):
 * ``side``: ``examples/causal-32.yaml`` (32 robots, perfect network) live with ``pibt``
   and with ``causal``, side by side.
 
-Usage: python bench/live_pibt.py [--cases udp24,zenoh24,udp64,side] [--time-scale 2]
+With ``--before REV`` every case runs first with the code of the git revision
+``REV`` (its ``src`` exported to a temporary folder and put first on the
+``PYTHONPATH`` of a child run of this script, and so of its robot processes),
+then with the code here: the rows before and after a change, side by side on
+one machine.
+
+Usage: python bench/live_pibt.py [--cases udp24,zenoh24,udp64,side] [--time-scale 2] [--before REV]
 """
 
 from __future__ import annotations
@@ -30,12 +38,17 @@ from __future__ import annotations
 import argparse
 import os
 import random
+import subprocess
 import sys
+import tarfile
 import tempfile
+import threading
 import time
+from io import BytesIO
 from pathlib import Path
 
 from mrmp.core import NetworkFaults, PolicyOptions, RobotSpec, Scenario
+from mrmp.core.heading import Heading, right_turns
 from mrmp.core.result import RunResult
 from mrmp.io.scenario_file import load_scenario
 from mrmp.live.launcher import LiveOptions, run_live
@@ -81,6 +94,77 @@ def live(scenario: Scenario, transport: str, loss: float, time_scale: float) -> 
     return result, before, os.getloadavg()[0], time.monotonic() - began
 
 
+def execution_bound(scenario: Scenario, time_scale: float) -> float:
+    """Seconds the bodies of a live run would take to carry out the simulator's decisions, with no time for messages.
+
+    The simulator's paths (``pibt``, local sequencing, perfect network) are
+    executed as an action dependency graph (W. Hönig, S. Kiesel, A. Tinka,
+    J. W. Durham, N. Ayanian, "Persistent and robust execution of MAPF
+    schedules in warehouses", IEEE RA-L 4(2), 2019): each move starts as soon
+    as the robot's previous move has ended and every robot that stood on its
+    target cell earlier in the plan has left it, and lasts what a live body
+    takes (right turns, then one cell; a body covers both cells until it
+    arrives). No live execution of those decisions can end sooner.
+    """
+    local = scenario.with_changes(policy=PolicyOptions(name="pibt", sequencing="local"), network=NetworkFaults())
+    paths = [[tuple(cell) for cell in robot.path] for robot in LocalRoundsSimulator(local).run().robots]
+    length = max(len(path) for path in paths)
+    paths = [path + [path[-1]] * (length - len(path)) for path in paths]
+    cell_seconds = scenario.timing.cell_time / time_scale
+    turn_seconds = scenario.timing.turn_time / time_scale
+    stays: dict[tuple[int, int], list[tuple[int, int]]] = {}  # cell -> (robot, last tick there) of every visit
+    for robot, path in enumerate(paths):
+        for tick in range(length):
+            if tick + 1 == length or path[tick + 1] != path[tick]:
+                stays.setdefault(path[tick], []).append((robot, tick))
+    turns: dict[tuple[int, int], int] = {}
+    for robot, path in enumerate(paths):
+        heading = scenario.robots[robot].heading
+        for tick in range(1, length):
+            if path[tick] != path[tick - 1]:
+                direction = Heading.between(path[tick - 1], path[tick])
+                turns[robot, tick] = right_turns(heading, direction)
+                heading = direction
+    ends: dict[tuple[int, int], float] = {}
+
+    def end(robot: int, tick: int) -> float:  # when the move of ``robot`` into its cell at ``tick`` ends
+        if (robot, tick) in ends:
+            return ends[robot, tick]
+        ends[robot, tick] = 0.0  # a rotation's cycle: its moves count as starting together
+        path = paths[robot]
+        earlier = [t for t in range(1, tick) if (robot, t) in turns]
+        ready = end(robot, earlier[-1]) if earlier else 0.0
+        for other, last in stays[path[tick]]:
+            if other != robot and last < tick:
+                ready = max(ready, end(other, last + 1))  # it has left the cell
+        ends[robot, tick] = ready + turns[robot, tick] * turn_seconds + cell_seconds
+        return ends[robot, tick]
+
+    sys.setrecursionlimit(max(sys.getrecursionlimit(), 100 * len(turns) + 1000))
+    result: list[float] = []
+    worker = threading.Thread(target=lambda: result.append(max((end(*move) for move in turns), default=0.0)))
+    threading.stack_size(256 * 1024 * 1024)
+    worker.start()
+    worker.join()
+    return result[0]
+
+
+def export_source(revision: str) -> Path:
+    """The ``src`` folder of git revision ``revision`` of this repository, exported to a temporary folder."""
+    archive = subprocess.run(["git", "-C", str(ROOT), "archive", revision, "src"], capture_output=True, check=True).stdout
+    folder = Path(tempfile.mkdtemp(prefix="mrmp-before-"))
+    with tarfile.open(fileobj=BytesIO(archive)) as tar:
+        tar.extractall(folder, filter="data")
+    return folder / "src"
+
+
+def run_before(source: Path, case: str, revision: str, time_scale: float) -> None:
+    """Run ``case`` in a child process with the code under ``source`` first on its path."""
+    environment = {**os.environ, "PYTHONPATH": os.pathsep.join([str(source), os.environ.get("PYTHONPATH", "")])}
+    command = [sys.executable, __file__, "--cases", case, "--time-scale", str(time_scale), "--label", f"before ({revision})"]
+    subprocess.run(command, env=environment, check=True)
+
+
 def row(label: str, scenario: Scenario, transport: str, loss: float, time_scale: float, compare: bool = True) -> None:
     result, load_before, load_after, _ = live(scenario, transport, loss, time_scale)
     cell = scenario.timing.cell_time / time_scale
@@ -91,7 +175,8 @@ def row(label: str, scenario: Scenario, transport: str, loss: float, time_scale:
         ticks = simulated_makespan(scenario)
         simulated = ticks * cell
         ratio = f"{result.time_makespan_s / simulated:.2f}" if ticks > 0 else "-"
-        sim_text = f"{ticks} ticks = {simulated:.2f} s"
+        bound = execution_bound(scenario, time_scale)
+        sim_text = f"{ticks} ticks = {simulated:.2f} s (its execution bound {bound:.2f} s, ratio {bound / simulated:.2f})"
     else:
         sim_text, ratio = "-", "-"
     print(
@@ -112,20 +197,26 @@ def main() -> int:
     parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     parser.add_argument("--cases", default="udp24,zenoh24,udp64,side")
     parser.add_argument("--time-scale", type=float, default=2.0)
+    parser.add_argument("--before", metavar="REV", help="run every case first with the code of git revision REV")
+    parser.add_argument("--label", default="", help=argparse.SUPPRESS)
     arguments = parser.parse_args()
     scale = arguments.time_scale
-    for case in arguments.cases.split(","):
-        if case == "udp24":
+    source = export_source(arguments.before) if arguments.before else None
+    for name in arguments.cases.split(","):
+        if source is not None:
+            run_before(source, name, arguments.before, scale)
+        case = f"{name} {arguments.label or ('after' if source is not None else '')}".strip()
+        if name == "udp24":
             row(case, example(24), "udp", 0.2, scale)
-        elif case == "zenoh24":
+        elif name == "zenoh24":
             row(case, example(24), "zenoh", 0.2, scale)
-        elif case == "udp64":
+        elif name == "udp64":
             row(case, drawn(64), "udp", 0.1, scale)
-        elif case == "side":
+        elif name == "side":
             row(case, example(), "udp", 0.0, scale)
             row(case, example(policy="causal"), "udp", 0.0, scale, compare=False)
         else:
-            print(f"unknown case {case!r}", file=sys.stderr)
+            print(f"unknown case {name!r}", file=sys.stderr)
             return 2
     return 0
 

@@ -15,8 +15,16 @@ it with what a live robot adds, sans-IO (fed with the clock, never reading it):
   naming step ``p`` counts as a message of step ``p - 1``), and keeps that
   schedule: the fleet keeps the schedule of its earliest robot, each robot
   within a message's delay of it. The first
-  ``decide`` seconds of a step are its decision phase; then every robot that
-  decided for good queues its move, any other stays (an abandoned step);
+  ``decide`` seconds of a step are its decision phase, at whose end a robot
+  that has not decided for good stays (an abandoned step);
+* **moves queued as soon as decided, decisions overlapping moves**: a robot
+  queues its move the moment it decides for good (a decision for good never
+  changes), not at the end of the decision phase, and the next step begins
+  while the body still performs it: the step lasts a move with one right turn
+  (:meth:`PibtTiming.for_body`), not the decision phase and a move one after
+  the other. Step ``k + 1`` is decided from the cells the fleet decided in step
+  ``k``, whether the bodies have reached them or not (the decisions never
+  depended on the bodies);
 * **bodies through the safety layer**: a queued move is claimed from the
   cell's replicas (:class:`~mrmp.protocol.safety.SafetyLayer`); the body starts
   only once a majority registered the cell to it, and its old cell is
@@ -34,7 +42,8 @@ it with what a live robot adds, sans-IO (fed with the clock, never reading it):
 * the brain's timers run in whole milliseconds since ``t0``.
 
 :class:`PibtAgent` is the process around it (:class:`~mrmp.live.driver.LiveDriver`):
-the receiving and client threads, the body, the fleet heartbeat
+the receiving and client threads, the body (its step timing by default
+:meth:`PibtTiming.for_body` of the body's cell and turn times), the fleet heartbeat
 (a :class:`~mrmp.protocol.messages.StateMessage`, for discovery, for the end
 of the run, and to keep every robot's knowledge of the far robots fresh: its
 ``present`` is the cell the robot stands on at the start of step ``progress``).
@@ -91,24 +100,39 @@ class PibtTiming:
     """A live ``pibt`` robot's step, in seconds of wall-clock time (module docstring)."""
 
     decide: float
-    """The decision phase at the start of every step."""
+    """The decision phase at the start of every step (a robot not decided for good by its end stays)."""
     step: float
-    """The step's length: the decision phase and a move."""
+    """The step's length (a step's decisions overlap the moves of the step before)."""
     retry: float
     """How long the brain waits for an acknowledgement before it sends a message again."""
     hold: float
     """How long, from the step's start, a held robot waits for its grant before it stays."""
 
     @classmethod
-    def for_body(cls, cell_seconds: float, decide: float = 0.3, grace: float = 0.05, retry: float = 0.03) -> PibtTiming:
-        """Steps of ``decide`` seconds of decisions, one cell's move and ``grace`` seconds for the next grant.
+    def for_body(
+        cls,
+        cell_seconds: float,
+        turn_seconds: float = 0.0,
+        decide: float = 0.3,
+        grace: float = 0.05,
+        retry: float = 0.03,
+        hold: float = 0.4,
+    ) -> PibtTiming:
+        """Steps as long as a move with one right turn (the next step's decisions overlap it), or as ``decide``
+        seconds of decisions and a ``grace`` for the grant when the moves are shorter.
 
-        A held robot waits for its grant for half the decision phase.
+        The decision phase is all of the step but the grace: a robot's move is
+        queued the moment it decides for good, so a long phase costs nothing to
+        the robots that decided and gives the others time. A held robot waits
+        for its grant for the fraction ``hold`` of the decision phase.
 
-        >>> PibtTiming.for_body(0.5)
-        PibtTiming(decide=0.3, step=0.85, retry=0.03, hold=0.15)
+        >>> PibtTiming.for_body(0.5, 0.25)
+        PibtTiming(decide=0.7, step=0.75, retry=0.03, hold=0.28)
+        >>> PibtTiming.for_body(0.1, 0.05)   # moves shorter than the decisions: the decisions set the pace
+        PibtTiming(decide=0.3, step=0.35, retry=0.03, hold=0.12)
         """
-        return cls(decide, round(decide + cell_seconds + grace, 6), retry, decide / 2)
+        phase = max(decide, cell_seconds + turn_seconds - grace)
+        return cls(round(phase, 6), round(phase + grace, 6), retry, round(phase * hold, 6))
 
 
 def open_repeat(opener: Opener, data: bytes) -> Message | None:
@@ -194,6 +218,8 @@ class PibtBrain:
         self.t0: float | None = None
         self.step = 0
         self._deciding = False
+        self._decided: int | None = None
+        """The cell the robot decided for good on in this step (its move queued already), if it has."""
         self._act = False
         self._claimed_at = -math.inf
         self.crash_after = crash_after
@@ -235,15 +261,29 @@ class PibtBrain:
             if self._act or robot.wake or resent:
                 self._act = False
                 out.extend(robot.act())
+            if robot.final and self._decided is None:
+                self._queue_decided()
         out.extend(self._stamped(self.safety.expire(now)))
         return out
+
+    def _queue_decided(self) -> None:
+        """The robot decided for good: its move is queued now, before the decision phase ends (it cannot change)."""
+        robot = self.robot
+        assert robot.target is not None
+        self._decided = robot.target
+        if robot.target != robot.present:
+            cell = self.flat.cells[robot.target]
+            self.queue.append(cell)
+            self.moves.append((self.step, cell))
 
     def _finish_step(self) -> None:
         self._deciding = False
         robot = self.robot
+        decided, self._decided = self._decided, None
         before = robot.present
         after = robot.finish_step()
-        if after != before:
+        assert decided is None or decided == after, "a robot's decision for good changed"
+        if decided is None and after != before:
             cell = self.flat.cells[after]
             self.queue.append(cell)
             self.moves.append((self.step, cell))
@@ -347,7 +387,7 @@ class PibtAgent(LiveDriver):
     The parameters ``scenario``, ``index``, ``transport``, ``body``,
     ``sealer``, ``opener``, ``timing``, ``seed`` and ``clock`` are those of
     :class:`~mrmp.live.driver.LiveDriver`; ``pibt``: the step's timing (by
-    default :meth:`PibtTiming.for_body` of the body's cell time).
+    default :meth:`PibtTiming.for_body` of the body's cell and turn times).
     """
 
     robot: PibtBrain
@@ -367,7 +407,8 @@ class PibtAgent(LiveDriver):
     ) -> None:
         timing = dataclasses.replace(timing, poll=max(timing.poll, POLL))
         super().__init__(scenario, index, transport, body, sealer, opener, timing, seed, clock)
-        self.pibt_timing = pibt if pibt is not None else PibtTiming.for_body(self.cell_seconds)
+        turn_seconds = scenario.timing.turn_time / scenario.timing.cell_time * self.cell_seconds
+        self.pibt_timing = pibt if pibt is not None else PibtTiming.for_body(self.cell_seconds, turn_seconds)
         self.robot = PibtBrain(
             scenario, index, self.pibt_timing, claim_retry=min(timing.claim_retry, 0.05),
             crash_after=2 * timing.give_up_after,

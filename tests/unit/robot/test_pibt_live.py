@@ -1,11 +1,20 @@
 """``pibt``'s live brain: it knows, instead of sensing, which robots can be near; safe in crowds; what it answers."""
 
+import heapq
+import itertools
+import math
+import random
+
 import pytest
 from test_pibt_local import FAULTS, crowd
 
-from mrmp.core import Grid, NetworkFaults
+from mrmp.core import Grid, NetworkFaults, PolicyOptions, RobotSpec, Scenario, Timing
+from mrmp.core.heading import Heading
+from mrmp.live.body import OccupancyRecorder, SimulatedBody
+from mrmp.live.pibt_agent import PibtBrain, PibtTiming
 from mrmp.protocol.messages import BeaconMessage
 from mrmp.protocol.pibt_local import CallInheritMessage
+from mrmp.robot.messaging import Outgoing
 from mrmp.robot.pibt_live import LivePibtRobot
 from mrmp.search.flat_map import FlatMap
 from mrmp.sim.live_rounds import LiveRoundsSimulator
@@ -101,3 +110,209 @@ def test_a_held_robot_answers_a_request_once_its_move_is_allowed_or_refuses_it_w
             assert answers == [] and flat.cell(b.target) == (2, 0)  # it took the request up: it leaves for (2, 0)
         else:
             assert [answer.moved for answer in answers] == [False] and b.stats["gave_up"] == 1
+
+
+# -- the live brain (PibtBrain) in steps on a clock, its bodies in simulated real time -------------------------
+
+
+class BrainFleet:
+    """``PibtBrain`` robots and simulated bodies on an in-memory network, driven as ``PibtAgent`` drives them.
+
+    Sans-IO: time is a number advanced by ``tick`` seconds; a message arrives
+    ``delay`` seconds after it is sent (lost with probability ``loss``); every
+    second each robot sends its state to every peer (the fleet heartbeat). Each
+    robot's loop is the driver's: messages in, the body (``PibtAgent._step``),
+    then the brain's timers.
+    """
+
+    def __init__(self, scenario, timing=None, brain_type=PibtBrain, tick=0.005, delay=0.002, loss=0.0, seed=0, time_scale=1.0):
+        self.timing = timing or PibtTiming.for_body(
+            scenario.timing.cell_time / time_scale, scenario.timing.turn_time / time_scale
+        )
+        self.scenario, self.tick, self.delay, self.loss = scenario, tick, delay, loss
+        self.rng = random.Random(seed)
+        self.brains = [brain_type(scenario, index, self.timing) for index in range(len(scenario.robots))]
+        self.recorders = [OccupancyRecorder() for _ in scenario.robots]
+        self.bodies = [
+            SimulatedBody(spec.start, spec.heading, scenario.grid, scenario.timing, time_scale, recorder=recorder)
+            for spec, recorder in zip(scenario.robots, self.recorders, strict=True)
+        ]
+        self.inbox: list[tuple[float, int, int, object]] = []
+        self.sent = 0
+        self.most_pending = 0
+        """The most moves one robot had decided and not yet been granted at once (the deadlock argument needs 1)."""
+        self.decided_while_moving = 0
+        """Moves decided while the robot's body was still performing the one before."""
+        self.arrivals: list[float | None] = [None] * len(self.brains)
+        self.now = 0.0
+
+    def send(self, sender, outgoing):
+        for item in outgoing:
+            recipients = item.recipients
+            if item.radius is not None:
+                recipients = (*self.brains[sender].robot.possibly_within(item.radius), *(recipients or ()))
+            if recipients is None:
+                recipients = [peer for peer in range(len(self.brains)) if peer != sender]
+            for peer in dict.fromkeys(recipients):
+                self.sent += 1
+                if self.rng.random() >= self.loss:
+                    heapq.heappush(self.inbox, (self.now + self.delay, self.sent, peer, item.message))
+
+    def run(self, until=120.0):
+        """Run until every robot is settled (or ``until`` seconds); return the time the last body arrived."""
+        for brain in self.brains:
+            brain.start(0.0)
+        heartbeat = 0.0
+        while self.now < until and not all(brain.settled for brain in self.brains):
+            while self.inbox and self.inbox[0][0] <= self.now:
+                _, _, peer, message = heapq.heappop(self.inbox)
+                self.send(peer, self.brains[peer].receive(message, self.now))
+            for index, (brain, body) in enumerate(zip(self.brains, self.bodies, strict=True)):
+                if body.moving:
+                    if body.poll(self.now):
+                        brain.arrived_at(body.cell)
+                        self.arrivals[index] = self.now
+                else:
+                    target, out = brain.motion(self.now)
+                    self.send(index, out)
+                    if target is not None:
+                        body.start_move(target, self.now)
+                decided = len(brain.moves)
+                self.send(index, brain.expire(self.now))
+                self.most_pending = max(self.most_pending, len(brain.queue))
+                self.decided_while_moving += len(brain.moves) > decided and body.moving
+            if self.now >= heartbeat:
+                heartbeat += 1.0
+                for index, brain in enumerate(self.brains):
+                    self.send(index, [Outgoing(brain.state(), None)])
+            self.now = round(self.now + self.tick, 6)
+        return max((t for t in self.arrivals if t is not None), default=0.0)
+
+    def collisions(self):
+        """Pairs of robots whose bodies covered one cell at once (ground truth, as the referee sees it)."""
+        covering: dict = {}
+        for index, (spec, recorder) in enumerate(zip(self.scenario.robots, self.recorders, strict=True)):
+            since = {spec.start: -1.0}
+            for event, cell, t in recorder.events:
+                if event == "enter":
+                    since[cell] = t
+                else:
+                    covering.setdefault(cell, []).append((since.pop(cell), t, index))
+            for cell, t in since.items():
+                covering.setdefault(cell, []).append((t, math.inf, index))
+        clashes = set()
+        for intervals in covering.values():
+            for a, b in itertools.combinations(intervals, 2):
+                if a[2] != b[2] and a[0] < b[1] and b[0] < a[1]:
+                    clashes.add((min(a[2], b[2]), max(a[2], b[2])))
+        return sorted(clashes)
+
+    def decided_paths(self):
+        """Every robot's decided cells, from its start, in order."""
+        return [
+            [spec.start, *(cell for _, cell in brain.moves)]
+            for spec, brain in zip(self.scenario.robots, self.brains, strict=True)
+        ]
+
+
+def corridor(robots=3, length=9):
+    """``robots`` robots nose to tail at the west end of a one-row corridor, each going ``length - robots`` cells east."""
+    specs = tuple(RobotSpec(f"r{i}", (i, 0), (length - robots + i, 0), Heading.EAST) for i in range(robots))
+    return Scenario(Grid(length, 1), specs, timing=Timing(0.5, 0.25), policy=PolicyOptions(name="pibt"))
+
+
+def test_a_move_decided_for_good_is_queued_and_started_before_the_decision_phase_ends():
+    scenario = corridor(robots=1)
+    brain = PibtBrain(scenario, 0, PibtTiming.for_body(0.5, 0.25))
+    brain.start(0.0)
+    for now in (0.01, 0.02, 0.03):
+        brain.expire(now)
+    assert brain.robot.final and brain.queue == [(1, 0)] and brain.step == 1  # its decision phase lasts 0.7 s
+    brain.motion(0.04)  # the claim: its only replica is itself, which registers the cell at once
+    assert brain.motion(0.05) == ((1, 0), [])  # the body goes, 0.65 s before the decision phase ends
+
+
+def test_a_convoy_decides_its_next_steps_while_its_bodies_move_and_arrives_sooner_than_with_steps_in_series():
+    overlapped = BrainFleet(corridor())
+    series = BrainFleet(corridor(), PibtTiming(decide=0.3, step=0.85, retry=0.03, hold=0.15), brain_type=LateBrain)
+    assert overlapped.run() < series.run()
+    assert overlapped.collisions() == [] and all(brain.settled for brain in overlapped.brains)
+    assert overlapped.decided_while_moving > series.decided_while_moving
+    assert overlapped.most_pending == 1  # a held robot decides no second move before its first is granted
+
+
+class LateBrain(PibtBrain):
+    """The step in series: a move is queued only when the decision phase ends."""
+
+    def _queue_decided(self):
+        self._decided = None
+
+
+class EagerBrain(PibtBrain):
+    """Broken: the body starts into the next decided cell without waiting for its grant."""
+
+    def motion(self, now):
+        if self.moving or not self.queue:
+            return None, []
+        self.moving = True
+        cell = self.queue.pop(0)
+        if not self.queue:
+            self.robot.release()
+        return cell, []
+
+    def arrived_at(self, cell):
+        self.moving = False
+
+
+class UnheldBrain(PibtBrain):
+    """Broken: a robot whose move has not been granted takes part in the next step as if it had been."""
+
+    def expire(self, now):
+        queue, self.queue = self.queue, []  # what begin_step is told: nothing pending
+        try:
+            return super().expire(now)
+        finally:
+            self.queue = queue + self.queue
+
+
+def test_bodies_that_start_before_their_grant_collide():
+    guarded = BrainFleet(corridor())
+    guarded.run()
+    assert guarded.collisions() == [] and all(brain.settled for brain in guarded.brains)
+    eager = BrainFleet(corridor(), brain_type=EagerBrain)
+    eager.run(until=20)
+    assert eager.collisions() != []
+
+
+def test_a_robot_not_held_decides_a_second_move_before_its_first_is_granted():
+    unheld = BrainFleet(corridor(), brain_type=UnheldBrain)
+    unheld.run(until=20)
+    assert unheld.most_pending > 1
+
+
+@pytest.mark.parametrize("seed", range(4))
+def test_live_brains_in_crowds_over_a_lossy_network_arrive_and_their_bodies_never_collide(seed):
+    scenario = crowd(seed, density=0.3, max_ticks=200)
+    fleet = BrainFleet(scenario, loss=0.2, seed=seed, tick=0.01)
+    fleet.run(until=120)
+    assert fleet.collisions() == [] and all(brain.settled for brain in fleet.brains)
+    assert fleet.most_pending <= 1
+
+
+def test_on_a_perfect_network_live_brains_make_the_simulators_decisions():
+    """Radius covering the map (the calls run in priority order), moves short beside the decisions: no robot gives
+    up a step, and every robot's decided cells are the simulator's."""
+    robots = (
+        RobotSpec("a", (0, 2), (4, 2)),
+        RobotSpec("b", (4, 2), (0, 2)),
+        RobotSpec("c", (2, 0), (2, 4)),
+        RobotSpec("d", (2, 4), (2, 0)),
+    )
+    scenario = Scenario(Grid(5, 5, [(2, 2)]), robots, timing=Timing(1.0, 0.5), policy=PolicyOptions(name="pibt", radius=8))
+    simulated = LiveRoundsSimulator(scenario, step_ticks=4).run()
+    fleet = BrainFleet(scenario, time_scale=10)
+    fleet.run()
+    assert sum(brain.robot.stats["gave_up"] + brain.robot.stats["abandoned"] for brain in fleet.brains) == 0
+    assert [[cell for i, cell in enumerate(path) if i == 0 or path[i - 1] != cell] for path in fleet.decided_paths()] == [
+        [tuple(cell) for i, cell in enumerate(robot.path) if i == 0 or robot.path[i - 1] != cell] for robot in simulated.robots
+    ]
