@@ -138,6 +138,8 @@ class PendingClaim:
     committed: bool = False
     standing: bool = False
     """Refused, and kept past the step for a grant on a handoff or a release (``keep_refused``)."""
+    handoff_repeated: bool = False
+    """Committed, and its handoff sent once more (:meth:`SafetyLayer.repeat_handoff`, a lossy network's driver)."""
 
     @property
     def refused(self) -> bool:
@@ -526,6 +528,27 @@ class SafetyLayer:
         if self.index in self.replicas_of(self.present):
             sends.extend(self._grant_deferred(self.present))
         return sends
+
+    def repeat_handoff(self) -> list[Send]:
+        """The handoff of the Present once more, while the pending claim is committed (lockstep model): for a
+        driver of a lossy network, so that a lost handoff does not cost a follower its tick. A replica takes a
+        second copy as it takes a duplicate (it names the same record), so the argument is unchanged.
+
+        >>> a = SafetyLayer(0, [(0, 0), (0, 1), (0, 2)], following=True)
+        >>> a.repeat_handoff()   # nothing committed
+        []
+        >>> claim = a.start_claim((1, 0), now=0)
+        >>> a.replicas_of((1, 0))
+        (0, 1, 2)
+        >>> _ = a.handle_reply(ReplyMessage(1, 0, 0, claim.claim, (1, 0), True), now=0)   # its majority: committed
+        >>> [(type(message).__name__, message.cell, to) for message, to in a.repeat_handoff()]
+        [('HandoffMessage', (0, 0), (1, 2))]
+        """
+        pending = self.pending
+        if not self.following or pending is None or not pending.committed:
+            return []
+        recipients = self.claim_recipients(self.present)
+        return [(HandoffMessage(self.index, 0, self.present_claim, self.present), recipients)] if recipients else []
 
     def handle_handoff(self, message: HandoffMessage) -> list[Send]:
         """A peer leaves a cell this robot keeps in this tick: mark its registration, grant a deferred claim.

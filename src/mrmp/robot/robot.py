@@ -171,6 +171,7 @@ class Robot(MessageEndpoint):
         self.moving = False
         self.belief = Belief()
         self._heard_since: set[int] = set()
+        self._heard_since_decision: set[int] = set()
         self._answered: set[int] = set()
         self.safety = SafetyLayer(
             index,
@@ -309,6 +310,7 @@ class Robot(MessageEndpoint):
             return []
         decision = self.policy.decide(self.situation(), self.intended)
         self.last_decision = decision
+        self._heard_since_decision.clear()
         self.wanted = decision.next if decision.next != self.present else None
         if standing is not None and self.wanted == standing.cell:
             return []  # the claim refused earlier stands: its replicas grant it when its cell is handed off or released
@@ -345,6 +347,47 @@ class Robot(MessageEndpoint):
             if waiting:
                 sends.append(Outgoing(self.state_message(), waiting))
         sends.extend(Outgoing(self._stamp(message), recipients) for message, recipients in self.safety.resend_claim(now))
+        return sends
+
+    def exchange_again(self, now: float) -> list[Outgoing]:
+        """A further round of the tick's exchange after :meth:`retry`, for a driver of a lossy network: what was lost
+        is made up within the tick rather than costing it.
+
+        * A robot that stayed because of peers (its decision's conflicts) and has
+          heard a state from one of them since it decided decides again (a lost
+          state, made up by a pull's answer or a repeat, no longer costs it the tick).
+        * A robot still waiting for its peers' progress asks them again: its state
+          goes to its policy's :func:`~mrmp.policies.base.listeners`, and a peer
+          that owes it its state answers within the round.
+        * A committed robot hands its Present off once more (a lost handoff no
+          longer costs a follower the tick).
+        * A claim still short of its majority goes again to the replicas that have
+          not granted it, and a release to those that have not acknowledged it,
+          when the retry interval has passed.
+
+        Every message of such a round is one the robot could send at any time
+        (a state, a claim, a duplicate of a handoff), so the safety layer's
+        argument is unchanged (``docs/protocol.md``, "More rounds on a lossy network").
+        """
+        self.now = now
+        if not self.guarded:
+            return []
+        self._answered.clear()
+        sends: list[Outgoing] = []
+        stayed = not self.moving and self.wanted is None and self.safety.pending is None
+        decision = self.last_decision
+        if stayed and decision is not None and not self._heard_since_decision.isdisjoint(decision.conflicts):
+            sends.extend(self.decide(now))
+        if not self.moving and self.wanted is None and self.safety.pending is None:
+            waited_for = tuple(listeners(self.policy))
+            if waited_for:
+                sends.append(Outgoing(self.state_message(), waited_for))
+        pending = self.safety.pending
+        if pending is not None and pending.committed and not pending.handoff_repeated:
+            pending.handoff_repeated = True
+            sends.extend(Outgoing(self._stamp(message), to) for message, to in self.safety.repeat_handoff())
+        sends.extend(Outgoing(self._stamp(message), recipients) for message, recipients in self.safety.resend_claim(now))
+        sends.extend(Outgoing(self._stamp(message), recipients) for message, recipients in self.safety.releases_due(now))
         return sends
 
     def motion(self, now: float) -> Cell | None:
@@ -399,6 +442,7 @@ class Robot(MessageEndpoint):
         was_near = self._near(sender)
         if not self.belief.update(message, now) and self.state_refresh is not None:
             return []
+        self._heard_since_decision.add(sender)
         if self.state_radius is None:
             return []
         self._heard_since.add(sender)

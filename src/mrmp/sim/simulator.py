@@ -85,6 +85,13 @@ def safety_timers(delay_max: int) -> tuple[int, int]:
     return retry, 3 * (retry + 1) + 1
 
 
+EXTRA_ROUNDS = 6
+"""Rounds of exchange a tick adds, on a network that is not perfect, after its three (:meth:`Robot.exchange_again
+<mrmp.robot.robot.Robot.exchange_again>`): a tick stands for a move, which lasts many message round trips, and in
+these rounds the robots make up within the tick for what was lost (``docs/protocol.md``, "More rounds on a lossy
+network")."""
+
+
 LOSS_LEASE = 2
 """Extra ticks a robot keeps a peer's state on a lossy network: it forgets a peer only after that many more
 heartbeats in a row were lost."""
@@ -201,6 +208,7 @@ class LockstepSimulator:
                     lossy=not (quiet and faults.is_perfect),
                 )
             )
+        self.extra_rounds = 0 if scenario.worst_faults().is_perfect else EXTRA_ROUNDS
         self.bodies = SpatialIndex(starts)
         """Where every body stands: the simulated radio delivers radius broadcasts through it."""
         slowdown = network_slowdown(scenario) if scenario.safety else 1.0
@@ -249,6 +257,10 @@ class LockstepSimulator:
         for robot in robots:
             self._send(robot, robot.retry(tick))
         self._drain()
+        for _ in range(self.extra_rounds):
+            for robot in robots:
+                self._send(robot, robot.exchange_again(tick))
+            self._drain()
         if self.record_decisions:
             self.decisions.append([robot.last_decision for robot in robots])  # type: ignore[misc]
         before = [robot.present for robot in robots]
