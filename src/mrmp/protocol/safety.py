@@ -377,7 +377,7 @@ class SafetyLayer:
             elif now - pending.sent_at >= self.retry_interval and len(pending.votes) < self.quorum:
                 pending.sent_at = now
                 sends.append((ClaimMessage(self.index, 0, pending.number, pending.cell), self.claim_recipients(pending.cell)))
-        sends.extend(self._releases_due(now))
+        sends.extend(self.releases_due(now))
         return sends
 
     @property
@@ -385,10 +385,6 @@ class SafetyLayer:
         """Whether the pending claim is a standing one: refused in an earlier step, kept (``keep_refused``)."""
         pending = self.pending
         return pending is not None and pending.standing and not pending.committed
-
-    def releases_due(self, now: float) -> list[Send]:
-        """The releases due now (a claim just given up, or one to send again), without running the claim's timers."""
-        return self._releases_due(now)
 
     def resend_claim(self, now: float) -> list[Send]:
         """Send the pending claim again to the replicas that have not granted it, if it is due for a resend.
@@ -439,7 +435,8 @@ class SafetyLayer:
             self._releases[(cell, claim)] = _Release(claim, cell, waiting)
             self.stats.releases += 1
 
-    def _releases_due(self, now: float) -> list[Send]:
+    def releases_due(self, now: float) -> list[Send]:
+        """The releases due now (a claim just given up, or one to send again), without running the claim's timers."""
         sends: list[Send] = []
         for key, release in list(self._releases.items()):
             if now - release.sent_at < self.retry_interval:
@@ -521,18 +518,15 @@ class SafetyLayer:
             return []
         pending.committed = True
         self.present_handed_off = True
-        sends: list[Send] = []
-        recipients = self.claim_recipients(self.present)
-        if recipients:
-            sends.append((HandoffMessage(self.index, 0, self.present_claim, self.present), recipients))
+        sends = self._handoff()
         if self.index in self.replicas_of(self.present):
             sends.extend(self._grant_deferred(self.present))
         return sends
 
     def repeat_handoff(self) -> list[Send]:
-        """The handoff of the Present once more, while the pending claim is committed (lockstep model): for a
-        driver of a lossy network, so that a lost handoff does not cost a follower its tick. A replica takes a
-        second copy as it takes a duplicate (it names the same record), so the argument is unchanged.
+        """The handoff of the Present once more, once per committed claim (lockstep model): for a driver of a
+        lossy network, so that a lost handoff does not cost a follower its tick. A replica takes a second copy
+        as it takes a duplicate (it names the same record), so the argument is unchanged.
 
         >>> a = SafetyLayer(0, [(0, 0), (0, 1), (0, 2)], following=True)
         >>> a.repeat_handoff()   # nothing committed
@@ -543,10 +537,17 @@ class SafetyLayer:
         >>> _ = a.handle_reply(ReplyMessage(1, 0, 0, claim.claim, (1, 0), True), now=0)   # its majority: committed
         >>> [(type(message).__name__, message.cell, to) for message, to in a.repeat_handoff()]
         [('HandoffMessage', (0, 0), (1, 2))]
+        >>> a.repeat_handoff()   # once only
+        []
         """
         pending = self.pending
-        if not self.following or pending is None or not pending.committed:
+        if not self.following or pending is None or not pending.committed or pending.handoff_repeated:
             return []
+        pending.handoff_repeated = True
+        return self._handoff()
+
+    def _handoff(self) -> list[Send]:
+        """The handoff of the Present to its other replicas (none when this robot is its only replica)."""
         recipients = self.claim_recipients(self.present)
         return [(HandoffMessage(self.index, 0, self.present_claim, self.present), recipients)] if recipients else []
 

@@ -29,6 +29,7 @@ copy of an old state is still refused) and the peer's progress, which only grows
 
 from __future__ import annotations
 
+from mrmp.core.cell import manhattan
 from mrmp.policies.base import PeerState
 from mrmp.protocol.messages import StateMessage
 
@@ -79,10 +80,7 @@ class Belief:
         >>> belief.forget_beyond((0, 0), 2), sorted(belief.peers)
         ([1], [2])
         """
-        x, y = cell
-        gone = [
-            index for index, peer in self.peers.items() if abs(peer.present[0] - x) + abs(peer.present[1] - y) > radius
-        ]
+        gone = [index for index, peer in self.peers.items() if manhattan(peer.present, cell) > radius]
         for index in gone:
             del self.peers[index]
         return gone

@@ -388,7 +388,7 @@ class CausalRobot(MessageEndpoint):
 
     def _safety_sends(self, now: float) -> list[Outgoing]:
         """The safety layer's messages due now (releases of the cells left, claims to resend), stamped."""
-        return [Outgoing(self._stamp(message), recipients) for message, recipients in self.safety.expire(now)]
+        return self._stamped(self.safety.expire(now))
 
     def _give_up_head(self) -> list[Outgoing]:
         """Extended into a cell the registries keep refusing: contract again on the tail."""

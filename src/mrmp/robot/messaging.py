@@ -31,7 +31,7 @@ Examples
 from __future__ import annotations
 
 from collections import Counter
-from collections.abc import Callable
+from collections.abc import Callable, Iterable
 from typing import Any, NamedTuple, TypeVar
 
 from mrmp.core.cell import Cell
@@ -118,6 +118,10 @@ class MessageEndpoint:
         """``message`` with this robot's next sequence number."""
         self.seq += 1
         return message.with_seq(self.seq)
+
+    def _stamped(self, sends: Iterable[tuple[Message, tuple[int, ...]]]) -> list[Outgoing]:
+        """The safety layer's ``(message, recipients)`` pairs, each message with this robot's next sequence number."""
+        return [Outgoing(self._stamp(message), recipients) for message, recipients in sends]
 
     def _state(self, present: Cell, next: Cell, heading: Heading, arrived: bool, progress: int = 0) -> StateMessage:
         """A fresh state message with the next sequence number and the safety layer's state."""

@@ -47,7 +47,7 @@ from collections import Counter
 from collections.abc import Sequence
 from dataclasses import replace
 
-from mrmp.core.cell import Cell
+from mrmp.core.cell import Cell, manhattan
 from mrmp.core.grid import Grid
 from mrmp.core.heading import Heading
 from mrmp.core.scenario import RobotSpec
@@ -286,12 +286,11 @@ class Robot(MessageEndpoint):
             self._behind = {}
             return [Outgoing(message, tuple(named))]
         behind, self._behind = self._behind, {}
-        x, y = self.present
         radius = self.state_radius
         named.extend(
             peer
-            for peer, (px, py) in behind.items()
-            if abs(px - x) + abs(py - y) >= radius and peer not in named and radius > 0
+            for peer, cell in behind.items()
+            if manhattan(cell, self.present) >= radius and peer not in named and radius > 0
         )
         self._sent, self._sent_at = fingerprint, now
         return [Outgoing(message, tuple(named), radius)]
@@ -317,7 +316,7 @@ class Robot(MessageEndpoint):
         sends: list[Outgoing] = []
         if standing is not None:
             given_up = self.safety.give_up_claim()  # another decision: its release goes now, before this step's claims
-            sends = [Outgoing(self._stamp(message), to) for message, to in [*self.safety.releases_due(now), *given_up]]
+            sends = self._stamped([*self.safety.releases_due(now), *given_up])
         if self.wanted is None or not self.guarded:
             return sends
         claim = self.safety.start_claim(self.wanted, now)
@@ -346,7 +345,7 @@ class Robot(MessageEndpoint):
             waiting = tuple(index for index, peer in self.belief.peers.items() if peer.next in cells)
             if waiting:
                 sends.append(Outgoing(self.state_message(), waiting))
-        sends.extend(Outgoing(self._stamp(message), recipients) for message, recipients in self.safety.resend_claim(now))
+        sends.extend(self._stamped(self.safety.resend_claim(now)))
         return sends
 
     def exchange_again(self, now: float) -> list[Outgoing]:
@@ -374,21 +373,22 @@ class Robot(MessageEndpoint):
             return []
         self._answered.clear()
         sends: list[Outgoing] = []
-        stayed = not self.moving and self.wanted is None and self.safety.pending is None
         decision = self.last_decision
-        if stayed and decision is not None and not self._heard_since_decision.isdisjoint(decision.conflicts):
+        if self._staying and decision is not None and not self._heard_since_decision.isdisjoint(decision.conflicts):
             sends.extend(self.decide(now))
-        if not self.moving and self.wanted is None and self.safety.pending is None:
+        if self._staying:
             waited_for = tuple(listeners(self.policy))
             if waited_for:
                 sends.append(Outgoing(self.state_message(), waited_for))
-        pending = self.safety.pending
-        if pending is not None and pending.committed and not pending.handoff_repeated:
-            pending.handoff_repeated = True
-            sends.extend(Outgoing(self._stamp(message), to) for message, to in self.safety.repeat_handoff())
-        sends.extend(Outgoing(self._stamp(message), recipients) for message, recipients in self.safety.resend_claim(now))
-        sends.extend(Outgoing(self._stamp(message), recipients) for message, recipients in self.safety.releases_due(now))
+        sends.extend(self._stamped(self.safety.repeat_handoff()))
+        sends.extend(self._stamped(self.safety.resend_claim(now)))
+        sends.extend(self._stamped(self.safety.releases_due(now)))
         return sends
+
+    @property
+    def _staying(self) -> bool:
+        """Whether the robot stays this tick: not moving, no cell wanted, no claim pending."""
+        return not self.moving and self.wanted is None and self.safety.pending is None
 
     def motion(self, now: float) -> Cell | None:
         """The cell the body may start entering now, if any; the robot then counts as moving."""
@@ -421,7 +421,7 @@ class Robot(MessageEndpoint):
         sends = self.safety.expire(now)
         if self.safety.pending is None and not self.moving:
             self.wanted = None
-        return [Outgoing(self._stamp(message), recipients) for message, recipients in sends]
+        return self._stamped(sends)
 
     # -- messages in ----------------------------------------------------------------------
 
@@ -467,7 +467,7 @@ class Robot(MessageEndpoint):
         known = self.belief.peers.get(peer)
         if known is None:
             return False
-        return abs(known.present[0] - self.present[0]) + abs(known.present[1] - self.present[1]) <= self.state_radius
+        return manhattan(known.present, self.present) <= self.state_radius
 
     @handlers.on(ClaimMessage)
     def _take_claim(self, message: ClaimMessage, now: float) -> list[Outgoing]:
@@ -477,18 +477,18 @@ class Robot(MessageEndpoint):
     @handlers.on(ReplyMessage)
     def _take_reply(self, message: ReplyMessage, now: float) -> list[Outgoing]:
         sends = self.safety.handle_reply(message, now)
-        return [Outgoing(self._stamp(sent), recipients) for sent, recipients in sends]
+        return self._stamped(sends)
 
     @handlers.on(HandoffMessage)
     def _take_handoff(self, message: HandoffMessage, now: float) -> list[Outgoing]:
         sends = self.safety.handle_handoff(message)
-        return [Outgoing(self._stamp(sent), recipients) for sent, recipients in sends]
+        return self._stamped(sends)
 
     @handlers.on(ReleaseMessage)
     def _take_release(self, message: ReleaseMessage, now: float) -> list[Outgoing]:
         answers = self._answer_release(message)
         granted = self.safety.take_granted_on_release()
-        return [*answers, *(Outgoing(self._stamp(sent), recipients) for sent, recipients in granted)]
+        return [*answers, *self._stamped(granted)]
 
     @handlers.on(ReleaseAckMessage)
     def _take_release_ack(self, message: ReleaseAckMessage, now: float) -> list[Outgoing]:

@@ -185,11 +185,11 @@ class LockstepSimulator:
         self.scenario = scenario
         grid = scenario.grid
         starts = [spec.start for spec in scenario.robots]
-        retry, timeout = safety_timers(scenario.worst_faults().delay_max)
+        faults = scenario.worst_faults()
+        retry, timeout = safety_timers(faults.delay_max)
         self.robots = []
         for index, spec in enumerate(scenario.robots):
             policy = policies[index] if policies is not None else make_policy(scenario.policy, scenario.timing)
-            faults = scenario.worst_faults()
             state_radius, lease = neighbourhood(policy, faults)
             self.robots.append(
                 Robot(
@@ -208,11 +208,11 @@ class LockstepSimulator:
                     lossy=not (quiet and faults.is_perfect),
                 )
             )
-        self.extra_rounds = 0 if scenario.worst_faults().is_perfect else EXTRA_ROUNDS
+        self.extra_rounds = 0 if faults.is_perfect else EXTRA_ROUNDS
         self.bodies = SpatialIndex(starts)
         """Where every body stands: the simulated radio delivers radius broadcasts through it."""
         slowdown = network_slowdown(scenario) if scenario.safety else 1.0
-        per_round_trip = slowdown / (2 * scenario.worst_faults().delay_max + 1)
+        per_round_trip = slowdown / (2 * faults.delay_max + 1)
         self.recurrence_limit = int((RECURRENCE_LIMIT + 2 * timeout) * max(1.0, per_round_trip))
         self.network = scenario_network(scenario)
         self.referee = Referee(grid, [spec.id for spec in scenario.robots])
