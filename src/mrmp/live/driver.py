@@ -327,7 +327,7 @@ class LiveDriver:
         body = self.body
         if not body.moving:
             return math.inf
-        event = getattr(body, "next_event", lambda: None)()
+        event = body.next_event()
         return self.clock() + SENSOR_POLL if event is None else event
 
     def _timers_idle(self) -> bool:
@@ -503,15 +503,19 @@ class LiveDriver:
             newly_heard = tuple(sorted(set(unheard) - set(still_unheard)))
             unheard = still_unheard
             if newly_heard and now - last_fleet_state < self.timing.fleet_heartbeat:  # answered at once
-                self._send([item._replace(recipients=newly_heard, radius=None) for item in self._fleet_wait_messages()])
+                self._send(self._fleet_wait_to(newly_heard))
             if now - last_fleet_state >= self.timing.fleet_heartbeat:
                 self._send(fleet_wide(self._fleet_wait_messages()))
                 last_state = last_fleet_state = now
             elif now - last_state >= self.timing.heartbeat and unheard:
-                self._send([item._replace(recipients=unheard, radius=None) for item in self._fleet_wait_messages()])
+                self._send(self._fleet_wait_to(unheard))
                 last_state = now
             next_state = min(last_state + self.timing.heartbeat, last_fleet_state + self.timing.fleet_heartbeat)
             self._sleep(min(next_state, deadline), timers=False)  # no brain timers run before the start
+
+    def _fleet_wait_to(self, peers: tuple[int, ...]) -> list[Outgoing]:
+        """The fleet-wait state addressed to ``peers`` only."""
+        return [item._replace(recipients=peers, radius=None) for item in self._fleet_wait_messages()]
 
     def _unheard_peers(self) -> tuple[int, ...]:
         """The peers not heard from yet."""

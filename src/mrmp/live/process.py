@@ -10,7 +10,6 @@ them ends, however it ends (:mod:`mrmp.io.lifetime`).
 from __future__ import annotations
 
 import contextlib
-import cProfile
 import os
 import signal
 import sys
@@ -273,6 +272,8 @@ def profiled(path: Path, environment: Mapping[str, str] = os.environ) -> Iterato
     if not environment.get(PROFILE_VARIABLE):
         yield
         return
+    import cProfile  # only when profiling: a robot process starts without it
+
     profile = cProfile.Profile(time.thread_time)
     profile.enable()
     try:

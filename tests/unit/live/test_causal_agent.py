@@ -33,6 +33,9 @@ class OneSecondBody:
     def start_move(self, target, now):
         self.target, self.ends_at, self.moving = target, now + 1.0, True
 
+    def next_event(self):
+        return self.ends_at if self.moving else float("inf")
+
     def poll(self, now):
         if self.moving and now >= self.ends_at:
             self.cell, self.moving = self.target, False
