@@ -5,8 +5,14 @@ LaCAM, executes the plan live over UDP with ``--loss`` message loss at
 ``--time-scale`` times the robots' speed (optionally killing robots: ``--kill
 ID@SECONDS``), and prints, per time scale: robots arrived, collisions, the wall
 makespan against the plan's makespan in seconds at that speed (plan ticks x cell
-time / time scale; bodies also spend time turning, which the plan does not
-count), moves, and messages per move (datagram-recipients, heartbeats included).
+time / time scale), the plan's execution bound at that speed and the wall makespan
+against it, moves, and messages per move (datagram-recipients, heartbeats included).
+
+The execution bound (:func:`mrmp.centralized.body_time.execution_seconds`) is the
+soonest live bodies can carry the plan out, whatever messages cost: they turn right
+only, which the plan's ticks do not count, and cover both cells while they move, so a
+robot that follows another into a cell it leaves in the same tick starts once the
+other has arrived. It is what the messages are measured against.
 
 Usage: python bench/live_plan.py [--agents 100] [--time-scales 2,5] [--loss 0.1] [--kill 3@2]
 """
@@ -18,6 +24,7 @@ import sys
 import tempfile
 from pathlib import Path
 
+from mrmp.centralized.body_time import execution_seconds
 from mrmp.centralized.registry import plan_with
 from mrmp.io import load_movingai_scenario
 from mrmp.live.launcher import LiveOptions, run_live
@@ -44,7 +51,8 @@ def main() -> int:
     print(f"{scenario.name}: {arguments.agents} robots, plan makespan {plan.makespan()} ticks,", end=" ")
     print(f"loss {arguments.loss}, kill {kill}")
     print(
-        f"{'scale':>5} {'arrived':>8} {'coll':>4} {'wall s':>7} {'plan s':>7} {'ratio':>6} {'moves':>6}"
+        f"{'scale':>5} {'arrived':>8} {'coll':>4} {'wall s':>7} {'plan s':>7} {'ratio':>6} {'bound s':>7} {'/bound':>6}"
+        f" {'moves':>6}"
         f" {'messages':>9} {'msg/move':>8}  stop"
     )
     for scale in [float(text) for text in arguments.time_scales.split(",")]:
@@ -54,9 +62,11 @@ def main() -> int:
         arrived = sum(robot.arrived for robot in result.robots)
         moves = max(1, result.network.get("moves", 0))
         planned = plan.makespan() * scenario.timing.cell_time / scale
+        bound = execution_seconds(plan.paths, [robot.heading for robot in scenario.robots], scenario.timing, scale)
         print(
             f"{scale:>5g} {arrived:>4}/{len(result.robots):<3} {len(result.collisions):>4} {result.time_makespan_s:>7.2f}"
-            f" {planned:>7.2f} {result.time_makespan_s / planned:>6.2f} {moves:>6} {result.messages:>9}"
+            f" {planned:>7.2f} {result.time_makespan_s / planned:>6.2f} {bound:>7.2f} {result.time_makespan_s / bound:>6.2f}"
+            f" {moves:>6} {result.messages:>9}"
             f" {result.messages / moves:>8.1f}  {result.stop_reason}",
             flush=True,
         )

@@ -20,6 +20,13 @@ clock:
   (:mod:`mrmp.live.driver`; a policy without an interaction radius, every time);
 * run the safety layer's timers (resend or abandon a claim).
 
+A robot whose policy reads no peer's cells (interaction radius 0: a robot
+following a plan, which waits only for its peers' progress) has nothing to
+listen for: it decides at once after announcing, and the pause after a decision
+to stay (it waits for a peer's move) ends as soon as a message comes, rather than
+after ``listen_time``, so that it starts the move as soon as it hears that it may.
+The pause after a refused claim keeps its random length (it breaks symmetry).
+
 Before its first step a robot waits (at most ``start_wait`` seconds) until it
 has heard from every peer, so that a fleet whose processes start one by one
 begins together; its clock starts then.
@@ -111,6 +118,8 @@ class Agent(LiveDriver):
         self._decided_at = 0.0
         self._said: tuple[object, ...] | None = None
         self._said_at = 0.0
+        self._stayed = False
+        """This pause follows a decision to stay, by a robot that listens for nothing: news ends it."""
 
     # -- what the driver reads of the brain --------------------------------------------------
 
@@ -154,8 +163,19 @@ class Agent(LiveDriver):
         self._send(outgoing)
         return True
 
+    def _listen_time(self) -> float:
+        """How long to listen before deciding: ``listen_time``, or 0 for a policy that reads no peer's cells."""
+        return 0.0 if interaction_radius(self.robot.policy) == 0 else self.timing.listen_time
+
+    def _drain_inbox(self, now: float) -> None:
+        """Hand the brain its messages; a robot that listens for nothing ends its pause on news (module docstring)."""
+        received = self.report.messages_received
+        super()._drain_inbox(now)
+        if self._phase is Phase.PAUSE and self._stayed and self.report.messages_received > received:
+            self._next_decision = min(self._next_decision, now)
+
     def _begin(self, started: float) -> None:
-        self._phase, self._next_decision, self._decided_at = Phase.LISTEN, started + self.timing.listen_time, started
+        self._phase, self._next_decision, self._decided_at = Phase.LISTEN, started + self._listen_time(), started
 
     def _timers_idle(self) -> bool:
         """No claim pending and no release unacknowledged: the safety layer's timers have nothing to do."""
@@ -182,7 +202,7 @@ class Agent(LiveDriver):
                 self._send(robot.announce(now))
                 self._said, self._said_at = (robot.present, robot.intended, robot.heading, robot.arrived, robot.progress), now
                 sent_state = True
-                self._phase, self._next_decision = Phase.LISTEN, now + timing.listen_time
+                self._phase, self._next_decision = Phase.LISTEN, now + self._listen_time()
         elif self._phase is Phase.LISTEN and now >= self._next_decision:
             self._send(robot.decide(now))
             self._phase, self._decided_at = Phase.CLAIM, now
@@ -195,7 +215,9 @@ class Agent(LiveDriver):
             elif robot.wanted is None and robot.safety.pending is None:
                 pause = timing.heartbeat if robot.arrived else timing.listen_time * (1 + self.random.random())
                 self._phase, self._next_decision = Phase.PAUSE, now + pause
+                decision = robot.last_decision
+                self._stayed = self._listen_time() == 0 and decision is not None and decision.next == robot.present
         if self._phase is Phase.PAUSE and now >= self._next_decision:
             sent_state = self._announce_if_new(now)
-            self._phase, self._next_decision = Phase.LISTEN, now + timing.listen_time
+            self._phase, self._next_decision = Phase.LISTEN, now + self._listen_time()
         return sent_state

@@ -89,10 +89,14 @@ LIVE_SLACK = 2
 def live_state_radius(interaction: int) -> int:
     """The radius (cells) of a live robot's states: its interaction radius plus :data:`LIVE_SLACK`.
 
-    >>> live_state_radius(2)
-    4
+    A policy whose decisions read no peer's cells (radius 0: a robot following a
+    plan, which hears by name from the robots it waits for) gets no slack: its
+    states go to the peers it names and to nobody by radius.
+
+    >>> live_state_radius(2), live_state_radius(0)
+    (4, 0)
     """
-    return interaction + LIVE_SLACK
+    return interaction + LIVE_SLACK if interaction > 0 else 0
 
 
 def believed_near(
@@ -396,7 +400,7 @@ class LiveDriver:
         report, client = self.report, self._client
         for item in outgoing:
             data = self.sealer.seal(item.message)
-            if item.radius is not None:
+            if item.radius:  # a radius of 0 reaches no peer but those named
                 near = self._believed_within(item.radius)
                 item = item._replace(recipients=(*near, *(peer for peer in item.recipients or () if peer not in near)))
             if item.recipients is None:
@@ -548,9 +552,9 @@ class LiveDriver:
         return True
 
     def _peer_state(self, index: int, now: float) -> str:
-        """``"done"`` (arrived, heard lately), ``"silent"`` (not heard for ``give_up_after``) or ``"running"``."""
+        """``"done"`` (arrived, heard within ``give_up_after``), ``"silent"`` (not heard that long) or ``"running"``."""
         news = self._peer_news(index)
-        if news is not None and news[1] and news[0] >= now - 2 * self.timing.silence_timeout:
+        if news is not None and news[1] and news[0] >= now - self.timing.give_up_after:
             return "done"
         if news is None or news[0] < now - self.timing.give_up_after:
             return "silent"

@@ -85,13 +85,38 @@ they start (each imports Python modules for a good part of a CPU second), so the
 the first; a first robot that started without the last would take it for crashed."""
 
 
-def fleet_timing(timing: AgentTiming, robots: int) -> AgentTiming:
-    """``timing`` with a start wait of at least :data:`START_WAIT_PER_ROBOT` seconds per robot of a fleet of ``robots``.
+FLEET_STATES_PER_SECOND = 20.0
+"""At most this many fleet-heartbeat datagrams a robot sends a second, whatever the fleet's size (and so at most
+this many it receives): a fleet of more than this many robots and one spaces its fleet heartbeats further apart
+(:func:`fleet_timing`). Sent to every peer once a second, they would cost each of ``N`` processes ``N - 1``
+datagrams to receive a second, ``N**2`` in all: at 100 robot processes they alone filled two cores."""
 
-    >>> fleet_timing(AgentTiming(), 8).start_wait, fleet_timing(AgentTiming(), 100).start_wait
-    (15.0, 50.0)
+
+def fleet_timing(timing: AgentTiming, robots: int) -> AgentTiming:
+    """``timing`` fitted to a fleet of ``robots``: its start wait, fleet heartbeat and silences.
+
+    * The start wait is at least :data:`START_WAIT_PER_ROBOT` seconds per robot.
+    * The fleet heartbeat comes at most :data:`FLEET_STATES_PER_SECOND` times ``robots - 1`` a
+      second: its period is at least ``(robots - 1) / FLEET_STATES_PER_SECOND`` seconds.
+    * ``give_up_after`` (a peer silent that long is given up on; news older than that of a
+      peer's arrival is too old to end the run on) stretches with the period, so that it
+      still spans as many fleet heartbeats: a far peer is heard only by them.
+
+    >>> small, large = fleet_timing(AgentTiming(), 8), fleet_timing(AgentTiming(), 101)
+    >>> small.start_wait, small.fleet_heartbeat, small.give_up_after
+    (15.0, 1.0, 3.0)
+    >>> large.start_wait, large.fleet_heartbeat, large.give_up_after
+    (50.5, 5.0, 15.0)
     """
-    return replace(timing, start_wait=max(timing.start_wait, START_WAIT_PER_ROBOT * robots))
+    period = max(timing.fleet_heartbeat, (robots - 1) / FLEET_STATES_PER_SECOND)
+    stretch = period / timing.fleet_heartbeat
+    return replace(
+        timing,
+        start_wait=max(timing.start_wait, START_WAIT_PER_ROBOT * robots),
+        fleet_heartbeat=period,
+        silence_timeout=timing.silence_timeout * stretch,
+        give_up_after=timing.give_up_after * stretch,
+    )
 
 
 def stop_on_signals() -> threading.Event:
