@@ -118,8 +118,6 @@ class Agent(LiveDriver):
         self._decided_at = 0.0
         self._said: tuple[object, ...] | None = None
         self._said_at = 0.0
-        self._stayed = False
-        """This pause follows a decision to stay, by a robot that listens for nothing: news ends it."""
 
     # -- what the driver reads of the brain --------------------------------------------------
 
@@ -171,8 +169,18 @@ class Agent(LiveDriver):
         """Hand the brain its messages; a robot that listens for nothing ends its pause on news (module docstring)."""
         received = self.report.messages_received
         super()._drain_inbox(now)
-        if self._phase is Phase.PAUSE and self._stayed and self.report.messages_received > received:
+        if self.report.messages_received > received and self._waits_for_news():
             self._next_decision = min(self._next_decision, now)
+
+    def _waits_for_news(self) -> bool:
+        """Pausing after a decision to stay, as a robot that listens for nothing: news ends the pause."""
+        decision = self.robot.last_decision
+        return (
+            self._phase is Phase.PAUSE
+            and decision is not None
+            and decision.next == self.robot.present
+            and self._listen_time() == 0
+        )
 
     def _begin(self, started: float) -> None:
         self._phase, self._next_decision, self._decided_at = Phase.LISTEN, started + self._listen_time(), started
@@ -215,8 +223,6 @@ class Agent(LiveDriver):
             elif robot.wanted is None and robot.safety.pending is None:
                 pause = timing.heartbeat if robot.arrived else timing.listen_time * (1 + self.random.random())
                 self._phase, self._next_decision = Phase.PAUSE, now + pause
-                decision = robot.last_decision
-                self._stayed = self._listen_time() == 0 and decision is not None and decision.next == robot.present
         if self._phase is Phase.PAUSE and now >= self._next_decision:
             sent_state = self._announce_if_new(now)
             self._phase, self._next_decision = Phase.LISTEN, now + self._listen_time()

@@ -98,15 +98,16 @@ def fleet_timing(timing: AgentTiming, robots: int) -> AgentTiming:
     * The start wait is at least :data:`START_WAIT_PER_ROBOT` seconds per robot.
     * The fleet heartbeat comes at most :data:`FLEET_STATES_PER_SECOND` times ``robots - 1`` a
       second: its period is at least ``(robots - 1) / FLEET_STATES_PER_SECOND`` seconds.
-    * ``give_up_after`` (a peer silent that long is given up on; news older than that of a
-      peer's arrival is too old to end the run on) stretches with the period, so that it
-      still spans as many fleet heartbeats: a far peer is heard only by them.
+    * ``silence_timeout`` (a peer silent that long stands still for its peers' policies) and
+      ``give_up_after`` (a peer silent that long is given up on; news older than that of a
+      peer's arrival is too old to end the run on) stretch with the period, so that they
+      still span as many fleet heartbeats: a far peer is heard only by them.
 
     >>> small, large = fleet_timing(AgentTiming(), 8), fleet_timing(AgentTiming(), 101)
     >>> small.start_wait, small.fleet_heartbeat, small.give_up_after
     (15.0, 1.0, 3.0)
-    >>> large.start_wait, large.fleet_heartbeat, large.give_up_after
-    (50.5, 5.0, 15.0)
+    >>> large.start_wait, large.fleet_heartbeat, large.silence_timeout, large.give_up_after
+    (50.5, 5.0, 7.5, 15.0)
     """
     period = max(timing.fleet_heartbeat, (robots - 1) / FLEET_STATES_PER_SECOND)
     stretch = period / timing.fleet_heartbeat

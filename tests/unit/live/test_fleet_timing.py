@@ -64,9 +64,8 @@ class _Silent:
 
 def hear_everyone(robot: Agent, now: float) -> None:
     """Robot 0 hears every peer's state, each from its own cell, at ``now``."""
-    for index in range(1, len(robot.scenario.robots)):
-        peer = Agent(robot.scenario, index, _Silent(), robot.body, Sealer(KEY, 1), Opener(KEY, 1))
-        robot.robot.receive(peer.robot.state_message(), now)
+    for index, spec in enumerate(robot.scenario.robots[1:], start=1):
+        robot.robot.receive(StateMessage(index, 1, spec.start, spec.start, spec.heading, True), now)
 
 
 def test_a_robot_following_a_plan_sends_its_state_only_to_the_peers_it_names():
