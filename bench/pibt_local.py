@@ -6,8 +6,9 @@ driver (:class:`mrmp.sim.rounds.RoundsSimulator`) and with local sequencing
 (:class:`mrmp.sim.local_rounds.LocalRoundsSimulator`). One line each:
 
 * success, SoC/LB, makespan;
-* ms/step: wall time per step (a ratio of the two lines is what to read: both
-  ran in the same process, one after the other);
+* ms/step: wall time per step (the distance tables are computed before it; a
+  ratio of the two lines is what to read: both ran in the same process, one
+  after the other);
 * rounds/step and msg/robot/step (messages, one per recipient);
 * for local sequencing, the robots' own counts per robot and step: rounds
   waited before starting, reservations withdrawn, requests refused, cells
@@ -29,7 +30,7 @@ runs one order only.
 
 Usage: python bench/pibt_local.py [--maps DIR] [--only random-32-32-20:100,empty-32-32:400 | --scale] [--limit TICKS]
        [--radius R] [--loss P] [--duplicate P] [--delay-max TICKS] [--reach-cap R] [--stall-slack S]
-       [--order driver|local]
+       [--driver-radius R] [--order driver|local]
 """
 
 from __future__ import annotations
@@ -71,7 +72,10 @@ def main() -> int:
     parser.add_argument("--maps", type=Path, default=ROOT / "maps", help="folder of .map and .scen files")
     parser.add_argument("--only", default=",".join(CASES), help="comma-separated MAP:N cases")
     parser.add_argument("--limit", type=int, default=0, help="stop every run after this many ticks (0: no limit)")
-    parser.add_argument("--radius", type=int, default=2, help="beacon radius (local sequencing waits that far)")
+    parser.add_argument(
+        "--radius", type=int, default=PolicyOptions(name="pibt").radius, help="beacon radius (local sequencing waits that far)"
+    )
+    parser.add_argument("--driver-radius", type=int, default=2, help="the sequenced driver's beacon radius (it decides alike)")
     parser.add_argument("--loss", type=float, default=0.0, help="loss probability of every datagram")
     parser.add_argument("--duplicate", type=float, default=0.0, help="duplication probability of every datagram")
     parser.add_argument("--delay-max", type=int, default=0, help="largest delay of a datagram, in ticks")
@@ -98,14 +102,14 @@ def main() -> int:
         agents = len(scenario.robots)
         case = f"{name}:{agents}"
         scenario = scenario.with_changes(
-            policy=PolicyOptions(name="pibt", radius=arguments.radius),
             seed=scenario.seed if arguments.scale else 0,
             network=NetworkFaults(loss=arguments.loss, duplicate=arguments.duplicate, delay_max=arguments.delay_max),
         )
         if arguments.limit:
             scenario = scenario.with_changes(max_ticks=arguments.limit)
         for label, simulator in simulators:
-            result = simulator(scenario).run()
+            radius = arguments.driver_radius if label == "driver" else arguments.radius
+            result = simulator(scenario.with_changes(policy=PolicyOptions(name="pibt", radius=radius, sequencing=label))).run()
             if result.collisions:
                 raise SystemExit(f"{case} {label}: the referee found collisions: {result.collisions[:3]}")
             network = result.network

@@ -2,8 +2,9 @@
 
 For each map and N, the first N agents of each of the map's ``.scen`` files
 (``-random-*.scen`` next to the map; maps without one get seeded random
-instances) run with policy ``pibt`` in the synchronous-round simulator, and
-the thesis scenarios run too. One line per (map, N), printed as soon as it is
+instances) run with policy ``pibt`` in the synchronous-round simulator of its
+order of calls (``--sequencing``: ``local``, the default, the robots order
+them; ``driver``, the simulator does), and the thesis scenarios run too. One line per (map, N), printed as soon as it is
 measured:
 
 * success: share of instances where every robot stood on its goal together;
@@ -20,6 +21,7 @@ Every line is also appended to ``--out`` (JSON lines) as it is measured.
 default 1), so "inst" counts instances times seeds.
 
 Usage: python bench/pibt_scale.py [--maps DIR] [--only random-32-32-20,empty-32-32] [--seeds K] [--out FILE]
+       [--sequencing local|driver] [--radius R]
 """
 
 from __future__ import annotations
@@ -34,7 +36,7 @@ from mrmp.core import PolicyOptions, Scenario
 from mrmp.core.map_generators import random_instance as seeded_instance
 from mrmp.io import load_movingai_scenario, load_scenario
 from mrmp.io.movingai import read_map
-from mrmp.sim.rounds import RoundsSimulator
+from mrmp.sim.policy_table import pibt_simulator
 
 ROOT = Path(__file__).resolve().parents[1]
 AGENTS = {
@@ -83,11 +85,14 @@ def instances(maps: Path, name: str, agents: int) -> list[Scenario]:
     return [random_instance(map_path, agents, instance) for instance in range(RANDOM_INSTANCES)]
 
 
-def measure(label: str, agents: int, scenarios: list[Scenario], out: Path | None, seeds: int = 1) -> None:
+def measure(
+    label: str, agents: int, scenarios: list[Scenario], out: Path | None, seeds: int = 1, policy: PolicyOptions | None = None
+) -> None:
     runs = []
+    policy = policy or PolicyOptions(name="pibt")
     for scenario, offset in ((scenario, offset) for scenario in scenarios for offset in range(seeds)):
-        run = scenario.with_changes(policy=PolicyOptions(name="pibt"), seed=scenario.seed + offset)
-        result = RoundsSimulator(run).run()
+        run = scenario.with_changes(policy=policy, seed=scenario.seed + offset)
+        result = pibt_simulator(run).run()
         if result.collisions:
             raise SystemExit(f"{label} N={agents}: the referee found collisions: {result.collisions[:3]}")
         steps = max(1, result.network["steps"])
@@ -113,6 +118,8 @@ def measure(label: str, agents: int, scenarios: list[Scenario], out: Path | None
         "table_ms": mean(run["table_ms"] for run in runs),
         "messages_per_robot_step": mean(run["messages_per_robot_step"] for run in runs),
         "lacam_cpp_soc_lb": LACAM_CPP.get((label, agents)),
+        "sequencing": policy.sequencing,
+        "radius": policy.radius,
     }
     quality = f"{row['soc_lb']:.3f}" if row["soc_lb"] is not None else "-"
     makespan = f"{row['makespan']:.0f}" if row["makespan"] is not None else "-"
@@ -133,9 +140,13 @@ def main() -> int:
     parser.add_argument("--only", default="", help="comma-separated map names (default: all)")
     parser.add_argument("--out", type=Path, default=None, help="append one JSON line per row to this file")
     parser.add_argument("--seeds", type=int, default=1, help="run every instance with seeds 0 to SEEDS-1")
+    default = PolicyOptions(name="pibt")
+    parser.add_argument("--sequencing", choices=("local", "driver"), default=default.sequencing, help="who orders the calls")
+    parser.add_argument("--radius", type=int, default=default.radius, help="the robots' beacon radius")
     arguments = parser.parse_args()
     if arguments.seeds < 1:
         parser.error(f"--seeds must be at least 1, not {arguments.seeds}")
+    policy = PolicyOptions(name="pibt", sequencing=arguments.sequencing, radius=arguments.radius)
     only = {name for name in arguments.only.split(",") if name}
     print(
         f"{'map':<24} {'N':>5} {'inst':>4} {'success':>8} {'SoC/LB':>7} {'makespan':>8}"
@@ -144,12 +155,12 @@ def main() -> int:
     if not only:
         for path in sorted((ROOT / "examples").glob("thesis-*.yaml")):
             scenario = load_scenario(path)
-            measure(path.stem, len(scenario.robots), [scenario], arguments.out, arguments.seeds)
+            measure(path.stem, len(scenario.robots), [scenario], arguments.out, arguments.seeds, policy)
     for name, counts in AGENTS.items():
         if (only and name not in only) or not (arguments.maps / f"{name}.map").exists():
             continue
         for agents in counts:
-            measure(name, agents, instances(arguments.maps, name, agents), arguments.out, arguments.seeds)
+            measure(name, agents, instances(arguments.maps, name, agents), arguments.out, arguments.seeds, policy)
     return 0
 
 

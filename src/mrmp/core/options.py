@@ -170,7 +170,7 @@ def heading_aware_setting() -> Any:
 def radius_setting() -> Any:
     """``radius``: how far a ``pibt`` robot's beacon reaches (cells, Manhattan, 2 to :data:`~mrmp.core.limits.MAX_RADIUS`)."""
     return setting(
-        2, help=f"pibt: how far a robot's beacon reaches, in cells (2 to {MAX_RADIUS}).", yaml_key="radius",
+        3, help=f"pibt: how far a robot's beacon reaches, in cells (2 to {MAX_RADIUS}).", yaml_key="radius",
         flag="--radius", check=_radius_in_bounds,
     )
 
@@ -204,7 +204,7 @@ def _one_of_sequencings(value: object) -> str | None:
 def sequencing_setting() -> Any:
     """``sequencing``: who orders ``pibt``'s calls, ``driver`` (the simulator) or ``local`` (the robots themselves)."""
     return setting(
-        "driver", help="pibt: who orders the robots' calls: driver (the simulator) or local (the robots themselves).",
+        "local", help="pibt: who orders the robots' calls: local (the robots themselves) or driver (the simulator).",
         yaml_key="sequencing", flag="--sequencing", check=_one_of_sequencings, choices=SEQUENCINGS,
     )  # fmt: skip
 

@@ -989,8 +989,8 @@ def _policy_text(policy: PolicyOptions) -> str:
     """The ``policy`` section's items: its name, then every setting by its YAML key.
 
     >>> _policy_text(PolicyOptions())  # doctest: +NORMALIZE_WHITESPACE
-    'name: "thesis", resolve: "divert", heading_aware: false, radius: 2, swap: true, search: "default",
-     sequencing: "driver"'
+    'name: "thesis", resolve: "divert", heading_aware: false, radius: 3, swap: true, search: "default",
+     sequencing: "local"'
     """
     items = [f"name: {_quote(policy.name)}"]
     items += [f"{setting.yaml_key}: {_setting_text(getattr(policy, option.name))}" for option, setting in POLICY_SETTINGS]

@@ -90,6 +90,9 @@ __all__ = ["LocalPibtRobot"]
 Rank = tuple[int, int, int]
 """A priority ``(elapsed, tie, -index)``: larger goes first."""
 
+NO_RANK: Rank = (-1, 0, 0)
+"""Below every robot's priority: the rank of a robot not heard."""
+
 
 class LocalPibtRobot(PibtRobot):
     """One robot's PIBT brain that decides itself when its call starts (module docstring).
@@ -124,11 +127,15 @@ class LocalPibtRobot(PibtRobot):
         self.wake = False
         self._ranks: dict[int, Rank] = {}
         self._near: list[int] = []
+        self._listeners: list[int] = []  # robots within 2 cells (they hear its reservations)
+        self._waiters: list[int] = []  # robots farther away within the radius that it outranks (they may wait for it)
         self._final: set[int] = set()
+        self._above = 0  # robots heard that outrank it and are not known to have decided for good
         self._calls: dict[int, int] = {}  # robot -> root of the call its provisional reservation belongs to
         self._claims: dict[int, Rank] = {}  # robot -> rank of the call of its latest reservation
         self._root = index
         self._rank: Rank = self.priority
+        self._own_rank: Rank = self.priority  # this step's priority, kept: it is compared with every rank heard
         self._confirmed = True
         self._finishing: bool | None = None
         self._lost = False
@@ -149,10 +156,14 @@ class LocalPibtRobot(PibtRobot):
             out = [Outgoing(item.message, None, reach) for item in out]
         self._ranks = {}
         self._near = []
+        self._listeners = []
+        self._waiters = []
         self._final = set()
+        self._above = 0
         self._calls = {}
         self._claims = {}
         self._root, self._rank = self.index, self.priority
+        self._own_rank = self._rank
         self._confirmed, self._finishing, self._lost, self._done = True, None, False, False
         self.wake = True  # evaluate the start rule once the beacons are in
         return out
@@ -173,11 +184,22 @@ class LocalPibtRobot(PibtRobot):
     def receive_beacons(self, beacons: list[BeaconMessage]) -> None:
         """Take in beacons: cells, goals and priorities; note the robots within 2 cells."""
         super().receive_beacons(beacons)
-        ranks, near = self._ranks, self._near
+        ranks, near, listeners, waiters = self._ranks, self._near, self._listeners, self._waiters
+        x, y = self.flat.cells[self.present]
+        mine = self._own_rank
+        above = 0
         for message in beacons:
             sender = message.sender
-            ranks[sender] = (message.elapsed, message.tie, -sender)
+            rank = ranks[sender] = (message.elapsed, message.tie, -sender)
             near.append(sender)  # the radio brings a beacon only within its sender's reach
+            if rank > mine:
+                above += 1
+            there_x, there_y = message.present
+            if abs(there_x - x) + abs(there_y - y) <= RESERVE_RADIUS:
+                listeners.append(sender)
+            elif rank < mine:
+                waiters.append(sender)
+        self._above += above
 
     reach_cap = 8
     """The largest reach a stalled robot's beacon and final reservation grow to (cells)."""
@@ -204,10 +226,17 @@ class LocalPibtRobot(PibtRobot):
         reserved, targets = self._reserved, self._targets
         old = targets.get(sender)
         if old is not None and old != cell and reserved.get(old) == sender:
-            del reserved[old]  # a reservation replaced (after a lost conflict or backtracking)
+            if old == self.present and self._parent is not None:
+                reserved[old] = self._parent  # its own cell stays promised to the robot that pushed it
+            else:
+                del reserved[old]  # a reservation replaced (after a lost conflict or backtracking)
         targets[sender] = cell
         rank = self._claims[sender] = (message.root_elapsed, message.root_tie, -message.root)
-        if message.final:
+        final = message.final
+        waited = final and self._ranks.get(sender, NO_RANK) > self._own_rank  # it may have waited for the sender
+        if final:
+            if waited and sender not in self._final:
+                self._above -= 1
             self._final.add(sender)
             self._calls.pop(sender, None)
         else:
@@ -222,9 +251,19 @@ class LocalPibtRobot(PibtRobot):
         holder = reserved.get(cell)
         if holder is None or holder == sender or targets.get(holder) != cell or self._outranks(sender, holder, cell):
             reserved[cell] = sender  # two claims of one cell in one round: the winner holds it, as the robots decide
-        # a robot waiting to start reconsiders when a robot it may have waited for decided for good (a provisional
-        # reservation, or the final one of a robot it did not wait for, cannot let it start)
-        return self.target is None and message.final and (old is not None or self._ranks.get(sender, (-1, 0, 0)) > self.priority)
+        # a robot waiting to start reconsiders when the last robot it may have waited for decided for good
+        if self.target is None and final and (old is not None or waited):
+            return self.reconsiders_at_every_decision or (not self._above and not self._calls)
+        return False
+
+    reconsiders_at_every_decision = False
+    """Whether a waiting robot reconsiders starting whenever a robot it may have waited for decides for good.
+
+    When False it reconsiders only once no robot heard that outranks it is left
+    undecided and none heard is in the middle of a call, which :meth:`_may_start`
+    needs anyway (those robots are all within its radius: every reach is at
+    least the radius). A brain that learns of decisions otherwise sets it.
+    """
 
     def _outranks(self, claimant: int, holder: int, cell: int) -> bool:
         """Whether ``claimant``'s claim of ``cell`` beats ``holder``'s: staying on one's cell first, then the call's rank."""
@@ -280,7 +319,7 @@ class LocalPibtRobot(PibtRobot):
 
     def _may_start(self) -> bool:
         """Every robot within 2 cells of higher priority has decided, and none is in the middle of a call."""
-        mine = self.priority
+        mine = self._own_rank
         final, targets, ranks = self._final, self._targets, self._ranks
         for other in self._near:
             if other in final:
@@ -300,6 +339,7 @@ class LocalPibtRobot(PibtRobot):
             return
         self._reserved[self.present] = message.sender
         self._targets[message.sender] = self.present
+        self._claims[message.sender] = message.rank  # its reservation may arrive later than this request, or never
         self._parent = message.sender
         self._root, self._rank = message.root, message.rank
         self._begin_call(out)
@@ -334,7 +374,28 @@ class LocalPibtRobot(PibtRobot):
         self.seq += 1
         root, (elapsed, tie, _) = self._root, self._rank
         message = CallReserveMessage(self.index, self.seq, self.step, self.flat.cells[cell], root, elapsed, tie, final)
-        out.append(Outgoing(message, None, self.reach if final else RESERVE_RADIUS))
+        out.append(self._reservation(message, final))
+
+    def _reservation(self, message: CallReserveMessage, final: bool) -> Outgoing:
+        """Where a reservation goes: the robots that can still use it, by name.
+
+        The robots within 2 cells (they may claim the cell, or take ours) and,
+        when final, the robots within the radius that it outranks (they may
+        wait for it to decide); neither if known to have decided for good
+        already, since a robot decided for good ignores every reservation.
+        Every robot within the radius has reached this robot with its beacon
+        (every reach is at least the radius), so these are exactly the robots
+        a radio broadcast would reach and use. A stalled robot's final
+        reservation goes by radio to its whole reach, which can hold robots it
+        has not heard.
+        """
+        if final and self.reach != self.radius:
+            return Outgoing(message, None, self.reach)
+        decided = self._final
+        recipients = [robot for robot in self._listeners if robot not in decided]
+        if final:
+            recipients.extend(robot for robot in self._waiters if robot not in decided)
+        return Outgoing(message, tuple(recipients))
 
     def _continue(self, out: list[Outgoing]) -> None:
         here = self.present

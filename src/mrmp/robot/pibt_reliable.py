@@ -27,7 +27,9 @@ acknowledged its messages):
   rotations): a step can end before such a call has finished, and the robot
   whose cell was taken would then stay;
 * the reach of a stalled robot does not grow (``reach_cap`` 0): the beacon
-  and the final reservation go to the radio radius only.
+  and the final reservation go to the radio radius only, and a final
+  reservation is sent again until every robot known within that radius
+  acknowledged it (a robot there may wait for it to start its call).
 
 The step ends at a tick the driver's clock fixes for everyone; a robot that
 has decided for good moves, any other stays (an abandoned step, counted).
@@ -101,9 +103,9 @@ class ReliablePibtRobot(LocalPibtRobot):
     rotations = False
 
     reach_cap = 0
-    """The reach stays the radio radius: only robots within 2 cells acknowledge a final reservation, so a robot
-    farther away that waited for it could wait in vain for the rest of the step (and an abandoned step, counted
-    as a stall, would widen the reach further)."""
+    """The reach stays the radio radius: only the robots known within it acknowledge a final reservation, so a
+    robot farther away that waited for it could wait in vain for the rest of the step (and an abandoned step,
+    counted as a stall, would widen the reach further)."""
 
     def __init__(
         self,
@@ -244,15 +246,19 @@ class ReliablePibtRobot(LocalPibtRobot):
             super()._begin_call(out)
         out.extend(super().act())
         self._track(out)
+        if not self._confirmed and self._may_confirm():  # nobody within 2 cells to hear the claim: it stands at once
+            settled = super().act()
+            self._track(settled)
+            out.extend(settled)
         replies, self._replies = self._replies, []
         return replies + out
 
     def _track(self, out: list[Outgoing]) -> None:
-        """Remember what ``out`` sends until acknowledged: named recipients, or the known robots within 2 cells."""
+        """Remember what ``out`` sends until acknowledged: named recipients, or the known robots within its radius."""
         now = self._now
         for item in out:
             message = item.message
-            pending = set(item.recipients) if item.recipients is not None else self._known_within(RESERVE_RADIUS)
+            pending = set(item.recipients) if item.recipients is not None else self._known_within(item.radius or RESERVE_RADIUS)
             self._unacknowledged[message.seq] = _Unacknowledged(item, pending, now)
 
     def _known_within(self, radius: int) -> set[int]:
@@ -281,6 +287,12 @@ class ReliablePibtRobot(LocalPibtRobot):
     def _take_pull_local(self, message: PullMessage, out: list[Outgoing]) -> None:
         if self._complete():  # else it could take a cell whose claimants it does not all know
             super()._take_pull_local(message, out)
+
+    reconsiders_at_every_decision = True  # acknowledgements, crashed peers and the live lookout also tell decisions
+
+    def _reservation(self, message: CallReserveMessage, final: bool) -> Outgoing:
+        """By radio to every robot within 2 cells (the radio radius when final): each acknowledges, with its claim."""
+        return Outgoing(message, None, self.reach if final else RESERVE_RADIUS)
 
     def _reserve(self, cell: int, out: list[Outgoing], final: bool = False) -> None:
         super()._reserve(cell, out, final)

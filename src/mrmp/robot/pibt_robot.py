@@ -280,12 +280,14 @@ class PibtRobot:
         delivers: the simulator delivers the beacon round this way.
         """
         occupants, goals, settled = self._occupants, self._goals, self._settled
-        index = self.flat.index
+        y_size = self.flat.y_size  # the flat index (FlatGrid.index), inlined: this runs for every beacon heard
         for message in beacons:
             sender = message.sender
-            cell = index(message.present)
+            x, y = message.present
+            cell = x * y_size + y
+            x, y = message.goal
+            goal = goals[sender] = x * y_size + y
             occupants[cell] = sender
-            goal = goals[sender] = index(message.goal)
             if cell == goal:
                 settled.add(cell)
 
