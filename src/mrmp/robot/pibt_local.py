@@ -29,7 +29,9 @@ then acts):
 3. an asked robot (priority inheritance, :class:`CallInheritMessage`) decides
    at once, within the call of the robot that asked (its *root*), as in PIBT;
 4. a reservation (:class:`CallReserveMessage`, to every robot within 2
-   cells) is *provisional* for one round: two calls can reserve the same cell
+   cells, and when final also to the robots within the radius that the robot
+   outranks; by name, leaving out the robots known to have decided for good,
+   which ignore it) is *provisional* for one round: two calls can reserve the same cell
    only in the same round (a robot that reserves a cell has heard every
    earlier reservation of it, since both reservers stand next to the cell and
    so within 2 cells of each other). In the next round both hear of it; the
@@ -43,8 +45,9 @@ then acts):
 6. at the end of the step a robot moves if it has decided *finally*; one that
    has not (it did not finish in time) stays and counts an abandoned step.
 
-Counted by the robot itself (:attr:`LocalPibtRobot.stats`): ``waits`` (rounds
-in which it could not start yet), ``withdrawn`` (reservations lost to a call
+Counted by the robot itself (:attr:`LocalPibtRobot.stats`): ``waits`` (times
+it looked at the start rule and could not start yet; a waiting robot looks
+again only once no robot it waits for is left), ``withdrawn`` (reservations lost to a call
 of higher priority), ``refused`` (requests refused because it was busy),
 ``passed_busy`` (cells passed by because their occupant was busy in another
 call) and ``abandoned`` (steps it ended undecided); :attr:`LocalPibtRobot.stalled`
