@@ -170,7 +170,7 @@ def heading_aware_setting() -> Any:
 def radius_setting() -> Any:
     """``radius``: how far a ``pibt`` robot's beacon reaches (cells, Manhattan, 2 to :data:`~mrmp.core.limits.MAX_RADIUS`)."""
     return setting(
-        3, help=f"pibt: how far a robot's beacon reaches, in cells (2 to {MAX_RADIUS}).", yaml_key="radius",
+        2, help=f"pibt: how far a robot's beacon reaches, in cells (2 to {MAX_RADIUS}).", yaml_key="radius",
         flag="--radius", check=_radius_in_bounds,
     )
 

@@ -989,7 +989,7 @@ def _policy_text(policy: PolicyOptions) -> str:
     """The ``policy`` section's items: its name, then every setting by its YAML key.
 
     >>> _policy_text(PolicyOptions())  # doctest: +NORMALIZE_WHITESPACE
-    'name: "thesis", resolve: "divert", heading_aware: false, radius: 3, swap: true, search: "default",
+    'name: "thesis", resolve: "divert", heading_aware: false, radius: 2, swap: true, search: "default",
      sequencing: "local"'
     """
     items = [f"name: {_quote(policy.name)}"]

@@ -27,9 +27,7 @@ acknowledged its messages):
   rotations): a step can end before such a call has finished, and the robot
   whose cell was taken would then stay;
 * the reach of a stalled robot does not grow (``reach_cap`` 0): the beacon
-  and the final reservation go to the radio radius only, and a final
-  reservation is sent again until every robot known within that radius
-  acknowledged it (a robot there may wait for it to start its call).
+  and the final reservation go to the radio radius only.
 
 The step ends at a tick the driver's clock fixes for everyone; a robot that
 has decided for good moves, any other stays (an abandoned step, counted).
@@ -103,9 +101,9 @@ class ReliablePibtRobot(LocalPibtRobot):
     rotations = False
 
     reach_cap = 0
-    """The reach stays the radio radius: only the robots known within it acknowledge a final reservation, so a
-    robot farther away that waited for it could wait in vain for the rest of the step (and an abandoned step,
-    counted as a stall, would widen the reach further)."""
+    """The reach stays the radio radius: only robots within 2 cells acknowledge a final reservation, so a robot
+    farther away that waited for it could wait in vain for the rest of the step (and an abandoned step, counted
+    as a stall, would widen the reach further)."""
 
     def __init__(
         self,
@@ -254,11 +252,11 @@ class ReliablePibtRobot(LocalPibtRobot):
         return replies + out
 
     def _track(self, out: list[Outgoing]) -> None:
-        """Remember what ``out`` sends until acknowledged: named recipients, or the known robots within its radius."""
+        """Remember what ``out`` sends until acknowledged: named recipients, or the known robots within 2 cells."""
         now = self._now
         for item in out:
             message = item.message
-            pending = set(item.recipients) if item.recipients is not None else self._known_within(item.radius or RESERVE_RADIUS)
+            pending = set(item.recipients) if item.recipients is not None else self._known_within(RESERVE_RADIUS)
             self._unacknowledged[message.seq] = _Unacknowledged(item, pending, now)
 
     def _known_within(self, radius: int) -> set[int]:
