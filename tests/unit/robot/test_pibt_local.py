@@ -11,7 +11,9 @@ from mrmp.core.grid import connected_regions
 from mrmp.protocol.messages import AnswerMessage, BeaconMessage
 from mrmp.protocol.pibt_local import NO_CLAIM, CallAckMessage, CallInheritMessage, CallReserveMessage
 from mrmp.robot.pibt_local import LocalPibtRobot
+from mrmp.robot.messaging import Outgoing
 from mrmp.robot.pibt_reliable import ReliablePibtRobot
+from mrmp.robot.pibt_robot import RESERVE_RADIUS
 from mrmp.search.flat_map import FlatMap
 from mrmp.sim.local_rounds import LocalRoundsSimulator
 from mrmp.sim.rounds import RoundsSimulator
@@ -357,3 +359,27 @@ def test_handing_messages_over_equals_sending_them_encoded_through_the_network(s
         assert [robot.path for robot in handed.robots] == [robot.path for robot in encoded.robots]
         assert [robot.bytes_sent for robot in handed.robots] == [robot.bytes_sent for robot in encoded.robots]
         assert handed.network == encoded.network
+
+
+class Broadcasting(LocalPibtRobot):
+    """Every reservation by radio to every robot within its radius, and a look at the start rule after every decision."""
+
+    reconsiders_at_every_decision = True
+
+    def _reservation(self, message, final):
+        return Outgoing(message, None, self.reach if final else RESERVE_RADIUS)
+
+
+@pytest.mark.parametrize("radius", [2, 3])
+@pytest.mark.parametrize("seed", range(6))
+def test_reservations_by_name_and_fewer_looks_change_no_decision_and_send_fewer_messages(seed, radius):
+    class Radio(LocalRoundsSimulator):
+        robot_type = Broadcasting
+
+    for scenario in (crowd(seed), dead_ends(*DEAD_ENDS[seed % len(DEAD_ENDS)], max_ticks=40)):
+        scenario = scenario.with_changes(policy=PolicyOptions(name="pibt", radius=radius))
+        named, radio = LocalRoundsSimulator(scenario).run(), Radio(scenario).run()
+        assert [robot.path for robot in named.robots] == [robot.path for robot in radio.robots]
+        assert named.network["messages"] <= radio.network["messages"]
+        if len(scenario.robots) > 3:
+            assert named.network["waits"] < radio.network["waits"] or radio.network["waits"] == 0
