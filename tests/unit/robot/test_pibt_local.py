@@ -10,8 +10,8 @@ from mrmp.core.errors import InputError
 from mrmp.core.grid import connected_regions
 from mrmp.protocol.messages import AnswerMessage, BeaconMessage
 from mrmp.protocol.pibt_local import NO_CLAIM, CallAckMessage, CallInheritMessage, CallReserveMessage
-from mrmp.robot.pibt_local import LocalPibtRobot
 from mrmp.robot.messaging import Outgoing
+from mrmp.robot.pibt_local import LocalPibtRobot
 from mrmp.robot.pibt_reliable import ReliablePibtRobot
 from mrmp.robot.pibt_robot import RESERVE_RADIUS
 from mrmp.search.flat_map import FlatMap
