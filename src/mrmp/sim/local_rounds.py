@@ -304,8 +304,9 @@ class LocalRoundsSimulator(RoundsSimulator):
         key = (sender, item.radius)
         hearers = self._hearers.get(key)
         if hearers is None:  # the bodies stand still during a step: who hears whom is found once
+            occupant = self._occupant
             cells = self._within(self.robots[sender].present, item.radius)
-            hearers = self._hearers[key] = tuple(filter(NO_ROBOT.__ne__, map(self._occupant.__getitem__, cells)))
+            hearers = self._hearers[key] = tuple(other for cell in cells if (other := occupant[cell]) != NO_ROBOT)
         return hearers
 
     def _send(self, sender: int, item: Outgoing, now: int) -> None:
