@@ -137,7 +137,12 @@ def test_shell_completion_completes_choices_from_the_tables() -> None:
     assert complete("mrmp run --policy ") == list(policy_names())
     assert complete("mrmp run --transport m") == ["multicast"]
     assert complete("mrmp run --planner ") == list(PLANNER_NAMES)
-    shown = subprocess.run([sys.executable, "-m", "mrmp", "--show-completion", "bash"], capture_output=True, text=True, check=False)
+    # the shell named, not detected from the process's ancestors (typer's own switch for that): the test must not
+    # depend on being started from a shell
+    named = {**os.environ, "_TYPER_COMPLETE_TEST_DISABLE_SHELL_DETECTION": "1"}
+    shown = subprocess.run(
+        [sys.executable, "-m", "mrmp", "--show-completion", "bash"], env=named, capture_output=True, text=True, check=False
+    )
     assert shown.returncode == 0 and "complete -o default -F _mrmp_completion mrmp" in shown.stdout
 
 
