@@ -47,6 +47,15 @@ ever on its last heard Present and Next. The robot stops waiting for it:
   waiting for it, and so on transitively: a robot that waits for one that has
   left its plan is released, not stuck behind a dead robot two links away.
 
+A robot is known only as of its last state heard, and a robot far away is heard
+rarely (a live driver's fleet heartbeat): the dead robot may have driven on after
+it, and died in the cell of a move whose dependencies on it were dropped (the
+plan has it use that cell first: that is what the dependencies say). When the
+robot chooses such a move :data:`REFUSED_TRIES` times in a row from the same cell
+without leaving it (its claims refused: the dead robot's registration stays at
+the cell's replicas), the cell counts as one of the dead robot's from then on,
+and the robot leaves its plan (second case above) rather than claim it for ever.
+
 What is lost is the plan's order of visits between the robots released this way
 and the robot they no longer wait for, and with it the plan's freedom from
 deadlock (a robot off its plan and one following it can block each other). What
@@ -84,7 +93,9 @@ from mrmp.policies.base import Decision, PeerState, Situation
 
 REFUSED_TRIES = 4
 """Off its plan, after choosing the same cell this many decisions in a row without leaving its own, the robot
-plans around that cell until it moves (a crashed robot may hold a cell it was not heard announcing)."""
+plans around that cell until it moves (a crashed robot may hold a cell it was not heard announcing). On its
+plan, after choosing this many times in a row a move whose dependencies on a crashed robot it dropped, it
+counts the move's cell as that robot's (module docstring)."""
 
 
 class PlanFollowingPolicy:
@@ -162,6 +173,8 @@ class PlanFollowingPolicy:
         """The reactive policy driving the robot once it has left its plan (None while it follows it)."""
         self._stuck: tuple[Cell, Cell, int] | None = None
         self._refused: set[Cell] = set()
+        self._past_dropped: tuple[Cell, int, int] | None = None
+        """The robot's cell, its next move and how many decisions in a row chose that move, dependencies dropped."""
 
     def _catch_up(self, present: Cell) -> None:
         while self.done < len(self.moves) and present == self.moves[self.done]:
@@ -242,6 +255,30 @@ class PlanFollowingPolicy:
                 self.reactive = AstarPolicy()
                 self.waits_for = []
                 return
+
+    def _held_by_dropped(self, situation: Situation) -> bool:
+        """Count a decision to make the next move past dropped dependencies; after :data:`REFUSED_TRIES` such
+        decisions in a row from the same cell, count the move's cell as the dropped robots' (module docstring),
+        wait for them again, and return True (the crash rule then takes the robot off its plan)."""
+        move = self.done
+        dropped = [
+            robot
+            for robot, progress in self.dependencies.get(move, ())
+            if situation.progress_of(robot) < progress and self._dropped(situation, robot)
+        ]
+        if not dropped:
+            self._past_dropped = None
+            return False
+        last = self._past_dropped
+        tries = last[2] + 1 if last is not None and last[:2] == (situation.present, move) else 1
+        if tries <= REFUSED_TRIES:
+            self._past_dropped = (situation.present, move, tries)
+            return False
+        self._past_dropped = None
+        for robot in dropped:
+            self._last_heard[robot] = self._last_heard.get(robot, frozenset()) | {self.moves[move]}
+            self.dropped.discard(robot)
+        return True
 
     def ready(self, situation: Situation) -> bool:
         """Whether every dependency of the next move is met, by what the peers have said
@@ -343,12 +380,17 @@ class PlanFollowingPolicy:
         """Follow the plan: the dependencies already ruled out every conflict.
 
         Readiness is checked with what the peers have said by now. Off its plan
-        (crash rule, module docstring), the reactive policy decides.
+        (crash rule, module docstring), the reactive policy decides; a move past
+        dropped dependencies chosen :data:`REFUSED_TRIES` times in a row from the
+        same cell takes the robot off its plan.
         """
         intended = self._allowed(situation)
+        if self.reactive is None and intended != situation.present and self._held_by_dropped(situation):
+            intended = self._allowed(situation)  # the crash rule again, the move's cell now the dead robots'
         if self.reactive is not None:
             return self._reactive_decision(situation)
         if intended == situation.present:
+            self._past_dropped = None
             reason = "arrived" if situation.present == situation.goal and self.done >= len(self.moves) else "wait"
             return Decision(situation.present, reason, tuple(self.waits_for))
         return Decision(intended, "clear")

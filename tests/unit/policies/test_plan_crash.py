@@ -7,7 +7,7 @@ that the same assertion catches it.
 
 from mrmp.core import Grid, Heading, RobotSpec
 from mrmp.policies.base import PeerState, Situation
-from mrmp.policies.plan_following import PlanFollowingPolicy
+from mrmp.policies.plan_following import REFUSED_TRIES, PlanFollowingPolicy
 from mrmp.robot.robot import Robot
 
 GRID = Grid(4, 4)
@@ -128,3 +128,35 @@ def test_with_a_crash_silence_a_robot_silent_for_less_is_still_waited_for():
     dead = PeerState(1, (2, 2), (2, 2), Heading.NORTH, False, 1, heard_at=1.0, silent=True)
     assert step(policy, situation((0, 1), (0, 3), dead, now=3.5)).next == (0, 1)
     assert step(policy, situation((0, 1), (0, 3), dead, now=4.0)).next == (0, 2)
+
+
+def leaves_plan_when_a_dropped_robot_holds_its_cell(policy):
+    """Robot 1 was last heard on (2, 2), out of the way, and died after driving on to (0, 2), the cell of robot 0's
+    next move, which the plan has it use first: robot 0 drops it and chooses (0, 2), its claims refused (robot 1's
+    registration stays); after four such decisions it counts (0, 2) as robot 1's and goes round it."""
+    dead = situation((0, 1), (1, 3), peer(1, (2, 2), 0, silent=True))
+    choices = [step(policy, dead).next for _ in range(5)]
+    return choices[:4] == [(0, 2)] * 4 and choices[4] == (1, 1)
+
+
+def test_a_move_past_a_dropped_robot_chosen_again_and_again_takes_the_robot_off_its_plan():
+    policy = PlanFollowingPolicy([(0, 1), (0, 2), (0, 3), (1, 3)], {1: [(1, 1)]})
+    assert leaves_plan_when_a_dropped_robot_holds_its_cell(policy)
+    assert policy.off_plan and policy.reactive is not None and (0, 2) in policy.reactive.held
+    assert policy.reported_progress(1) == 4  # its dependents stop waiting for it
+    moved = situation((1, 1), (1, 3), peer(1, (2, 2), 0, silent=True))
+    assert step(policy, moved).next == (1, 2)  # (0, 2) stays the dead robot's once the robot has moved on
+    assert not leaves_plan_when_a_dropped_robot_holds_its_cell(
+        PlanFollowingPolicy([(0, 1), (0, 2), (0, 3), (1, 3)], {1: [(1, 1)]}, follow_crashed=True)
+    )
+
+
+def test_a_move_past_a_dropped_robot_made_is_not_counted_against_the_next():
+    """Each move past the dropped robot that the robot makes starts the count again (only a move it cannot make
+    takes it off its plan)."""
+    policy = PlanFollowingPolicy([(0, 1), (0, 2), (0, 3), (1, 3)], {1: [(1, 1)], 2: [(1, 2)]})
+    for _ in range(REFUSED_TRIES):
+        assert step(policy, situation((0, 1), (1, 3), peer(1, (2, 2), 0, silent=True))).next == (0, 2)
+    for _ in range(REFUSED_TRIES):
+        assert step(policy, situation((0, 2), (1, 3), peer(1, (2, 2), 0, silent=True))).next == (0, 3)
+    assert not policy.off_plan and policy.dropped == {1}
