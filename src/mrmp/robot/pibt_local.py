@@ -38,7 +38,10 @@ then acts):
    call of lower priority withdraws and tries its next cell; staying on one's
    own cell always wins (whoever reserved it asked its occupant, who refuses).
    A robot that has decided and whose reservation survived its round says so:
-   the same reservation, marked *final*, and the answer to its parent;
+   the same reservation, marked *final*, and the answer to its parent. A
+   reservation that no other robot can rival is final at once: every robot
+   standing next to the cell (only those can claim it) is known to have
+   decided for good (:meth:`LocalPibtRobot._uncontested`);
 5. a robot treats the cell of a neighbour as free to take only when that
    neighbour's reservation elsewhere is final, or the neighbour is in the same
    call (PIBT's rotations); a neighbour busy in another call is passed by;
@@ -50,7 +53,8 @@ it looked at the start rule and could not start yet; a waiting robot looks
 again only once no robot it waits for is left), ``withdrawn`` (reservations lost to a call
 of higher priority), ``refused`` (requests refused because it was busy),
 ``passed_busy`` (cells passed by because their occupant was busy in another
-call) and ``abandoned`` (steps it ended undecided); :attr:`LocalPibtRobot.stalled`
+call), ``settled_at_once`` (reservations final at once, with no rival
+possible) and ``abandoned`` (steps it ended undecided); :attr:`LocalPibtRobot.stalled`
 and :attr:`LocalPibtRobot.reach` are its stall count and this step's reach.
 
 Examples
@@ -73,7 +77,14 @@ because nobody within 2 cells outranks it, while robot 1 waits for it.
 ...         _ = robots[1 - sender].receive(item.message)
 ...     sent = [(robot.index, item) for robot in (a, b) for item in robot.act()]
 >>> [flat.cell(robot.finish_step()) for robot in (a, b)], rounds, b.stats["waits"]
-([(0, 1), (1, 1)], 5, 1)
+([(0, 1), (1, 1)], 4, 1)
+
+Robot 1, asked, took the bay: nobody else stands next to it, so its
+reservation was final at once; robot 0's claim of robot 1's cell waited its
+round.
+
+>>> a.stats["settled_at_once"], b.stats["settled_at_once"]
+(0, 1)
 """
 
 from __future__ import annotations
@@ -414,8 +425,7 @@ class LocalPibtRobot(PibtRobot):
                 if occupant is not None and targets.get(occupant) == here:
                     self._next += 1  # would swap
                     continue
-                self._reserve(cell, out)
-                self._finish(True, out)
+                self._claim(cell, True, out)
                 return
             target = targets.get(occupant)
             if target == here:
@@ -435,8 +445,40 @@ class LocalPibtRobot(PibtRobot):
             inherit = CallInheritMessage(self.index, self._seq(), self.step, self.flat.cells[cell], root, elapsed, tie)
             out.append(Outgoing(inherit, (occupant,)))
             return
-        self._reserve(here, out)  # no candidate left: stay
-        self._finish(False, out)
+        self._claim(here, False, out)  # no candidate left: stay
+
+    def _claim(self, cell: int, moved: bool, out: list[Outgoing]) -> None:
+        """Reserve ``cell``, which no robot of this step stands on any more, and end the call.
+
+        For good at once when no other robot can claim the cell in this step
+        (:meth:`_uncontested`); provisionally otherwise, final once the claim
+        has survived (:meth:`_may_confirm`).
+        """
+        if self.settles_uncontested and self._uncontested(cell):
+            self.stats["settled_at_once"] += 1
+            self.target = cell
+            self._finalize(moved, out)
+        else:
+            self._reserve(cell, out)
+            self._finish(moved, out)
+
+    settles_uncontested = True
+    """Whether a claim no other robot can contest is final at once, without a provisional round."""
+
+    def _uncontested(self, cell: int) -> bool:
+        """No robot but this one that stands on ``cell`` or next to it is undecided.
+
+        Only such a robot can claim ``cell`` in this step (a robot moves one
+        cell, pushed or not), and every one of them is within 2 cells of this
+        robot, so it is known here (its beacon came in before any call began);
+        a robot known to have decided for good will not claim again.
+        """
+        occupants, final, index = self._occupants, self._final, self.index
+        for place in (cell, *self.flat.neighbours[cell]):
+            other = occupants.get(place)
+            if other is not None and other != index and other not in final:
+                return False
+        return True
 
     def _finish(self, moved: bool, out: list[Outgoing]) -> None:
         if self._confirmed:

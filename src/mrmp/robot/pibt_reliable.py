@@ -22,7 +22,11 @@ acknowledged its messages):
   its sender's own reservation: of two calls claiming one cell, each either
   heard the other's claim before claiming (and passed the cell by) or receives
   it in the acknowledgement of its own claim, before confirming; the call of
-  lower priority withdraws, as in synchronous rounds;
+  lower priority withdraws, as in synchronous rounds. A reservation that no
+  other robot can rival (every robot next to the cell known to have decided for
+  good, :meth:`~mrmp.robot.pibt_local.LocalPibtRobot._uncontested`) is final at
+  once, as in synchronous rounds: the robot knows every robot within 2 cells
+  before it claims;
 * a call never takes the cell of a robot busy in the same call (no
   rotations): a step can end before such a call has finished, and the robot
   whose cell was taken would then stay;

@@ -66,7 +66,9 @@ __all__ = ["STEP_RETRIES", "LocalRoundsSimulator"]
 STEP_RETRIES = 8
 """Over a faulty network a step lasts this many retry intervals (``2 * delay_max + 1`` ticks each) by default."""
 
-ROBOT_COUNTS = ("waits", "withdrawn", "refused", "passed_busy", "abandoned", "acks", "retransmissions")
+ROBOT_COUNTS = (
+    "waits", "withdrawn", "refused", "passed_busy", "settled_at_once", "abandoned", "acks", "retransmissions",
+)  # fmt: skip
 """What the robots count themselves, reported in the result's ``network``."""
 
 

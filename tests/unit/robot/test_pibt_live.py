@@ -107,7 +107,8 @@ def test_a_held_robot_answers_a_request_once_its_move_is_allowed_or_refuses_it_w
         sent = b.act()
         answers = [item.message for item in sent if type(item.message).__name__ == "AnswerMessage"]
         if allowed:
-            assert answers == [] and flat.cell(b.target) == (2, 0)  # it took the request up: it leaves for (2, 0)
+            # it took the request up: nobody else can claim (2, 0), so it leaves for it for good at once
+            assert [answer.moved for answer in answers] == [True] and flat.cell(b.target) == (2, 0) and b.final
         else:
             assert [answer.moved for answer in answers] == [False] and b.stats["gave_up"] == 1
 
