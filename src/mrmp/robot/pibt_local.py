@@ -448,7 +448,7 @@ class LocalPibtRobot(PibtRobot):
         self._claim(here, False, out)  # no candidate left: stay
 
     def _claim(self, cell: int, moved: bool, out: list[Outgoing]) -> None:
-        """Reserve ``cell``, which no robot of this step stands on any more, and end the call.
+        """Reserve ``cell`` (free, left for good by its occupant, or the robot's own) and end the call.
 
         For good at once when no other robot can claim the cell in this step
         (:meth:`_uncontested`); provisionally otherwise, final once the claim
