@@ -261,11 +261,7 @@ class PlanFollowingPolicy:
         decisions in a row from the same cell, count the move's cell as the dropped robots' (module docstring),
         wait for them again, and return True (the crash rule then takes the robot off its plan)."""
         move = self.done
-        dropped = [
-            robot
-            for robot, progress in self.dependencies.get(move, ())
-            if situation.progress_of(robot) < progress and self._dropped(situation, robot)
-        ]
+        dropped = [robot for robot in self._unmet(situation) if self._dropped(situation, robot)]
         if not dropped:
             self._past_dropped = None
             return False
@@ -283,12 +279,15 @@ class PlanFollowingPolicy:
     def ready(self, situation: Situation) -> bool:
         """Whether every dependency of the next move is met, by what the peers have said
         (a silent robot whose dependencies were dropped counts as met while it stays silent)."""
-        waiting = []
-        for robot, progress in self.dependencies.get(self.done, ()):
-            if situation.progress_of(robot) < progress and not self._dropped(situation, robot):
-                waiting.append(robot)
+        waiting = [robot for robot in self._unmet(situation) if not self._dropped(situation, robot)]
         self.waits_for = waiting
         return not waiting
+
+    def _unmet(self, situation: Situation) -> list[int]:
+        """The robots that have not yet made the progress the next move depends on, by what they have said."""
+        return [
+            robot for robot, progress in self.dependencies.get(self.done, ()) if situation.progress_of(robot) < progress
+        ]
 
     def _dropped(self, situation: Situation, robot: int) -> bool:
         peer = situation.peers.get(robot)
