@@ -41,6 +41,9 @@ from mrmp.protocol.messages import StateMessage
 
 IDS = ("A", "B", "C")
 
+BURST = 12
+"""Datagrams sent back to back to one peer in :meth:`TransportConformance.test_a_burst_to_one_peer_arrives_whole`."""
+
 
 @dataclass(frozen=True)
 class Stack:
@@ -125,6 +128,14 @@ class TransportConformance:
             expected = [data for sender, recipient, data in ((0, 2, b"0 to 2"), (2, 1, b"2 to 1"))
                         if index in delivery.receivers(sender, recipient, len(robots))]
             assert receive_expected(robot, expected) == Counter(expected), f"robot {index}"
+
+    def test_a_burst_to_one_peer_arrives_whole(self, stack, fleet):
+        """A robot answers several messages at once: a dozen datagrams sent back to back to one peer all arrive."""
+        a, b, _ = fleet()
+        burst = [b"burst %d" % number + bytes(40) for number in range(BURST)]
+        for data in burst:
+            a.send(data, recipient=1)
+        assert receive_expected(b, burst) == Counter(burst)
 
     def test_everyone_broadcasting_at_once(self, stack, fleet):
         robots = fleet()
