@@ -326,7 +326,6 @@ class LivePibtRobot(ReliablePibtRobot):
 
     def _begin_call(self, out: list[Outgoing]) -> None:
         if self.held and self._parent is None:
-            self._reserve(self.present, out)  # its turn came while held: it stays, as a call with no cell left does
-            self._finish(False, out)
+            self._claim(self.present, False, out)  # its turn came while held: it stays, as a call with no cell left does
             return
         super()._begin_call(out)

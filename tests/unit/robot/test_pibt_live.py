@@ -13,7 +13,7 @@ from mrmp.core.heading import Heading
 from mrmp.live.body import OccupancyRecorder, SimulatedBody
 from mrmp.live.pibt_agent import PibtBrain, PibtTiming
 from mrmp.protocol.messages import BeaconMessage
-from mrmp.protocol.pibt_local import CallInheritMessage
+from mrmp.protocol.pibt_local import CallInheritMessage, CallReserveMessage
 from mrmp.robot.messaging import Outgoing
 from mrmp.robot.pibt_live import LivePibtRobot
 from mrmp.search.flat_map import FlatMap
@@ -111,6 +111,23 @@ def test_a_held_robot_answers_a_request_once_its_move_is_allowed_or_refuses_it_w
             assert [answer.moved for answer in answers] == [True] and flat.cell(b.target) == (2, 0) and b.final
         else:
             assert [answer.moved for answer in answers] == [False] and b.stats["gave_up"] == 1
+
+
+def test_a_held_robot_that_gives_up_stays_for_good_at_once_only_when_nobody_next_to_its_cell_is_undecided():
+    flat, cells = line(5)
+    for neighbour in (False, True):
+        starts = [cells[1], cells[2]] if neighbour else [cells[1]]
+        b = LivePibtRobot(0, cells[1], cells[4], flat, starts=starts, tie=5)
+        b.begin_step(3, held=True)
+        if neighbour:  # robot 1 next to b's cell, of lower priority: it has not decided when b's turn comes
+            b.receive(BeaconMessage(1, 1, 3, (2, 0), (0, 0), 0, 0))
+        b.act()
+        assert b.target is None  # held: it does not start
+        b.give_up()
+        reservations = [item.message for item in b.act() if isinstance(item.message, CallReserveMessage)]
+        assert b.target == cells[1]  # it stays
+        assert [message.final for message in reservations] == [not neighbour]
+        assert b.final is (not neighbour) and b.stats["settled_at_once"] == (0 if neighbour else 1)
 
 
 # -- the live brain (PibtBrain) in steps on a clock, its bodies in simulated real time -------------------------
