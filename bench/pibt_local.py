@@ -8,7 +8,8 @@ driver (:class:`mrmp.sim.rounds.RoundsSimulator`) and with local sequencing
 * success, SoC/LB, makespan;
 * ms/step: wall time per step (the distance tables are computed before it; a
   ratio of the two lines is what to read: both ran in the same process, one
-  after the other);
+  after the other), and on the local line that ratio (``x drv``: local
+  sequencing's ms per step over the driver's);
 * rounds/step and msg/robot/step (messages, one per recipient);
 * for local sequencing, the robots' own counts per robot and step: rounds
   waited before starting, reservations withdrawn, requests refused, cells
@@ -95,7 +96,7 @@ def main() -> int:
     simulators = [(label, simulator) for label, simulator in (("driver", RoundsSimulator), ("local", Local))]
     simulators = [(label, simulator) for label, simulator in simulators if arguments.order in (None, label)]
     print(
-        f"{'map':<30} {'N':>5} {'order':>6} {'success':>7} {'SoC/LB':>7} {'mksp':>5} {'ms/step':>8} {'rnd/step':>8}"
+        f"{'map':<30} {'N':>5} {'order':>6} {'success':>7} {'SoC/LB':>7} {'mksp':>5} {'ms/step':>8} {'x drv':>6} {'rnd/step':>8}"
         f" {'msg/r/s':>7} {'wait':>6} {'withdr':>7} {'refuse':>7} {'passed':>7} {'aband':>6} {'retrans':>7}"
     )
     for name, scenario in cases(arguments):
@@ -107,6 +108,7 @@ def main() -> int:
         )
         if arguments.limit:
             scenario = scenario.with_changes(max_ticks=arguments.limit)
+        driver_ms = None
         for label, simulator in simulators:
             radius = arguments.driver_radius if label == "driver" else arguments.radius
             result = simulator(scenario.with_changes(policy=PolicyOptions(name="pibt", radius=radius, sequencing=label))).run()
@@ -117,6 +119,10 @@ def main() -> int:
             per = agents * steps
             soc = f"{result.sum_of_costs / result.lower_bound:.3f}" if result.success else "-"
             mksp = f"{result.makespan}" if result.success else "-"
+            ms_per_step = 1000 * result.wall_time_s / steps
+            if label == "driver":
+                driver_ms = ms_per_step
+            ratio = f"{ms_per_step / driver_ms:.2f}" if label == "local" and driver_ms else "-"
             counts = " ".join(
                 f"{network.get(key, 0) / per:>{width}.3f}"
                 for key, width in (
@@ -130,7 +136,7 @@ def main() -> int:
             )
             print(
                 f"{name:<30} {agents:>5} {label:>6} {100 * result.success:>6.0f}% {soc:>7} {mksp:>5}"
-                f" {1000 * result.wall_time_s / steps:>8.2f} {network['rounds'] / steps:>8.1f}"
+                f" {ms_per_step:>8.2f} {ratio:>6} {network['rounds'] / steps:>8.1f}"
                 f" {network['messages'] / per:>7.2f} {counts}",
                 flush=True,
             )
