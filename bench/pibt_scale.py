@@ -18,10 +18,11 @@ measured:
 
 Every line is also appended to ``--out`` (JSON lines) as it is measured.
 ``--seeds K`` runs every instance with seeds 0 to K-1 (the seed drives the robots' random tie-breaks;
-default 1), so "inst" counts instances times seeds.
+default 1), so "inst" counts instances times seeds. ``--reach-cap`` sets how far a stalled robot's reach
+grows with local sequencing (:attr:`~mrmp.robot.pibt_local.LocalPibtRobot.reach_cap`).
 
 Usage: python bench/pibt_scale.py [--maps DIR] [--only random-32-32-20,empty-32-32] [--seeds K] [--out FILE]
-       [--sequencing local|driver] [--radius R]
+       [--sequencing local|driver] [--radius R] [--reach-cap R]
 """
 
 from __future__ import annotations
@@ -36,6 +37,7 @@ from mrmp.core import PolicyOptions, Scenario
 from mrmp.core.map_generators import random_instance as seeded_instance
 from mrmp.io import load_movingai_scenario, load_scenario
 from mrmp.io.movingai import read_map
+from mrmp.robot.pibt_local import LocalPibtRobot
 from mrmp.sim.policy_table import pibt_simulator
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -143,9 +145,15 @@ def main() -> int:
     default = PolicyOptions(name="pibt")
     parser.add_argument("--sequencing", choices=("local", "driver"), default=default.sequencing, help="who orders the calls")
     parser.add_argument("--radius", type=int, default=default.radius, help="the robots' beacon radius")
+    parser.add_argument(
+        "--reach-cap", type=int, default=LocalPibtRobot.reach_cap, help="largest reach of a stalled robot (local order)"
+    )
     arguments = parser.parse_args()
     if arguments.seeds < 1:
         parser.error(f"--seeds must be at least 1, not {arguments.seeds}")
+    if arguments.reach_cap < 0:
+        parser.error(f"--reach-cap must be at least 0, not {arguments.reach_cap}")
+    LocalPibtRobot.reach_cap = arguments.reach_cap  # the policy table builds the robots: set on their class
     policy = PolicyOptions(name="pibt", sequencing=arguments.sequencing, radius=arguments.radius)
     only = {name for name in arguments.only.split(",") if name}
     print(
