@@ -30,7 +30,12 @@ With ``--before REV`` every case runs first with the code of the git revision
 then with the code here: the rows before and after a change, side by side on
 one machine.
 
+``--synchronizer local`` runs the live ``pibt`` robots with a local
+synchronizer (each ends its step when its neighbours are done) instead of the
+common clock; the simulator's makespan stays that of the clock's lockstep.
+
 Usage: python bench/live_pibt.py [--cases udp24,zenoh24,udp64,side] [--time-scale 2] [--before REV]
+       [--synchronizer clock|local]
 """
 
 from __future__ import annotations
@@ -59,11 +64,22 @@ ROOT = Path(__file__).resolve().parents[1]
 EXAMPLE = ROOT / "examples" / "causal-32.yaml"
 
 
+SYNCHRONIZER = "clock"
+"""``--synchronizer``: how the live ``pibt`` robots end their steps (``clock`` or ``local``)."""
+
+
+def pibt_policy(policy: str = "pibt") -> PolicyOptions:
+    """The policy of a live case: ``pibt`` with the chosen synchronizer, or ``policy`` with its defaults."""
+    if policy == "pibt" and SYNCHRONIZER != "clock":  # named only when not the default: --before runs older code
+        return PolicyOptions(name=policy, synchronizer=SYNCHRONIZER)
+    return PolicyOptions(name=policy)
+
+
 def example(count: int | None = None, policy: str = "pibt") -> Scenario:
     """``examples/causal-32.yaml`` with its first ``count`` robots (all by default), policy ``policy``."""
     scenario = load_scenario(EXAMPLE)
     robots = scenario.robots if count is None else scenario.robots[:count]
-    return scenario.with_changes(robots=robots, policy=PolicyOptions(name=policy), name=f"{scenario.name}-{len(robots)}")
+    return scenario.with_changes(robots=robots, policy=pibt_policy(policy), name=f"{scenario.name}-{len(robots)}")
 
 
 def drawn(count: int, seed: int = 0) -> Scenario:
@@ -74,7 +90,7 @@ def drawn(count: int, seed: int = 0) -> Scenario:
     rng = random.Random(seed)
     starts, goals = rng.sample(free, count), rng.sample(free, count)
     robots = tuple(RobotSpec(f"r{i}", start, goal) for i, (start, goal) in enumerate(zip(starts, goals, strict=True)))
-    return scenario.with_changes(robots=robots, policy=PolicyOptions(name="pibt"), name=f"drawn-{count}")
+    return scenario.with_changes(robots=robots, policy=pibt_policy(), name=f"drawn-{count}")
 
 
 def simulated_makespan(scenario: Scenario) -> int:
@@ -170,6 +186,7 @@ def row(label: str, scenario: Scenario, transport: str, loss: float, time_scale:
     cell = scenario.timing.cell_time / time_scale
     network = result.network
     moves = max(1, network.get("moves", 0))
+    steps = f" (steps end by {getattr(scenario.policy, 'synchronizer', 'clock')})" if scenario.policy.name == "pibt" else ""
     arrived = sum(robot.arrived for robot in result.robots)
     if compare:
         ticks = simulated_makespan(scenario)
@@ -180,7 +197,7 @@ def row(label: str, scenario: Scenario, transport: str, loss: float, time_scale:
     else:
         sim_text, ratio = "-", "-"
     print(
-        f"{label}: {scenario.policy.name} {len(scenario.robots)} robots over {transport}, loss {loss:.0%}, "
+        f"{label}: {scenario.policy.name}{steps} {len(scenario.robots)} robots over {transport}, loss {loss:.0%}, "
         f"time scale {time_scale:g} (cell {cell:.2f} s): arrived {arrived}/{len(scenario.robots)}, "
         f"collisions {len(result.collisions)}, wall makespan {result.time_makespan_s:.2f} s, "
         f"simulator {sim_text}, ratio {ratio}, ideal {result.ideal_makespan_s or 0:.2f} s "
@@ -198,8 +215,11 @@ def main() -> int:
     parser.add_argument("--cases", default="udp24,zenoh24,udp64,side")
     parser.add_argument("--time-scale", type=float, default=2.0)
     parser.add_argument("--before", metavar="REV", help="run every case first with the code of git revision REV")
+    parser.add_argument("--synchronizer", choices=("clock", "local"), default="clock", help="how live pibt robots end steps")
     parser.add_argument("--label", default="", help=argparse.SUPPRESS)
     arguments = parser.parse_args()
+    global SYNCHRONIZER
+    SYNCHRONIZER = arguments.synchronizer
     scale = arguments.time_scale
     source = export_source(arguments.before) if arguments.before else None
     for name in arguments.cases.split(","):

@@ -212,9 +212,9 @@ def with_policy_flags(command: Callable[..., None]) -> Callable[..., None]:
     >>> def show(policy_settings: dict[str, Any]) -> None:
     ...     print(policy_settings)
     >>> list(inspect.signature(with_policy_flags(show)).parameters)
-    ['resolve', 'heading_aware', 'radius', 'swap', 'search', 'sequencing']
+    ['resolve', 'heading_aware', 'radius', 'swap', 'search', 'sequencing', 'synchronizer']
     >>> with_policy_flags(show)(radius=3)
-    {'resolve': None, 'heading_aware': None, 'radius': 3, 'swap': None, 'search': None, 'sequencing': None}
+    {'resolve': None, 'heading_aware': None, 'radius': 3, 'swap': None, 'search': None, 'sequencing': None, 'synchronizer': None}
     """
     types = setting_types(PolicyOptions)
     flags = [

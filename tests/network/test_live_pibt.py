@@ -64,6 +64,19 @@ def test_five_robots_over_lossy_udp(tmp_path):
     assert result.network["injected_lost"] > 0 and pibt_counts(result)["retransmissions"] > 0
 
 
+def test_robots_that_end_their_own_steps_cross_over_lossy_udp(tmp_path):
+    """``synchronizer: local``: no common clock; 20% of the datagrams lost; no step ends undecided."""
+    robots = (*CROSS, RobotSpec("e", (0, 0), (4, 4)))
+    scenario = crossing(robots=robots).with_changes(policy=PolicyOptions(name="pibt", synchronizer="local"))
+    faults = LiveFaults(loss=0.2, delay_min=0.0, delay_max=0.01, duplicate=0.1)
+    result = run_live(scenario, LiveOptions(results=tmp_path / "run", time_scale=10, faults=faults, seed=2))
+    assert result.collisions == [] and result.success, result.stop_reason
+    counts = pibt_counts(result)
+    assert result.network["injected_lost"] > 0 and counts["retransmissions"] > 0
+    assert counts.get("abandoned", 0) == 0 and counts["steps"] > 0
+    assert result.network["safety_granted"] == result.network["moves"]
+
+
 def distinct(cells) -> list[tuple[int, int]]:
     """``cells`` without repeats of the cell before (a path's cells, in the order they were entered)."""
     out: list[tuple[int, int]] = []

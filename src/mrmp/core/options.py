@@ -49,6 +49,10 @@ SEQUENCINGS = ("driver", "local")
 """Who orders ``pibt``'s calls: the simulator, in priority order (:mod:`mrmp.sim.rounds`), or the robots
 themselves, by messages among neighbours (:mod:`mrmp.sim.local_rounds`)."""
 
+SYNCHRONIZERS = ("clock", "local")
+"""When a ``pibt`` robot (local sequencing) ends its step: at a time common to all (:mod:`mrmp.sim.local_rounds`),
+or once every robot within 2 cells has decided, by its own word (:mod:`mrmp.sim.synchronized_rounds`)."""
+
 POLICY_DEFAULT_SEARCH = "default"
 """The ``search`` value that leaves each policy its own search (``thesis``: update-coordinate, ``astar``: A*)."""
 
@@ -113,8 +117,9 @@ def setting_types(options_type: type) -> dict[str, type]:
     """The Python type of each setting field of ``options_type``, by field name (annotations resolved).
 
     >>> from mrmp.core.scenario import PolicyOptions
-    >>> {name: kind.__name__ for name, kind in setting_types(PolicyOptions).items()}
-    {'resolve': 'str', 'heading_aware': 'bool', 'radius': 'int', 'swap': 'bool', 'search': 'str', 'sequencing': 'str'}
+    >>> {name: kind.__name__ for name, kind in setting_types(PolicyOptions).items()}  # doctest: +NORMALIZE_WHITESPACE
+    {'resolve': 'str', 'heading_aware': 'bool', 'radius': 'int', 'swap': 'bool', 'search': 'str', 'sequencing': 'str',
+     'synchronizer': 'str'}
     """
     hints = typing.get_type_hints(options_type)
     return {field.name: hints[field.name] for field, _ in settings(options_type)}
@@ -206,6 +211,20 @@ def sequencing_setting() -> Any:
     return setting(
         "local", help="pibt: who orders the robots' calls: local (the robots themselves) or driver (the simulator).",
         yaml_key="sequencing", flag="--sequencing", check=_one_of_sequencings, choices=SEQUENCINGS,
+    )  # fmt: skip
+
+
+def _one_of_synchronizers(value: object) -> str | None:
+    return None if value in SYNCHRONIZERS else f"must be one of {', '.join(SYNCHRONIZERS)}, got {value!r}"
+
+
+def synchronizer_setting() -> Any:
+    """``synchronizer``: when a ``pibt`` robot ends its step, ``clock`` (a time common to all) or ``local`` (its own word)."""
+    return setting(
+        "clock",
+        help="pibt (local sequencing, simulated): when a robot ends its step: clock (a time common to all) or local "
+        "(once every robot within 2 cells has decided; a local synchronizer).",
+        yaml_key="synchronizer", flag="--synchronizer", check=_one_of_synchronizers, choices=SYNCHRONIZERS,
     )  # fmt: skip
 
 

@@ -36,6 +36,7 @@ from mrmp.core.options import (
     search_setting,
     sequencing_setting,
     swap_setting,
+    synchronizer_setting,
 )
 
 __all__ = [
@@ -129,6 +130,7 @@ class PolicyOptions:
     swap: bool = swap_setting()
     search: str = search_setting()
     sequencing: str = sequencing_setting()
+    synchronizer: str = synchronizer_setting()
 
     def __post_init__(self) -> None:
         check_settings(self)

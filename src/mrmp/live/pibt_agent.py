@@ -84,6 +84,7 @@ from mrmp.protocol.pibt_local import CallAckMessage
 from mrmp.protocol.safety import SafetyLayer
 from mrmp.robot.messaging import Outgoing
 from mrmp.robot.pibt_live import LivePibtRobot
+from mrmp.robot.pibt_synchronized import SynchronizedPibtRobot
 from mrmp.search.flat_map import FlatMap
 
 __all__ = ["PibtAgent", "PibtBrain", "PibtTiming", "open_repeat"]
@@ -192,7 +193,10 @@ class PibtBrain:
         options = scenario.policy
         self.index = index
         self.timing = timing
-        self.robot = LivePibtRobot(
+        self.synchronized = options.synchronizer == "local"
+        """Whether the robot ends its steps itself (``synchronizer: local``) instead of on the common clock."""
+        brain_type = SynchronizedPibtRobot if self.synchronized else LivePibtRobot
+        self.robot: LivePibtRobot = brain_type(
             index, start, goal, flat,
             tie=int(distance) if distance != math.inf else 0,
             heading=spec.heading,
@@ -222,6 +226,7 @@ class PibtBrain:
         """The cell the robot decided for good on in this step (its move queued already), if it has."""
         self._act = False
         self._claimed_at = -math.inf
+        self._began = 0.0
         self.crash_after = crash_after
 
     # -- time -------------------------------------------------------------------------------
@@ -239,6 +244,8 @@ class PibtBrain:
         out: list[Outgoing] = []
         if self.t0 is None:
             return out
+        if self.synchronized:
+            return self._expire_synchronized(now)
         robot, timing = self.robot, self.timing
         begins = self.t0 + self.step * timing.step  # when the next step begins
         if self._deciding and now >= begins - timing.step + timing.hold:
@@ -252,9 +259,7 @@ class PibtBrain:
             out.extend(robot.begin_step(self.step, now=self._ms(now), held=bool(self.queue)))
             self._deciding = True
             self._act = True
-        for peer, (heard_at, _) in self.heard.items():
-            if now - heard_at > self.crash_after and peer not in robot.crashed:
-                robot.crash(peer)
+        self._crash_silent(now)
         if self._deciding:
             resent = robot.on_tick(self._ms(now))
             out.extend(resent)
@@ -265,6 +270,52 @@ class PibtBrain:
                 self._queue_decided()
         out.extend(self._stamped(self.safety.expire(now)))
         return out
+
+    def _expire_synchronized(self, now: float) -> list[Outgoing]:
+        """:meth:`expire` with a local synchronizer: the robot ends its step when its brain says so, not on a clock.
+
+        Step 1 begins at ``t0``; step ``k + 1`` at once when step ``k`` is done
+        (:attr:`~mrmp.robot.pibt_synchronized.SynchronizedPibtRobot.step_done`),
+        held while the move decided in step ``k`` is not granted. A held robot
+        waits for its grant as long as it takes: no step ends undecided.
+        """
+        robot = self.robot
+        assert isinstance(robot, SynchronizedPibtRobot)
+        out: list[Outgoing] = []
+        if self.step == 0:
+            self._begin_next_step(now, out)
+        if now - self._began >= self.timing.hold:
+            robot.give_up()
+        self._crash_silent(now)
+        resent = robot.on_tick(self._ms(now))
+        out.extend(resent)
+        if self._act or robot.wake or resent:
+            self._act = False
+            out.extend(robot.act())
+        if robot.final and self._decided is None:
+            self._queue_decided()
+        if robot.step_done:
+            self._finish_step()
+            self._begin_next_step(now, out)
+        out.extend(self._stamped(self.safety.expire(now)))
+        return out
+
+    def _begin_next_step(self, now: float, out: list[Outgoing]) -> None:
+        """Begin the next step at once and act on it (the synchronizer's step, :meth:`_expire_synchronized`)."""
+        self.step += 1
+        self._began = now
+        robot = self.robot
+        out.extend(robot.begin_step(self.step, now=self._ms(now), held=bool(self.queue)))
+        out.extend(robot.act())
+        self._deciding = True
+        self._act = False
+
+    def _crash_silent(self, now: float) -> None:
+        """Take every peer silent for ``crash_after`` seconds for crashed."""
+        robot = self.robot
+        for peer, (heard_at, _) in self.heard.items():
+            if now - heard_at > self.crash_after and peer not in robot.crashed:
+                robot.crash(peer)
 
     def _queue_decided(self) -> None:
         """The robot decided for good: its move is queued now, before the decision phase ends (it cannot change)."""
@@ -343,7 +394,7 @@ class PibtBrain:
         if sender in self.robot.crashed:
             self.robot.revive(sender)
         if isinstance(message, PibtMessage):
-            if self.t0 is not None and message.step > self.step:
+            if self.t0 is not None and message.step > self.step and not self.synchronized:
                 self.t0 = min(self.t0, now - (message.step - 1) * self.timing.step)  # a peer is ahead: catch it up
             if isinstance(message, BeaconMessage):
                 old = self.heard.get(sender)
@@ -355,7 +406,7 @@ class PibtBrain:
             self.heard[sender] = (now, message.arrived)
             if message.progress > 0:
                 self.robot.learn(sender, self.flat.index(message.present), message.progress)
-                if self.t0 is not None and message.progress - 1 > self.step:  # it is in step progress - 1 or later
+                if self.t0 is not None and message.progress - 1 > self.step and not self.synchronized:  # a later step
                     self.t0 = min(self.t0, now - (message.progress - 2) * self.timing.step)
             if first and self.t0 is None:
                 return [Outgoing(self.state(), (sender,))]  # so that it hears of us as soon as we heard of it

@@ -30,6 +30,7 @@ from mrmp.core.options import (
     search_setting,
     sequencing_setting,
     swap_setting,
+    synchronizer_setting,
 )
 from mrmp.core.scenario import PolicyOptions
 
@@ -67,6 +68,7 @@ class PibtOptions:
     radius: int = radius_setting()
     swap: bool = swap_setting()
     sequencing: str = sequencing_setting()
+    synchronizer: str = synchronizer_setting()
 
     def __post_init__(self) -> None:
         check_settings(self)

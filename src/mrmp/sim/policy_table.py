@@ -54,6 +54,7 @@ from mrmp.search.choices import chosen_search
 from mrmp.sim.asynchronous import AsynchronousSimulator
 from mrmp.sim.local_rounds import LocalRoundsSimulator
 from mrmp.sim.rounds import RoundsSimulator
+from mrmp.sim.synchronized_rounds import SynchronizedRoundsSimulator
 from mrmp.sim.ticking import TickObserver
 
 
@@ -157,10 +158,24 @@ def pibt_simulator(scenario: Scenario, on_tick: TickObserver | None = None) -> R
     >>> robots = (RobotSpec("A", (0, 0), (2, 0)),)
     >>> type(pibt_simulator(Scenario(Grid(3, 1), robots, policy=PolicyOptions(name="pibt", sequencing="local")))).__name__
     'LocalRoundsSimulator'
+    >>> type(pibt_simulator(Scenario(Grid(3, 1), robots, policy=PolicyOptions(name="pibt", synchronizer="local")))).__name__
+    'SynchronizedRoundsSimulator'
     """
-    if options_from(PibtOptions, scenario.policy).sequencing == "local":
-        return LocalRoundsSimulator(scenario, on_tick=on_tick)
+    options = options_from(PibtOptions, scenario.policy)
+    if options.sequencing == "local":
+        return STEP_ENDS[options.synchronizer](scenario, on_tick=on_tick)
+    if options.synchronizer != "clock":
+        raise InputError(
+            Problem("policy.synchronizer", "local needs sequencing: local (the driver's order ends steps on global quiet)")
+        )
     return RoundsSimulator(scenario, on_tick=on_tick)
+
+
+STEP_ENDS: dict[str, Callable[..., RoundsSimulator]] = {
+    "clock": LocalRoundsSimulator,
+    "local": SynchronizedRoundsSimulator,
+}
+"""``pibt``'s simulator with local sequencing, by ``synchronizer``: steps on a common clock, or ended by each robot."""
 
 POLICY_TABLE: dict[str, PolicyEntry] = {
     "thesis": PolicyEntry(

@@ -45,7 +45,7 @@ from __future__ import annotations
 import gc
 import time
 from collections import Counter
-from collections.abc import Sequence
+from collections.abc import Container, Sequence
 from operator import attrgetter
 
 from mrmp.core.faults import message_fates
@@ -230,8 +230,9 @@ class RoundsSimulator:
         if self.tick < self.max_ticks:
             self._advance(moves=not abandoned)
 
-    def _advance(self, moves: bool) -> None:
-        """One tick: the robots move to their reserved cells (``moves``) or all stand still."""
+    def _advance(self, moves: bool, movers: Container[int] | None = None) -> None:
+        """One tick: the robots move to their reserved cells (``moves``; only the robots in ``movers``, when
+        given, end their step) or all stand still."""
         self.tick += 1
         robots = self.robots
         cells = self.flat.cells
@@ -246,7 +247,7 @@ class RoundsSimulator:
             result = results[index]
             heading = robot.heading
             duration = cell_time
-            if moves:
+            if moves and (movers is None or index in movers):
                 was = robot.present
                 robot.finish_step()
                 if robot.present != was:

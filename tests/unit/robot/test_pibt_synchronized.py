@@ -1,0 +1,272 @@
+"""``pibt`` with a local synchronizer: robots end their own steps; no cell decided twice; every rule needed."""
+
+from pathlib import Path
+
+import pytest
+from test_pibt_live import BrainFleet, corridor
+from test_pibt_local import FAULTS, crowd
+
+from mrmp.core import Grid, NetworkFaults, PolicyOptions, RobotSpec, Scenario, Timing
+from mrmp.core.errors import InputError
+from mrmp.io import load_movingai_scenario
+from mrmp.live.pibt_agent import PibtBrain
+from mrmp.protocol.messages import BeaconMessage
+from mrmp.protocol.pibt_local import NO_CLAIM, CallAckMessage, CallReserveMessage
+from mrmp.robot.messaging import Outgoing
+from mrmp.robot.pibt_synchronized import SynchronizedPibtRobot
+from mrmp.search.flat_map import FlatMap
+from mrmp.sim.live_rounds import LiveRoundsSimulator
+from mrmp.sim.policy_table import pibt_simulator
+from mrmp.sim.synchronized_rounds import SynchronizedRoundsSimulator
+
+MAPS = Path(__file__).resolve().parents[3] / "maps"
+
+
+def synchronized(scenario):
+    return scenario.with_changes(policy=PolicyOptions(name="pibt", swap=scenario.policy.swap, synchronizer="local"))
+
+
+@pytest.mark.parametrize("faults", ["perfect", *FAULTS])
+@pytest.mark.parametrize("seed", range(10))
+def test_crowds_never_collide_and_no_cell_is_decided_twice(seed, faults):
+    network = FAULTS.get(faults, NetworkFaults())
+    scenario = synchronized(crowd(seed, density=0.5, max_ticks=300)).with_changes(network=network)
+    result = SynchronizedRoundsSimulator(scenario).run()
+    assert result.collisions == []
+    assert result.network["conflicting_decisions"] == 0
+    assert result.network["abandoned"] == 0
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_on_a_perfect_network_each_step_takes_one_tick_and_the_moves_are_the_live_brains_in_lockstep(seed):
+    scenario = synchronized(crowd(seed, density=0.3, max_ticks=400))
+    ended = SynchronizedRoundsSimulator(scenario).run()
+    lockstep = LiveRoundsSimulator(scenario, step_ticks=1).run()
+    assert ended.success and lockstep.success
+    assert [robot.path for robot in ended.robots] == [robot.path for robot in lockstep.robots]
+    assert ended.network["steps"] == ended.makespan
+
+
+def random_32(agents, network, seed=0, max_ticks=3000):
+    scenario = load_movingai_scenario(MAPS / "random-32-32-20.map", MAPS / "random-32-32-20-random-1.scen", agents)
+    return synchronized(scenario).with_changes(network=network, seed=seed, max_ticks=max_ticks)
+
+
+LOSSY = NetworkFaults(loss=0.2, delay_max=2)
+
+
+def test_over_twenty_percent_loss_every_robot_arrives_and_the_robots_count_their_synchronizer():
+    result = SynchronizedRoundsSimulator(random_32(30, LOSSY)).run()
+    network = result.network
+    assert result.success and result.collisions == []
+    assert network["lost"] > 0 and network["retransmissions"] > 0
+    assert network["late_acks"] > 0 and network["ahead"] > 0
+    assert network["abandoned"] == 0 and network["conflicting_decisions"] == 0
+
+
+# -- broken variants: each rule is needed ---------------------------------------------
+
+
+class EndsAlone(SynchronizedPibtRobot):
+    """Broken: ends its step once it decided, whether its neighbours did or not."""
+
+    @property
+    def step_done(self):
+        return self._done
+
+
+class IgnoresLaterSteps(SynchronizedPibtRobot):
+    """Broken: a message of a later step does not tell it that its sender decided (rule 4)."""
+
+    def _ahead(self, peer):
+        pass
+
+
+class AcknowledgesInThePast(SynchronizedPibtRobot):
+    """Broken: acknowledges a message of an ended step with an acknowledgement of that step (rule 3)."""
+
+    def _acknowledge_late(self, message):
+        self.seq += 1
+        elapsed, tie, _ = self._own_rank
+        ack = CallAckMessage(self.index, self.seq, message.step, message.seq, NO_CLAIM, self.index, elapsed, tie)
+        self._replies.append(Outgoing(ack, (message.sender,)))
+
+
+class StopsListeningOnceDecided(SynchronizedPibtRobot):
+    """Broken: once decided, it no longer notes who else decided (rule 2)."""
+
+    def receive(self, message):
+        if self._done and isinstance(message, CallReserveMessage) and message.step == self.step:
+            return super(SynchronizedPibtRobot, self).receive(message)
+        return super().receive(message)
+
+
+class Forgetful(SynchronizedPibtRobot):
+    """Broken: a peer is taken to be where it was last heard of, as if it had not moved since."""
+
+    def possibly_within(self, radius):
+        cells = self.flat.cells
+        x, y = cells[self.present]
+        return sorted(
+            peer for peer, (cell, _) in self.known.items() if abs(cells[cell][0] - x) + abs(cells[cell][1] - y) <= radius
+        )
+
+
+def run_with(brain, scenario):
+    class Simulator(SynchronizedRoundsSimulator):
+        robot_type = reliable_type = brain
+
+    simulator = Simulator(scenario)
+    return simulator.run(), min(robot.step for robot in simulator.robots)
+
+
+@pytest.mark.parametrize("brain", [EndsAlone, IgnoresLaterSteps, AcknowledgesInThePast, StopsListeningOnceDecided])
+def test_without_any_one_rule_the_fleet_stops_advancing_over_a_lossy_network(brain):
+    scenario = random_32(30, LOSSY, max_ticks=2000)
+    result, _ = run_with(SynchronizedPibtRobot, scenario)
+    assert result.success and result.makespan < 1500
+    broken, slowest_step = run_with(brain, scenario)
+    assert not broken.success and slowest_step <= 5  # some robot never got past its first steps in 2,000 ticks
+
+
+def test_a_robot_that_forgets_that_peers_move_decides_cells_that_others_decided():
+    conflicts = 0
+    for seed in range(2):
+        scenario = random_32(100, LOSSY, seed=seed, max_ticks=300)
+        assert run_with(SynchronizedPibtRobot, scenario)[0].network["conflicting_decisions"] == 0
+        broken, _ = run_with(Forgetful, scenario)
+        assert broken.collisions == []  # two bodies never enter one cell: both wait
+        conflicts += broken.network["conflicting_decisions"]
+    assert conflicts > 0
+
+
+# -- the brain's rules, one message at a time --------------------------------------------
+
+
+def pair():
+    flat = FlatMap(Grid(4, 1))
+    starts = [flat.index((0, 0)), flat.index((1, 0))]
+    a = SynchronizedPibtRobot(0, starts[0], flat.index((0, 0)), flat, tie=2, starts=starts)
+    b = SynchronizedPibtRobot(1, starts[1], flat.index((3, 0)), flat, tie=1, starts=starts)
+    return flat, a, b
+
+
+def exchange(robots, sent):
+    """Deliver ``sent`` (sender, item) pairs to the other robot until nothing more is sent."""
+    while sent:
+        for sender, item in sent:
+            robots[1 - sender].receive(item.message)
+        sent = [(robot.index, item) for robot in robots for item in robot.act()]
+
+
+def test_a_robot_ends_its_step_only_once_every_neighbour_decided():
+    _, a, b = pair()
+    robots = (a, b)
+    sent = [(robot.index, item) for robot in robots for item in robot.begin_step(1)]
+    decided_before_its_neighbour = 0
+    while sent:
+        for sender, item in sent:
+            robots[1 - sender].receive(item.message)
+        sent = [(robot.index, item) for robot in robots for item in robot.act()]
+        for robot, neighbour in ((a, b), (b, a)):
+            if robot.final and not neighbour.final:
+                decided_before_its_neighbour += 1
+                assert not robot.step_done
+    assert decided_before_its_neighbour > 0
+    assert a.step_done and b.step_done
+
+
+def test_a_message_of_an_ended_step_is_acknowledged_from_the_present_step():
+    flat, a, b = pair()
+    exchange((a, b), [(0, item) for item in a.begin_step(1)] + [(1, item) for item in b.begin_step(1)])
+    a.finish_step()
+    a.begin_step(2)
+    late = CallReserveMessage(1, 99, 1, flat.cells[b.present], 1, 0, 1, True)
+    assert a.receive(late)
+    acks = [item for item in a.act() if isinstance(item.message, CallAckMessage) and item.message.acked == 99]
+    assert [(item.message.step, item.recipients) for item in acks] == [(2, (1,))]
+    assert a.stats["late_acks"] == 1
+
+
+def test_a_message_of_a_later_step_marks_its_sender_done_and_stops_retransmissions_to_it():
+    flat, a, b = pair()
+    b_out = b.begin_step(1)
+    a.begin_step(1)
+    a.receive(b_out[0].message)
+    a.act()
+    assert any(1 in entry.pending for entry in a._unacknowledged.values())
+    beacon = BeaconMessage(1, 50, 2, flat.cells[b.present], flat.cells[b.goal], 0, 1)
+    assert a.receive(beacon)
+    assert 1 in a._final and a.stats["ahead"] == 1
+    assert all(1 not in entry.pending for entry in a._unacknowledged.values())
+    a.finish_step()
+    a.begin_step(2)  # the beacon kept for step 2 is taken in now
+    assert a.known[1] == (b.present, 2)
+
+
+def test_local_step_ends_need_local_sequencing():
+    scenario = crowd(0).with_changes(policy=PolicyOptions(name="pibt", sequencing="driver", synchronizer="local"))
+    with pytest.raises(InputError, match=r"policy\.synchronizer"):
+        pibt_simulator(scenario)
+    assert isinstance(pibt_simulator(synchronized(crowd(0))), SynchronizedRoundsSimulator)
+
+
+# -- live: PibtBrain with the synchronizer, simulated bodies on an in-memory network ------------------------
+
+
+def test_live_brains_that_end_their_own_steps_arrive_over_a_lossy_network_and_never_abandon_a_step():
+    for seed in range(3):
+        scenario = synchronized(crowd(seed, density=0.3, max_ticks=200))
+        fleet = BrainFleet(scenario, loss=0.2, seed=seed, tick=0.01)
+        fleet.run(until=120)
+        assert fleet.collisions() == [] and all(brain.settled for brain in fleet.brains)
+        assert fleet.most_pending <= 1  # a held robot decides no second move before its first is granted
+        assert sum(brain.robot.stats["abandoned"] for brain in fleet.brains) == 0
+        assert all(brain.synchronized for brain in fleet.brains)
+
+
+CROSS = (
+    RobotSpec("a", (0, 2), (4, 2)),
+    RobotSpec("b", (4, 2), (0, 2)),
+    RobotSpec("c", (2, 0), (2, 4)),
+    RobotSpec("d", (2, 4), (2, 0)),
+)
+
+
+@pytest.mark.parametrize("radius", [2, 8])
+def test_on_a_perfect_network_live_brains_that_end_their_own_steps_make_the_simulators_moves(radius):
+    """Two head-on pairs crossing around a pillar: the cells each robot enters, in order, are the simulator's
+    (held robots that gave up stayed a step longer, without changing what the fleet decided next)."""
+    policy = PolicyOptions(name="pibt", radius=radius, synchronizer="local")
+    scenario = Scenario(Grid(5, 5, [(2, 2)]), CROSS, timing=Timing(1.0, 0.5), policy=policy)
+    simulated = SynchronizedRoundsSimulator(scenario).run()
+    fleet = BrainFleet(scenario, time_scale=10)
+    fleet.run()
+    assert fleet.collisions() == [] and all(brain.settled for brain in fleet.brains)
+    assert sum(brain.robot.stats["gave_up"] for brain in fleet.brains) > 0
+    assert [distinct(path) for path in fleet.decided_paths()] == [distinct(robot.path) for robot in simulated.robots]
+
+
+def distinct(cells):
+    """``cells`` without repeats of the cell before."""
+    out = []
+    for cell in map(tuple, cells):
+        if not out or out[-1] != cell:
+            out.append(cell)
+    return out
+
+
+class NeverGivesUp(PibtBrain):
+    """A held robot that waits for its grant however long it takes (no ``give_up``)."""
+
+    def _expire_synchronized(self, now):
+        self._began = now
+        return super()._expire_synchronized(now)
+
+
+def test_a_held_robot_that_never_gives_up_makes_a_convoy_move_one_body_at_a_time():
+    convoy = synchronized(corridor())
+    giving_up = BrainFleet(convoy)
+    waiting = BrainFleet(convoy, brain_type=NeverGivesUp)
+    assert giving_up.run() < waiting.run()
+    assert giving_up.collisions() == waiting.collisions() == []
