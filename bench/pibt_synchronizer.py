@@ -15,8 +15,12 @@ ways:
 One line each: success, makespan in ticks, steps (the most any robot ended),
 ticks per step, abandoned robot-steps (a percentage), messages and
 retransmissions per robot and step, late acknowledgements and body waits per
-robot and step (synchronizer only), ticks at which two undone decisions
-claimed one cell (``confl``; must be 0) and wall seconds. Ticks, steps and
+robot and step (synchronizer only), the two audits of the synchronizer's
+simulator summed (``confl``: ticks at which two decisions not yet carried
+out claimed one cell, and steps two robots ended on one cell; must be 0) and
+wall seconds. Per robot and step divides by the robots and by ``steps``,
+which for the synchronizer is the most steps any robot ended (the others
+ended fewer). Ticks, steps and
 counts are deterministic for a seed; the seconds are only for comparing lines
 of one run.
 
@@ -96,13 +100,14 @@ def main() -> int:
                     raise SystemExit(f"{name}:{agents} {label}: the referee found collisions: {result.collisions[:3]}")
                 counts = result.network
                 steps = max(1, counts["steps"])
+                conflicts = counts.get("conflicting_decisions", 0) + counts.get("conflicting_steps", 0)
                 per = agents * steps
                 ticks = f"{result.makespan}" if result.success else f">{run.tick}"
                 print(
                     f"{name:<18} {agents:>4} {seed:>4} {label:<13} {100 * result.success:>6.0f}% {ticks:>6} {steps:>5}"
                     f" {run.tick / steps:>6.1f} {100 * counts['abandoned'] / per:>6.1f} {counts['messages'] / per:>7.2f}"
                     f" {counts['retransmissions'] / per:>8.2f} {counts.get('late_acks', 0) / per:>8.2f}"
-                    f" {counts.get('body_waits', 0) / per:>9.2f} {counts.get('conflicting_decisions', 0):>5} {wall:>6.1f}",
+                    f" {counts.get('body_waits', 0) / per:>9.2f} {conflicts:>5} {wall:>6.1f}",
                     flush=True,
                 )
     return 0

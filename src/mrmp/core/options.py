@@ -222,8 +222,8 @@ def synchronizer_setting() -> Any:
     """``synchronizer``: when a ``pibt`` robot ends its step, ``clock`` (a time common to all) or ``local`` (its own word)."""
     return setting(
         "clock",
-        help="pibt (local sequencing, simulated): when a robot ends its step: clock (a time common to all) or local "
-        "(once every robot within 2 cells has decided; a local synchronizer).",
+        help="pibt (local sequencing, simulated or live): when a robot ends its step: clock (a time common to all) or "
+        "local (once every robot within 2 cells has decided; a local synchronizer).",
         yaml_key="synchronizer", flag="--synchronizer", check=_one_of_synchronizers, choices=SYNCHRONIZERS,
     )  # fmt: skip
 

@@ -1,4 +1,4 @@
-"""The live driver of one ``pibt`` robot: locally sequenced PIBT in steps on a common clock, bodies guarded.
+"""The live driver of one ``pibt`` robot: locally sequenced PIBT, steps on a clock or ended by the robot, bodies guarded.
 
 No driver can order live processes, so a live ``pibt`` robot sequences its
 PIBT calls itself: its brain is :class:`~mrmp.robot.pibt_live.LivePibtRobot`
@@ -37,6 +37,13 @@ it with what a live robot adds, sans-IO (fed with the clock, never reading it):
   stays at its turn (``LivePibtRobot.held``): a robot leaves a cell only once its
   body owns it, which keeps the execution free of deadlocks (``docs/protocol.md``,
   "Local sequencing", "Live");
+* **or steps ended by the robots** (``synchronizer: local``): no step clock;
+  the brain is :class:`~mrmp.robot.pibt_synchronized.SynchronizedPibtRobot`,
+  which begins its next step the moment its step is done (it and every robot
+  within 2 cells decided for good), held while its last move is not granted;
+  a held robot gives up after ``hold`` seconds from its step's start, as on the
+  clock, and no step ends undecided (``docs/protocol.md``, "Live", "Steps
+  ended by the robots");
 * a peer silent for ``crash_after`` seconds is taken for crashed (an obstacle
   on its last known cell, no longer waited for), until it is heard again;
 * the brain's timers run in whole milliseconds since ``t0``.
@@ -277,7 +284,8 @@ class PibtBrain:
         Step 1 begins at ``t0``; step ``k + 1`` at once when step ``k`` is done
         (:attr:`~mrmp.robot.pibt_synchronized.SynchronizedPibtRobot.step_done`),
         held while the move decided in step ``k`` is not granted. A held robot
-        waits for its grant as long as it takes: no step ends undecided.
+        that has not been granted ``hold`` seconds after its step began gives up
+        and, at its turn, stays, as on the clock; no step ends undecided.
         """
         robot = self.robot
         assert isinstance(robot, SynchronizedPibtRobot)

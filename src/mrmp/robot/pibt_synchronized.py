@@ -38,8 +38,9 @@ apart while either decides. Counted: ``late_acks`` (rule 3) and ``ahead``
 
 Examples
 --------
-Two robots in a corridor of five cells, each on its way to the other's end:
-one decided robot alone may not end its step while its neighbour has not decided.
+A corridor of three cells with a bay beside its middle: robot 0 at one end
+bound for the other, robot 1 in the middle bound for robot 0's cell. Neither
+ends step 1 before both have decided.
 
 >>> from mrmp.core.grid import Grid
 >>> from mrmp.search.flat_map import FlatMap
@@ -58,26 +59,31 @@ one decided robot alone may not end its step while its neighbour has not decided
 >>> ended[0], ended[-1]
 ([False, False], [True, True])
 
-Robot 0 then ends its step and begins step 2 while robot 1 is still in step
-1: robot 1 takes robot 0's beacon of step 2 as proof that robot 0 is done.
+A robot that has not heard its neighbour decide takes the neighbour's beacon
+of the next step as proof of it (rule 4): robot 1's beacon of step 2 reaches
+a robot 2, in the bay, that heard nothing else.
 
->>> _ = a.finish_step()
->>> beacon = a.begin_step(2)[0].message
->>> b.receive(beacon), b.stats["ahead"]
-(True, 0)
+>>> c = SynchronizedPibtRobot(2, flat.index((1, 1)), flat.index((1, 1)), flat, starts=[*starts, flat.index((1, 1))])
+>>> _ = c.begin_step(1)
+>>> _ = b.finish_step()
+>>> beacon = b.begin_step(2)[0].message
+>>> c.receive(beacon), c.stats["ahead"], 1 in c._final
+(True, 1, True)
 """
 
 from __future__ import annotations
 
-from collections.abc import Iterable
-from typing import Any
+import random
+from collections.abc import Iterable, Sequence
 
+from mrmp.core.heading import Heading
 from mrmp.protocol.messages import BeaconMessage, PibtMessage
 from mrmp.protocol.pibt_local import NO_CLAIM, CallAckMessage, CallReserveMessage
 from mrmp.robot.messaging import Outgoing
 from mrmp.robot.pibt_live import LivePibtRobot
 from mrmp.robot.pibt_local import NO_RANK
-from mrmp.robot.pibt_robot import RESERVE_RADIUS
+from mrmp.robot.pibt_robot import MIN_RADIUS, RESERVE_RADIUS
+from mrmp.search.flat_map import FlatMap
 
 __all__ = ["SynchronizedPibtRobot"]
 
@@ -88,14 +94,39 @@ class SynchronizedPibtRobot(LivePibtRobot):
     Parameters are those of :class:`~mrmp.robot.pibt_live.LivePibtRobot`.
     """
 
-    def __init__(self, *args: Any, **kwargs: Any) -> None:
-        super().__init__(*args, **kwargs)
-        self._kept: set[tuple[int, int, int]] = set()
+    def __init__(
+        self,
+        index: int,
+        start: int,
+        goal: int,
+        flat: FlatMap,
+        *,
+        tie: int = 0,
+        heading: Heading = Heading.NORTH,
+        radius: int = MIN_RADIUS,
+        swap: bool = True,
+        heading_aware: bool = False,
+        turn_cost: float = 0.5,
+        rng: random.Random | None = None,
+        tie_penalties: bool | None = None,
+        retry: int = 1,
+        starts: Sequence[int] = (),
+        lookout: int = 2,
+    ) -> None:
+        self._kept: set[tuple[int, int, int]] = set()  # (sender, seq, step) of the messages kept for a later step
+        super().__init__(
+            index, start, goal, flat, tie=tie, heading=heading, radius=radius, swap=swap, heading_aware=heading_aware,
+            turn_cost=turn_cost, rng=rng, tie_penalties=tie_penalties, retry=retry, starts=starts, lookout=lookout,
+        )  # fmt: skip
 
     def begin_step(self, step: int, sensed: Iterable[int] = (), now: int = 0, held: bool = False) -> list[Outgoing]:
-        """As the live brain; the messages kept for this step are taken in once each."""
+        """As the live brain; the messages kept for this step are taken in once each, those of later steps kept on."""
+        later = [message for message in self._early if message.step > step]
+        self._early = [message for message in self._early if message.step <= step]
+        out = super().begin_step(step, sensed, now, held)
+        self._early.extend(later)
         self._kept = {key for key in self._kept if key[2] > step}
-        return super().begin_step(step, sensed, now, held)
+        return out
 
     def learn(self, peer: int, cell: int, step: int) -> None:
         """As the live brain; a peer waited for that this news puts out of reach is no longer waited for.
@@ -105,9 +136,15 @@ class SynchronizedPibtRobot(LivePibtRobot):
         away would never get it, and never answer with its own.
         """
         super().learn(peer, cell, step)
-        if peer in self._unknown and peer not in self.possibly_within(max(self.radius, RESERVE_RADIUS)):
+        if peer in self._unknown and not self._may_be_within(peer, max(self.radius, RESERVE_RADIUS)):
             self._unknown.discard(peer)
             self.wake = True
+
+    def _may_be_within(self, peer: int, radius: int) -> bool:
+        """Whether ``peer`` can stand within ``radius`` cells at the start of this step (as :meth:`possibly_within`)."""
+        cell, heard = self.known[peer]
+        (x, y), (px, py) = self.flat.cells[self.present], self.flat.cells[cell]
+        return abs(px - x) + abs(py - y) <= radius + max(0, self.step - heard)
 
     @property
     def step_done(self) -> bool:
@@ -141,16 +178,16 @@ class SynchronizedPibtRobot(LivePibtRobot):
         """Rules 2 to 4 (module docstring), then as the live brain; True when :meth:`act` should run."""
         step = self.step
         if message.step > step:
-            self._ahead(message.sender)
+            news = self._ahead(message.sender)
             if isinstance(message, CallAckMessage):
-                return True  # a late acknowledgement (rule 3): it acknowledges a message of this step
+                return news  # a late acknowledgement (rule 3): it acknowledges a message of this step
             key = (message.sender, message.seq, message.step)
             if key in self._kept:
                 self.dropped["duplicate"] += 1  # a second copy of a message kept for later: taken in once
             else:
                 self._kept.add(key)
                 super().receive(message)  # kept for the step it belongs to
-            return True
+            return news
         if message.step < step:
             if isinstance(message, CallAckMessage):
                 self.dropped["stale"] += 1
@@ -161,10 +198,13 @@ class SynchronizedPibtRobot(LivePibtRobot):
             self._final.add(message.sender)  # rule 2: the live brain ignores reservations once decided
         return super().receive(message)
 
-    def _ahead(self, peer: int) -> None:
-        """``peer`` is in a later step: it decided for good in this one and waits for nothing from here (rule 4)."""
+    def _ahead(self, peer: int) -> bool:
+        """``peer`` is in a later step: it decided for good in this one and waits for nothing from here (rule 4).
+
+        Returns whether that is news (the robot may then act on it).
+        """
         if peer == self.index or peer in self._final:
-            return
+            return False
         self.stats["ahead"] += 1
         if peer in self._ranks and self._ranks.get(peer, NO_RANK) > self._own_rank:
             self._above -= 1
@@ -175,6 +215,7 @@ class SynchronizedPibtRobot(LivePibtRobot):
         for entry in self._unacknowledged.values():
             entry.pending.discard(peer)
         self.wake = True
+        return True
 
     def _acknowledge_late(self, message: PibtMessage) -> None:
         """Answer a message of an ended step with an acknowledgement of this step (rule 3)."""

@@ -151,6 +151,13 @@ class PolicyEntry:
         return self.simulator(scenario, on_tick=on_tick)
 
 
+STEP_ENDS: dict[str, Callable[..., RoundsSimulator]] = {
+    "clock": LocalRoundsSimulator,
+    "local": SynchronizedRoundsSimulator,
+}
+"""``pibt``'s simulator with local sequencing, by ``synchronizer``: steps on a common clock, or ended by each robot."""
+
+
 def pibt_simulator(scenario: Scenario, on_tick: TickObserver | None = None) -> RoundsSimulator:
     """Policy ``pibt``'s simulator: the robots' calls ordered by the driver, or by the robots (``sequencing``).
 
@@ -170,12 +177,6 @@ def pibt_simulator(scenario: Scenario, on_tick: TickObserver | None = None) -> R
         )
     return RoundsSimulator(scenario, on_tick=on_tick)
 
-
-STEP_ENDS: dict[str, Callable[..., RoundsSimulator]] = {
-    "clock": LocalRoundsSimulator,
-    "local": SynchronizedRoundsSimulator,
-}
-"""``pibt``'s simulator with local sequencing, by ``synchronizer``: steps on a common clock, or ended by each robot."""
 
 POLICY_TABLE: dict[str, PolicyEntry] = {
     "thesis": PolicyEntry(

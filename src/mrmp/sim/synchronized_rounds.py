@@ -23,13 +23,16 @@ tick is:
 
 The simulator never reads a brain's private state to order or wait for the
 robots: it asks each brain only whether its step is done and which cell it
-decided on (what its body is told to do), and it counts, as an audit, the
-ticks at which two robots that decided for good, and have not yet moved,
-decided on the same cell or on each other's (``conflicting_decisions``;
-``docs/protocol.md``, "A local synchronizer", argues that it stays 0).
+decided on (what its body is told to do). It audits two things, which
+``docs/protocol.md``, "A local synchronizer", argues stay 0: the ticks at
+which two robots that decided for good, and have not yet moved, decided on
+the same cell (staying on it included) or on each other's
+(``conflicting_decisions``), and the robots that ended a step on a cell that
+another robot ended the same step on, or trading cells with it
+(``conflicting_steps``).
 
 The result's ``network`` holds the network's counts, the robots' own
-(``late_acks``, ``ahead``, ``retransmissions``, ``acks``, ``waits`` ...),
+(``late_acks``, ``ahead``, ``pulled``, ``retransmissions``, ``acks``, ``waits`` ...),
 ``steps`` (the most steps a robot ended) and ``abandoned`` (always 0: a robot
 never ends a step undecided).
 
@@ -42,7 +45,7 @@ Examples
 >>> swap = Scenario(Grid(5, 5), (RobotSpec("A", (0, 2), (4, 2)), RobotSpec("B", (4, 2), (0, 2))),
 ...                 policy=PolicyOptions(name="pibt", synchronizer="local"))
 >>> result = SynchronizedRoundsSimulator(swap).run()
->>> result.success, result.sum_of_costs, result.network["abandoned"], result.network["conflicting_decisions"]
+>>> result.success, result.sum_of_costs, result.network["conflicting_decisions"], result.network["conflicting_steps"]
 (True, 11, 0, 0)
 >>> lossy = swap.with_changes(network=NetworkFaults(loss=0.3, delay_max=2))
 >>> result = SynchronizedRoundsSimulator(lossy).run()
@@ -56,6 +59,7 @@ from collections import Counter
 
 from mrmp.core.result import RunResult
 from mrmp.core.scenario import Scenario
+from mrmp.robot.messaging import Outgoing
 from mrmp.robot.pibt_reliable import ReliablePibtRobot
 from mrmp.robot.pibt_synchronized import SynchronizedPibtRobot
 from mrmp.sim.live_rounds import LiveRoundsSimulator
@@ -64,8 +68,11 @@ from mrmp.sim.ticking import TickObserver
 
 __all__ = ["SynchronizedRoundsSimulator"]
 
-SYNCHRONIZER_COUNTS = ("late_acks", "ahead", "pulled", "body_waits", "conflicting_decisions")
-"""Counts reported in the result's ``network`` besides those of :class:`~mrmp.sim.local_rounds.LocalRoundsSimulator`."""
+ROBOT_COUNTS = ("late_acks", "ahead", "pulled")
+"""The robots' own counts reported in the result's ``network`` besides those of
+:class:`~mrmp.sim.local_rounds.LocalRoundsSimulator`."""
+SIMULATOR_COUNTS = ("body_waits", "conflicting_decisions", "conflicting_steps")
+"""The simulator's counts reported in the result's ``network``: bodies that waited, and the two audits."""
 
 
 class SynchronizedRoundsSimulator(LiveRoundsSimulator):
@@ -89,6 +96,7 @@ class SynchronizedRoundsSimulator(LiveRoundsSimulator):
     ) -> None:
         super().__init__(scenario, random_ties, on_tick, tie_penalties, step_ticks)
         self._begun = False
+        self._ended: dict[int, dict[int, int]] = {}  # step -> cell ended on -> cell begun on, over the robots that ended it
 
     def step(self) -> None:
         """One tick: timers and acts, deliveries, then the bodies of the robots whose step is done (module docstring)."""
@@ -108,6 +116,7 @@ class SynchronizedRoundsSimulator(LiveRoundsSimulator):
                 send(robot.index, item, now)
         self._deliver_rounds(now)
         movers = self._movers()
+        self._record_steps(movers)
         self._advance(moves=True, movers=set(movers))
         occupant = self._occupant
         for index in movers:
@@ -116,6 +125,11 @@ class SynchronizedRoundsSimulator(LiveRoundsSimulator):
             for item in robot.begin_step(robot.step + 1, (), self.tick):
                 send(index, item, self.tick)
         self.step_count = max(self.step_count, *(robot.step - 1 for robot in robots)) if robots else 0
+
+    def _address(self, sender: int, item: Outgoing) -> tuple[int, ...]:
+        """The recipients ``item`` names: a live brain names them all (no radio, whose bodies here move every tick)."""
+        assert item.recipients is not None, "a live brain addresses every message by name"
+        return item.recipients
 
     def _movers(self) -> list[int]:
         """The robots whose step is done and whose body can enter its cell now, the cells they leave emptied.
@@ -159,23 +173,44 @@ class SynchronizedRoundsSimulator(LiveRoundsSimulator):
         return movers
 
     def _audit(self, decided: dict[int, int]) -> None:
-        """Count a tick at which two robots decided for good, not yet moved, on one cell or on each other's."""
+        """Count a tick at which two robots decided for good, not yet moved, on one cell (staying on it
+        included) or on each other's."""
         robots = self.robots
         occupant = self._occupant
         claimed: set[int] = set()
         for index, target in decided.items():
             here = robots[index].present
-            if target == here:
-                continue
             other = occupant[target]
-            if target in claimed or (other != NO_ROBOT and decided.get(other) == here):
+            swaps = target != here and other != NO_ROBOT and decided.get(other) == here
+            if target in claimed or swaps:
                 self.stats["conflicting_decisions"] += 1
                 return
             claimed.add(target)
 
+    def _record_steps(self, movers: list[int]) -> None:
+        """Check, as the robots end their steps, that no two ended step ``k`` on one cell or trading cells.
+
+        Every robot's step ``k`` goes from the cell it began on to the cell it
+        ended on; over the robots that end step ``k`` (at whatever tick), those
+        cells must be a move of central PIBT's kind: no cell entered or kept
+        by two, no two robots trading cells (``conflicting_steps``).
+        """
+        robots = self.robots
+        for index in movers:
+            robot = robots[index]
+            assert robot.target is not None
+            step, here, there = robot.step, robot.present, robot.target
+            ended = self._ended.setdefault(step, {})
+            if there in ended or (here != there and ended.get(here) == there):
+                self.stats["conflicting_steps"] += 1
+            ended[there] = here  # the cell ended on -> the cell begun on
+        slowest = min(robot.step for robot in robots)
+        for step in [step for step in self._ended if step < slowest]:
+            del self._ended[step]  # every robot has ended it: nothing more to check against
+
     def _result(self, stop_reason: str, wall_time: float) -> RunResult:
         result = super()._result(stop_reason, wall_time)
-        counts = {name: sum(robot.stats[name] for robot in self.robots) for name in ("late_acks", "ahead", "pulled")}
-        counts.update({name: self.stats[name] for name in ("body_waits", "conflicting_decisions")})
+        counts = {name: sum(robot.stats[name] for robot in self.robots) for name in ROBOT_COUNTS}
+        counts.update({name: self.stats[name] for name in SIMULATOR_COUNTS})
         result.network.update(counts)
         return result
