@@ -268,15 +268,20 @@ class PibtBrain:
             self._act = True
         self._crash_silent(now)
         if self._deciding:
-            resent = robot.on_tick(self._ms(now))
-            out.extend(resent)
-            if self._act or robot.wake or resent:
-                self._act = False
-                out.extend(robot.act())
-            if robot.final and self._decided is None:
-                self._queue_decided()
+            self._run_brain(now, out)
         out.extend(self._stamped(self.safety.expire(now)))
         return out
+
+    def _run_brain(self, now: float, out: list[Outgoing]) -> None:
+        """The brain's timers, its act when something is to act on, and its move queued once decided for good."""
+        robot = self.robot
+        resent = robot.on_tick(self._ms(now))
+        out.extend(resent)
+        if self._act or robot.wake or resent:
+            self._act = False
+            out.extend(robot.act())
+        if robot.final and self._decided is None:
+            self._queue_decided()
 
     def _expire_synchronized(self, now: float) -> list[Outgoing]:
         """:meth:`expire` with a local synchronizer: the robot ends its step when its brain says so, not on a clock.
@@ -295,13 +300,7 @@ class PibtBrain:
         if now - self._began >= self.timing.hold:
             robot.give_up()
         self._crash_silent(now)
-        resent = robot.on_tick(self._ms(now))
-        out.extend(resent)
-        if self._act or robot.wake or resent:
-            self._act = False
-            out.extend(robot.act())
-        if robot.final and self._decided is None:
-            self._queue_decided()
+        self._run_brain(now, out)
         if robot.step_done:
             self._finish_step()
             self._begin_next_step(now, out)

@@ -31,9 +31,10 @@ messages of the pulse were acknowledged). Four rules on top of the live brain
 
 Messages of a later step are kept for that step, as in the live brain; their
 senders wait, since a robot decides in a step only with this step's beacon of
-every peer that can be within 2 cells. So two robots within 2 cells of each
-other decide in the same step, and neighbours are never more than one step
-apart while either decides. Counted: ``late_acks`` (rule 3) and ``ahead``
+every peer that can be within 2 cells. So a robot deciding in step ``k``
+knows every robot that could rival it in step ``k``, and a robot already in a
+later step stands at least 2 cells away and waits for it (``docs/protocol.md``,
+"Why no cell is decided twice"). Counted: ``late_acks`` (rule 3) and ``ahead``
 (peers found in a later step, rule 4), with the live brain's counts.
 
 Examples
@@ -73,17 +74,14 @@ a robot 2, in the bay, that heard nothing else.
 
 from __future__ import annotations
 
-import random
-from collections.abc import Iterable, Sequence
+from collections.abc import Iterable
 
-from mrmp.core.heading import Heading
 from mrmp.protocol.messages import BeaconMessage, PibtMessage
 from mrmp.protocol.pibt_local import NO_CLAIM, CallAckMessage, CallReserveMessage
 from mrmp.robot.messaging import Outgoing
 from mrmp.robot.pibt_live import LivePibtRobot
 from mrmp.robot.pibt_local import NO_RANK
-from mrmp.robot.pibt_robot import MIN_RADIUS, RESERVE_RADIUS
-from mrmp.search.flat_map import FlatMap
+from mrmp.robot.pibt_robot import RESERVE_RADIUS
 
 __all__ = ["SynchronizedPibtRobot"]
 
@@ -94,38 +92,12 @@ class SynchronizedPibtRobot(LivePibtRobot):
     Parameters are those of :class:`~mrmp.robot.pibt_live.LivePibtRobot`.
     """
 
-    def __init__(
-        self,
-        index: int,
-        start: int,
-        goal: int,
-        flat: FlatMap,
-        *,
-        tie: int = 0,
-        heading: Heading = Heading.NORTH,
-        radius: int = MIN_RADIUS,
-        swap: bool = True,
-        heading_aware: bool = False,
-        turn_cost: float = 0.5,
-        rng: random.Random | None = None,
-        tie_penalties: bool | None = None,
-        retry: int = 1,
-        starts: Sequence[int] = (),
-        lookout: int = 2,
-    ) -> None:
-        self._kept: set[tuple[int, int, int]] = set()  # (sender, seq, step) of the messages kept for a later step
-        super().__init__(
-            index, start, goal, flat, tie=tie, heading=heading, radius=radius, swap=swap, heading_aware=heading_aware,
-            turn_cost=turn_cost, rng=rng, tie_penalties=tie_penalties, retry=retry, starts=starts, lookout=lookout,
-        )  # fmt: skip
-
     def begin_step(self, step: int, sensed: Iterable[int] = (), now: int = 0, held: bool = False) -> list[Outgoing]:
         """As the live brain; the messages kept for this step are taken in once each, those of later steps kept on."""
         later = [message for message in self._early if message.step > step]
         self._early = [message for message in self._early if message.step <= step]
         out = super().begin_step(step, sensed, now, held)
         self._early.extend(later)
-        self._kept = {key for key in self._kept if key[2] > step}
         return out
 
     def learn(self, peer: int, cell: int, step: int) -> None:
@@ -181,11 +153,9 @@ class SynchronizedPibtRobot(LivePibtRobot):
             news = self._ahead(message.sender)
             if isinstance(message, CallAckMessage):
                 return news  # a late acknowledgement (rule 3): it acknowledges a message of this step
-            key = (message.sender, message.seq, message.step)
-            if key in self._kept:
+            if message in self._early:
                 self.dropped["duplicate"] += 1  # a second copy of a message kept for later: taken in once
             else:
-                self._kept.add(key)
                 super().receive(message)  # kept for the step it belongs to
             return news
         if message.step < step:
@@ -206,8 +176,8 @@ class SynchronizedPibtRobot(LivePibtRobot):
         if peer == self.index or peer in self._final:
             return False
         self.stats["ahead"] += 1
-        if peer in self._ranks and self._ranks.get(peer, NO_RANK) > self._own_rank:
-            self._above -= 1
+        if self._ranks.get(peer, NO_RANK) > self._own_rank:
+            self._above -= 1  # a robot heard that outranks it is no longer undecided
         self._final.add(peer)
         self._calls.pop(peer, None)
         self._unknown.discard(peer)

@@ -58,13 +58,11 @@ from __future__ import annotations
 from collections import Counter
 
 from mrmp.core.result import RunResult
-from mrmp.core.scenario import Scenario
 from mrmp.robot.messaging import Outgoing
 from mrmp.robot.pibt_reliable import ReliablePibtRobot
 from mrmp.robot.pibt_synchronized import SynchronizedPibtRobot
 from mrmp.sim.live_rounds import LiveRoundsSimulator
 from mrmp.sim.rounds import NO_ROBOT
-from mrmp.sim.ticking import TickObserver
 
 __all__ = ["SynchronizedRoundsSimulator"]
 
@@ -86,28 +84,22 @@ class SynchronizedRoundsSimulator(LiveRoundsSimulator):
     reliable_type: type[ReliablePibtRobot] = SynchronizedPibtRobot
     robots: list[SynchronizedPibtRobot]  # type: ignore[assignment]
 
-    def __init__(
-        self,
-        scenario: Scenario,
-        random_ties: bool = True,
-        on_tick: TickObserver | None = None,
-        tie_penalties: bool | None = None,
-        step_ticks: int | None = None,
-    ) -> None:
-        super().__init__(scenario, random_ties, on_tick, tie_penalties, step_ticks)
-        self._begun = False
-        self._ended: dict[int, dict[int, int]] = {}  # step -> cell ended on -> cell begun on, over the robots that ended it
+    _ended: dict[int, dict[int, int]]
+    """Per step, the cell each robot that ended it ended on -> the cell it began on (:meth:`_record_steps`)."""
+
+    def run(self) -> RunResult:
+        """Begin every robot's step 1, then run as :meth:`RoundsSimulator.run <mrmp.sim.rounds.RoundsSimulator.run>`."""
+        self._ended = {}
+        self._place_bodies()
+        for robot in self.robots:
+            for item in robot.begin_step(1, (), self.tick):
+                self._send(robot.index, item, self.tick)
+        return super().run()
 
     def step(self) -> None:
         """One tick: timers and acts, deliveries, then the bodies of the robots whose step is done (module docstring)."""
         robots = self.robots
         send = self._send
-        if not self._begun:
-            self._begun = True
-            self._place_bodies()
-            for robot in robots:
-                for item in robot.begin_step(1, (), self.tick):
-                    send(robot.index, item, self.tick)
         now = self.tick
         for robot in robots:
             for item in robot.on_tick(now):

@@ -3,7 +3,7 @@
 from pathlib import Path
 
 import pytest
-from test_pibt_live import BrainFleet, corridor
+from test_pibt_live import BrainFleet, Forgetful, corridor
 from test_pibt_local import FAULTS, crowd
 
 from mrmp.core import Grid, NetworkFaults, PolicyOptions, RobotSpec, Scenario, Timing
@@ -113,15 +113,8 @@ class StopsListeningOnceDecided(SynchronizedPibtRobot):
         return super().receive(message)
 
 
-class Forgetful(SynchronizedPibtRobot):
-    """Broken: a peer is taken to be where it was last heard of, as if it had not moved since."""
-
-    def possibly_within(self, radius):
-        cells = self.flat.cells
-        x, y = cells[self.present]
-        return sorted(
-            peer for peer, (cell, _) in self.known.items() if abs(cells[cell][0] - x) + abs(cells[cell][1] - y) <= radius
-        )
+class ForgetfulSynchronized(Forgetful, SynchronizedPibtRobot):
+    """Broken (as ``Forgetful``): a peer is taken to be where it was last heard of, as if it had not moved since."""
 
 
 def run_with(brain, scenario):
@@ -146,7 +139,7 @@ def test_a_robot_that_forgets_that_peers_move_decides_cells_that_others_decided(
     for seed in range(2):
         scenario = random_32(100, LOSSY, seed=seed, max_ticks=300)
         assert run_with(SynchronizedPibtRobot, scenario)[0].network["conflicting_decisions"] == 0
-        broken, _ = run_with(Forgetful, scenario)
+        broken, _ = run_with(ForgetfulSynchronized, scenario)
         assert broken.collisions == []  # two bodies never enter one cell: both wait
         conflicts += broken.network["conflicting_decisions"]
     assert conflicts > 0
