@@ -37,6 +37,7 @@ from pathlib import Path
 
 from mrmp.core import NetworkFaults, PolicyOptions
 from mrmp.core.errors import InputError
+from mrmp.core.scenario import scenario_problems
 from mrmp.io import load_movingai_scenario
 from mrmp.sim.live_rounds import LiveRoundsSimulator
 from mrmp.sim.local_rounds import LocalRoundsSimulator
@@ -75,7 +76,11 @@ def main() -> int:
             if not agents.isdigit() or int(agents) < 1:
                 raise InputError(f"--only: {case!r} is not MAP:N with N at least 1")
             map_path, scen = arguments.maps / f"{name}.map", arguments.maps / f"{name}-random-1.scen"
-            cases.append((name, load_movingai_scenario(map_path, scen, int(agents))))
+            base = load_movingai_scenario(map_path, scen, int(agents))
+            problems = scenario_problems(base.with_changes(network=network, max_ticks=arguments.limit or None))
+            if problems:
+                raise InputError(problems[0])
+            cases.append((name, base))
     except InputError as error:
         print(f"pibt_synchronizer: {error}", file=sys.stderr)
         return 2
