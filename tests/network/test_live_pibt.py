@@ -23,6 +23,7 @@ from mrmp.live.launcher import LiveOptions, run_live
 from mrmp.live.transport import LiveFaults
 from mrmp.live.transport_entry import free_ports
 from mrmp.sim.live_rounds import LiveRoundsSimulator
+from mrmp.sim.synchronized_rounds import SynchronizedRoundsSimulator
 
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 SWAP = EXAMPLES / "thesis-swap.yaml"
@@ -101,6 +102,22 @@ def test_a_live_fleet_moves_as_the_simulator_running_the_same_brain(tmp_path):
     assert live.collisions == [] and live.success, live.stop_reason
     counts = pibt_counts(live)
     assert counts.get("abandoned", 0) == 0 and counts.get("gave_up", 0) == 0, counts
+    for index, robot in enumerate(simulated.robots):
+        report = json.loads((results / f"agent-{index}.json").read_text())
+        assert distinct(cell for _, cell in report["believed_path"]) == distinct(robot.path), robot.robot_id
+
+
+def test_a_live_fleet_that_ends_its_own_steps_moves_as_the_simulator_running_the_same_brain(tmp_path):
+    """``synchronizer: local``, perfect network, a radius that covers the map: the cells each robot enters, in order,
+    are those of :class:`~mrmp.sim.synchronized_rounds.SynchronizedRoundsSimulator` (a held robot that gives up
+    only stays a step longer)."""
+    scenario = crossing(radius=8).with_changes(policy=PolicyOptions(name="pibt", radius=8, synchronizer="local"))
+    simulated = SynchronizedRoundsSimulator(scenario).run()
+    assert simulated.success
+    results = tmp_path / "run"
+    live = run_live(scenario, LiveOptions(results=results, time_scale=10, seed=0))
+    assert live.collisions == [] and live.success, live.stop_reason
+    assert pibt_counts(live)["ahead"] > 0  # the robots were in steps of their own
     for index, robot in enumerate(simulated.robots):
         report = json.loads((results / f"agent-{index}.json").read_text())
         assert distinct(cell for _, cell in report["believed_path"]) == distinct(robot.path), robot.robot_id
