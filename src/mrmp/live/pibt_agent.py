@@ -262,10 +262,7 @@ class PibtBrain:
         if now >= begins:
             if self._deciding:
                 self._finish_step()
-            self.step += 1
-            out.extend(robot.begin_step(self.step, now=self._ms(now), held=bool(self.queue)))
-            self._deciding = True
-            self._act = True
+            self._begin_next_step(now, out)
         self._crash_silent(now)
         if self._deciding:
             self._run_brain(now, out)
@@ -304,18 +301,17 @@ class PibtBrain:
         if robot.step_done:
             self._finish_step()
             self._begin_next_step(now, out)
+            self._run_brain(now, out)
         out.extend(self._stamped(self.safety.expire(now)))
         return out
 
     def _begin_next_step(self, now: float, out: list[Outgoing]) -> None:
-        """Begin the next step at once and act on it (the synchronizer's step, :meth:`_expire_synchronized`)."""
+        """Begin the next step, held while a queued move is not granted; the brain acts on it at its next run."""
         self.step += 1
         self._began = now
-        robot = self.robot
-        out.extend(robot.begin_step(self.step, now=self._ms(now), held=bool(self.queue)))
-        out.extend(robot.act())
+        out.extend(self.robot.begin_step(self.step, now=self._ms(now), held=bool(self.queue)))
         self._deciding = True
-        self._act = False
+        self._act = True
 
     def _crash_silent(self, now: float) -> None:
         """Take every peer silent for ``crash_after`` seconds for crashed."""

@@ -116,7 +116,7 @@ class SynchronizedRoundsSimulator(LiveRoundsSimulator):
             occupant[robot.present] = index
             for item in robot.begin_step(robot.step + 1, (), self.tick):
                 send(index, item, self.tick)
-        self.step_count = max(self.step_count, *(robot.step - 1 for robot in robots)) if robots else 0
+        self.step_count = max((robot.step for robot in robots), default=1) - 1  # the most steps a robot ended
 
     def _address(self, sender: int, item: Outgoing) -> tuple[int, ...]:
         """The recipients ``item`` names: a live brain names them all (no radio, whose bodies here move every tick)."""
@@ -159,8 +159,9 @@ class SynchronizedRoundsSimulator(LiveRoundsSimulator):
             if follower is not None:
                 movers.append(follower)
         for index in movers:
-            if ready[index] != robots[index].present and occupant[robots[index].present] == index:
-                occupant[robots[index].present] = NO_ROBOT
+            here = robots[index].present
+            if ready[index] != here:
+                occupant[here] = NO_ROBOT  # its body leaves: step() puts it on its new cell after the move
         self.stats["body_waits"] += len(ready) - len(movers)
         return movers
 
