@@ -134,10 +134,25 @@ class LivePibtRobot(ReliablePibtRobot):
                 self.learn(peer, cell, step)
 
     def learn(self, peer: int, cell: int, step: int) -> None:
-        """Know that ``peer`` stood on ``cell`` at the start of ``step`` (older news than what is known is ignored)."""
+        """Know that ``peer`` stood on ``cell`` at the start of ``step`` (older news than what is known is ignored).
+
+        A peer waited for that this news puts out of reach is no longer waited
+        for: the robot's beacon, sent again while it waits, goes only to the
+        peers that can be near, so a peer that fresher news (a fleet heartbeat)
+        put farther away would never get it, and never answer with its own.
+        """
         old = self.known.get(peer)
         if old is None or step >= old[1]:
             self.known[peer] = (cell, step)
+        if peer in self._unknown and not self._may_be_within(peer, max(self.radius, RESERVE_RADIUS)):
+            self._unknown.discard(peer)
+            self.wake = True
+
+    def _may_be_within(self, peer: int, radius: int) -> bool:
+        """Whether ``peer`` can stand within ``radius`` cells at the start of this step (as :meth:`possibly_within`)."""
+        cell, heard = self.known[peer]
+        (x, y), (px, py) = self.flat.cells[self.present], self.flat.cells[cell]
+        return abs(px - x) + abs(py - y) <= radius + max(0, self.step - heard)
 
     def possibly_within(self, radius: int) -> list[int]:
         """The peers that can stand within ``radius`` cells at the start of this step (module docstring)."""

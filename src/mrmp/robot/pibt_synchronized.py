@@ -100,24 +100,6 @@ class SynchronizedPibtRobot(LivePibtRobot):
         self._early.extend(later)
         return out
 
-    def learn(self, peer: int, cell: int, step: int) -> None:
-        """As the live brain; a peer waited for that this news puts out of reach is no longer waited for.
-
-        A robot's beacon, sent again while it waits, goes only to the peers
-        that can be near: one that fresher news (a fleet heartbeat) put farther
-        away would never get it, and never answer with its own.
-        """
-        super().learn(peer, cell, step)
-        if peer in self._unknown and not self._may_be_within(peer, max(self.radius, RESERVE_RADIUS)):
-            self._unknown.discard(peer)
-            self.wake = True
-
-    def _may_be_within(self, peer: int, radius: int) -> bool:
-        """Whether ``peer`` can stand within ``radius`` cells at the start of this step (as :meth:`possibly_within`)."""
-        cell, heard = self.known[peer]
-        (x, y), (px, py) = self.flat.cells[self.present], self.flat.cells[cell]
-        return abs(px - x) + abs(py - y) <= radius + max(0, self.step - heard)
-
     @property
     def step_done(self) -> bool:
         """Whether the robot may end its step: it and every robot it knows within 2 cells decided for good (rule 1)."""

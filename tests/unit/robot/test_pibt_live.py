@@ -16,6 +16,7 @@ from mrmp.protocol.messages import BeaconMessage
 from mrmp.protocol.pibt_local import CallInheritMessage, CallReserveMessage
 from mrmp.robot.messaging import Outgoing
 from mrmp.robot.pibt_live import LivePibtRobot
+from mrmp.robot.pibt_synchronized import SynchronizedPibtRobot
 from mrmp.search.flat_map import FlatMap
 from mrmp.sim.live_rounds import LiveRoundsSimulator
 
@@ -77,6 +78,18 @@ def test_a_peer_not_heard_of_for_steps_is_waited_for_and_its_beacon_pulled():
     assert [item.recipients for item in answers] == [(0,)] and b.stats["pulled"] == 1
     a.receive(answers[0].message)
     assert a.complete and a.known[1] == (cells[6], 5)
+
+
+@pytest.mark.parametrize("brain", [LivePibtRobot, SynchronizedPibtRobot])
+def test_a_peer_that_fresher_news_puts_out_of_reach_is_no_longer_waited_for(brain):
+    flat, cells = line(12)
+    a = brain(0, cells[0], cells[1], flat, starts=[cells[0], cells[4]])
+    sent = a.begin_step(3)  # no news for two steps: robot 1, 4 cells away at step 1, can be within 2 now
+    assert [item.recipients for item in sent] == [(1,)] and not a.complete
+    a.learn(1, cells[11], 3)  # a fleet heartbeat: at the start of this step it stood 11 cells away
+    assert a.complete and a.wake
+    resent = a.on_tick(10 * a.retry)
+    assert all(1 not in (item.recipients or ()) for item in resent)  # nor asked again for a beacon that will not come
 
 
 def test_a_message_of_the_next_step_waits_for_that_step():
