@@ -34,7 +34,7 @@ Examples
 
 from __future__ import annotations
 
-from dataclasses import dataclass
+from dataclasses import dataclass, fields
 from typing import Any, Self
 
 from mrmp.core.cell import Cell
@@ -63,9 +63,9 @@ class Message:
         >>> ClaimMessage(2, 0, 5, (1, 1)).with_seq(9)
         ClaimMessage(sender=2, seq=9, claim=5, cell=(1, 1))
         """
-        cls: Any = type(self)
-        names: tuple[str, ...] = cls.__slots__  # a slotted dataclass: its fields, in order
-        copy: Self = cls(self.sender, seq, *[getattr(self, name) for name in names[2:]])
+        message: Any = self  # every message type is a dataclass: its fields, in declared order
+        values = [getattr(message, field.name) for field in fields(message)]
+        copy: Self = type(message)(self.sender, seq, *values[2:])
         return copy
 
 

@@ -12,7 +12,12 @@ acknowledged (:class:`CallAckMessage`), and the acknowledgement carries the
 acknowledging robot's own reservation, so that two calls claiming one cell
 hear of it before either claim is confirmed.
 
-Registered in the message table (:mod:`mrmp.protocol.wire`) under codes 40 to 42.
+A robot that senses no body (the live brain, :mod:`mrmp.robot.pibt_live`)
+sends :class:`NewsBeaconMessage`: a beacon that also says where the sender
+last heard some peers stood, so that its neighbours learn of the robots around
+it without hearing each of them.
+
+Registered in the message table (:mod:`mrmp.protocol.wire`) under codes 40 to 43.
 
 Examples
 --------
@@ -24,6 +29,9 @@ Examples
 7
 >>> decode(encode(CallAckMessage(4, 1, 12, 9, NO_CLAIM, 0, 0, 0))).claim
 (-1, -1)
+>>> beacon = NewsBeaconMessage(3, 11, 12, (4, 5), (9, 9), 2, 30, news=((7, (4, 8), 11), (8, (2, 5), 12)))
+>>> decode(encode(beacon)) == beacon, len(encode(beacon))
+(True, 72)
 """
 
 from __future__ import annotations
@@ -32,11 +40,19 @@ from dataclasses import dataclass
 from typing import Any
 
 from mrmp.core.cell import Cell
-from mrmp.protocol import formats  # noqa: F401  (the project's own types first, so codes never clash silently)
-from mrmp.protocol.messages import PibtMessage
+from mrmp.protocol.formats import BEACON  # the project's own types first, so codes never clash silently
+from mrmp.protocol.messages import MAX_VISITED_CELLS, BeaconMessage, PibtMessage
 from mrmp.protocol.wire import DecodeError, WireFormat, register
 
-__all__ = ["NO_CLAIM", "CallAckMessage", "CallInheritMessage", "CallReserveMessage"]
+__all__ = [
+    "MAX_NEWS",
+    "NO_CLAIM",
+    "CallAckMessage",
+    "CallInheritMessage",
+    "CallReserveMessage",
+    "News",
+    "NewsBeaconMessage",
+]
 
 NO_CLAIM = (-1, -1)
 """The ``claim`` of an acknowledgement from a robot that holds no reservation."""
@@ -110,6 +126,45 @@ class CallAckMessage(PibtMessage):
         return (self.root_elapsed, self.root_tie, -self.root)
 
 
+News = tuple[int, Cell, int]
+"""``(peer, cell, step)``: robot ``peer`` stood on ``cell`` at the start of step ``step``."""
+
+MAX_NEWS = MAX_VISITED_CELLS // 2
+"""Most entries a :class:`NewsBeaconMessage` carries (each takes two cells on the wire)."""
+
+
+@dataclass(frozen=True, slots=True)
+class NewsBeaconMessage(BeaconMessage):
+    """A beacon (:class:`~mrmp.protocol.messages.BeaconMessage`) that also tells ``news``: where peers stood.
+
+    Every entry is a fact its sender learnt first hand or was told:
+    ``(peer, cell, step)``, robot ``peer`` stood on ``cell`` at the start of
+    step ``step``; at most :data:`MAX_NEWS` of them. On the wire each entry
+    is two cells: ``(peer, step)``, then ``cell``.
+    """
+
+    news: tuple[News, ...] = ()
+
+
+def _news_cells(message: NewsBeaconMessage) -> tuple[Cell, ...]:
+    if len(message.news) > MAX_NEWS:
+        raise ValueError(f"{len(message.news)} news entries, at most {MAX_NEWS}")
+    return tuple(cell for peer, place, step in message.news for cell in ((peer, step), place))
+
+
+def _unpack_news_beacon(sender: int, seq: int, fields: Any, cells: tuple[Cell, ...]) -> NewsBeaconMessage:
+    if len(cells) % 2:
+        raise DecodeError("malformed", f"news beacon with {len(cells)} cells, not pairs")
+    news = tuple(((peer, step), place) for (peer, step), place in zip(cells[::2], cells[1::2], strict=True))
+    if any(peer < 0 or step < 0 for (peer, step), _ in news):
+        raise DecodeError("malformed", "news of a negative robot or step")
+    beacon = BEACON.unpack(sender, seq, fields, ())
+    return NewsBeaconMessage(
+        sender, seq, beacon.step, beacon.present, beacon.goal, beacon.elapsed, beacon.tie, beacon.heading,
+        tuple((peer, place, step) for (peer, step), place in news),
+    )  # fmt: skip
+
+
 def _unpack_reserve(sender: int, seq: int, fields: Any, _: tuple[Cell, ...]) -> CallReserveMessage:
     step, x, y, root, elapsed, tie, final = fields
     if final > 1:
@@ -150,4 +205,7 @@ CALL_ACK = register(
         lambda m: (m.step, m.acked, *m.claim, m.root, m.root_elapsed, m.root_tie, int(m.settled)),
         _unpack_ack,
     )
+)
+NEWS_BEACON = register(
+    WireFormat(43, NewsBeaconMessage, BEACON.layout + "B", BEACON.pack, _unpack_news_beacon, cells=_news_cells)
 )

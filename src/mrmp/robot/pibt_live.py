@@ -22,7 +22,12 @@ it knows instead (``docs/protocol.md``, "Local sequencing", "Live"):
   with its beacon, so a peer that addressed it on older news still learns
   where it stands (*pulling*);
 * messages of a later step (a peer whose clock runs a little ahead) are kept
-  until the robot's own step begins.
+  until the robot's own step begins;
+* its beacon tells *news* (:class:`~mrmp.protocol.pibt_local.NewsBeaconMessage`):
+  where the peers it heard of at the start of this step or the last stood,
+  as heard, so that its neighbours learn of the robots around it without
+  hearing each of them, and wait for and address fewer peers. Each entry is
+  a fact of the form above, so the bound still holds.
 
 A robot whose body has not yet been allowed into the cell it decided on in an
 earlier step is *held* (:meth:`LivePibtRobot.begin_step`): it neither starts a
@@ -66,7 +71,7 @@ from collections.abc import Iterable, Sequence
 
 from mrmp.core.heading import Heading
 from mrmp.protocol.messages import AnswerMessage, BeaconMessage, PibtMessage, PullMessage
-from mrmp.protocol.pibt_local import CallInheritMessage
+from mrmp.protocol.pibt_local import MAX_NEWS, CallInheritMessage, News, NewsBeaconMessage
 from mrmp.robot.messaging import Outgoing
 from mrmp.robot.pibt_reliable import ReliablePibtRobot
 from mrmp.robot.pibt_robot import MIN_RADIUS, RESERVE_RADIUS
@@ -123,6 +128,7 @@ class LivePibtRobot(ReliablePibtRobot):
         self._beacon_to: set[int] = set()
         self._gave_up = False
         self._asked: list[CallInheritMessage] = []
+        self._news: tuple[News, ...] = ()
         self.crashed: dict[int, int] = {}
         """Peers taken for crashed (:meth:`crash`), by the cell each was last known on."""
         self.meet(starts)
@@ -154,6 +160,30 @@ class LivePibtRobot(ReliablePibtRobot):
         (x, y), (px, py) = self.flat.cells[self.present], self.flat.cells[cell]
         return abs(px - x) + abs(py - y) <= radius + max(0, self.step - heard)
 
+    def _fresh_news(self) -> tuple[News, ...]:
+        """What this step's beacon tells of others: where the peers heard of since the last step's start stood.
+
+        At most :data:`~mrmp.protocol.pibt_local.MAX_NEWS` of them, the
+        nearest first; nothing of a peer taken for crashed.
+        """
+        cells, step = self.flat.cells, self.step
+        x, y = cells[self.present]
+        fresh = [
+            (abs(cells[cell][0] - x) + abs(cells[cell][1] - y), peer, cell, heard)
+            for peer, (cell, heard) in self.known.items()
+            if step - 1 <= heard <= step and peer not in self.crashed
+        ]
+        fresh.sort()
+        return tuple((peer, cells[cell], heard) for _, peer, cell, heard in fresh[:MAX_NEWS])
+
+    def _beacon(self) -> NewsBeaconMessage:
+        """This step's beacon, with the news it tells (:meth:`_fresh_news`, chosen when the step began)."""
+        beacon = super()._beacon()
+        return NewsBeaconMessage(
+            beacon.sender, beacon.seq, beacon.step, beacon.present, beacon.goal, beacon.elapsed, beacon.tie,
+            beacon.heading, self._news,
+        )  # fmt: skip
+
     def possibly_within(self, radius: int) -> list[int]:
         """The peers that can stand within ``radius`` cells at the start of this step (module docstring)."""
         cells, step = self.flat.cells, self.step
@@ -184,7 +214,9 @@ class LivePibtRobot(ReliablePibtRobot):
         if held:
             self.stats["held"] += 1
         beacons = super().begin_step(step, (), now)
-        out = [Outgoing(item.message, tuple(self.possibly_within(self.radius + self.lookout))) for item in beacons]
+        self._news = self._fresh_news()
+        lookout = tuple(self.possibly_within(self.radius + self.lookout))
+        out = [Outgoing(self._beacon(), lookout) if isinstance(item.message, BeaconMessage) else item for item in beacons]
         self._beacon_to = {peer for item in out for peer in item.recipients or ()}
         self._unknown = set(self.possibly_within(max(self.radius, RESERVE_RADIUS)))
         for peer, cell in self.crashed.items():
@@ -260,9 +292,29 @@ class LivePibtRobot(ReliablePibtRobot):
             sender = message.sender
             cell = self.flat.index(message.present)
             self.learn(sender, cell, message.step)
+            if isinstance(message, NewsBeaconMessage):
+                self._take_news(message.news)
             if message.step == self.step:
                 self._take_step_beacon(sender, cell, repeated=(sender, message.seq) in self._seen)
         return super().receive(message)
+
+    def _take_news(self, news: tuple[News, ...]) -> None:
+        """Learn where a beacon's sender heard its peers stood (:meth:`learn`).
+
+        News of a step later than the robot's own is not taken: where a peer
+        stood later does not bound where it stands now. Nor is news of a
+        robot the fleet does not have, or of a cell off the map (counted
+        ``bad_news``).
+        """
+        known, step = self.known, self.step
+        for peer, place, heard in news:
+            if peer == self.index or heard > step:
+                continue
+            cell = self.flat.index_on_grid(place)
+            if peer not in known or cell is None:
+                self.dropped["bad_news"] += 1
+                continue
+            self.learn(peer, cell, heard)
 
     def _take_step_beacon(self, sender: int, cell: int, repeated: bool) -> None:
         """This step's beacon of ``sender``: one peer fewer to wait for, a body within 2 if it is.

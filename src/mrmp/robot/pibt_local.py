@@ -94,7 +94,7 @@ from collections import Counter
 
 from mrmp.core.heading import Heading
 from mrmp.protocol.messages import AnswerMessage, BeaconMessage, Message, PullMessage
-from mrmp.protocol.pibt_local import CallInheritMessage, CallReserveMessage
+from mrmp.protocol.pibt_local import CallInheritMessage, CallReserveMessage, NewsBeaconMessage
 from mrmp.robot.messaging import Handlers, Outgoing
 from mrmp.robot.pibt_robot import MIN_RADIUS, RESERVE_RADIUS, PibtRobot
 from mrmp.search.flat_map import FlatMap
@@ -225,7 +225,7 @@ class LocalPibtRobot(PibtRobot):
 
     informing = Handlers()
 
-    @informing.on(BeaconMessage)
+    @informing.on(BeaconMessage, NewsBeaconMessage)
     def _take_beacon_local(self, message: BeaconMessage) -> bool:
         self.receive_beacons([message])
         return False

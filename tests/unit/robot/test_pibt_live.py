@@ -13,7 +13,7 @@ from mrmp.core.heading import Heading
 from mrmp.live.body import OccupancyRecorder, SimulatedBody
 from mrmp.live.pibt_agent import PibtBrain, PibtTiming
 from mrmp.protocol.messages import BeaconMessage
-from mrmp.protocol.pibt_local import CallInheritMessage, CallReserveMessage
+from mrmp.protocol.pibt_local import CallInheritMessage, CallReserveMessage, NewsBeaconMessage
 from mrmp.robot.messaging import Outgoing
 from mrmp.robot.pibt_live import LivePibtRobot
 from mrmp.robot.pibt_synchronized import SynchronizedPibtRobot
@@ -47,12 +47,20 @@ class Forgetful(LivePibtRobot):
         )
 
 
-def test_a_robot_that_forgets_that_peers_move_collides():
+class Boastful(LivePibtRobot):
+    """Broken: the news its beacon tells is stamped with the current step, as if heard at its start."""
+
+    def _fresh_news(self):
+        return tuple((peer, cell, self.step) for peer, cell, _ in super()._fresh_news())
+
+
+@pytest.mark.parametrize("brain", [Forgetful, Boastful])
+def test_a_robot_that_forgets_that_peers_move_or_tells_old_news_as_new_collides(brain):
     class Simulator(LiveRoundsSimulator):
-        robot_type = reliable_type = Forgetful
+        robot_type = reliable_type = brain
 
     collided = 0
-    for seed in range(12):
+    for seed in range(20):
         scenario = crowd(seed, density=0.5, max_ticks=60)
         assert LiveRoundsSimulator(scenario, step_ticks=2).run().collisions == []
         collided += len(Simulator(scenario, step_ticks=2).run().collisions)
@@ -90,6 +98,31 @@ def test_a_peer_that_fresher_news_puts_out_of_reach_is_no_longer_waited_for(brai
     assert a.complete and a.wake
     resent = a.on_tick(10 * a.retry)
     assert all(1 not in (item.recipients or ()) for item in resent)  # nor asked again for a beacon that will not come
+
+
+def test_a_neighbours_news_spares_a_wait_for_a_peer_it_puts_out_of_reach():
+    flat, cells = line(12)
+    starts = [cells[0], cells[2], cells[5]]
+    a = LivePibtRobot(0, cells[0], cells[1], flat, starts=starts)
+    b = LivePibtRobot(1, cells[2], cells[3], flat, starts=starts)
+    b.learn(2, cells[7], 3)  # b heard robot 2 at the start of step 3; a last knew it 5 cells away at step 1
+    a.begin_step(4)
+    assert not a.complete  # robot 2 can be within 2 + 3 of where a last knew it: a waits for its beacon
+    beacon = b.begin_step(4)[0].message
+    assert beacon.news == ((2, (7, 0), 3),)  # only what is fresh: b's news of a is from step 1
+    a.receive(beacon)
+    assert a.known[2] == (cells[7], 3) and a.complete  # 7 cells away a step ago: out of reach, not waited for
+
+
+def test_news_of_a_later_step_of_no_robot_or_of_no_cell_is_not_taken():
+    flat, cells = line(12)
+    starts = [cells[0], cells[2], cells[5]]
+    a = LivePibtRobot(0, cells[0], cells[1], flat, starts=starts)
+    a.begin_step(4)
+    news = ((2, (9, 0), 5), (7, (3, 0), 3), (2, (40, 0), 3), (0, (11, 0), 4))
+    a.receive(NewsBeaconMessage(1, 1, 4, (2, 0), (3, 0), 0, 0, news=news))
+    assert a.known[2] == (cells[5], 1) and not a.complete  # where it stands at step 5 does not bound step 4
+    assert a.dropped["bad_news"] == 2  # robot 7 is not in the fleet; (40, 0) is off the map; news of a itself ignored
 
 
 def test_a_message_of_the_next_step_waits_for_that_step():

@@ -3,7 +3,7 @@
 from pathlib import Path
 
 import pytest
-from test_pibt_live import BrainFleet, Forgetful, corridor
+from test_pibt_live import Boastful, BrainFleet, Forgetful, corridor
 from test_pibt_local import FAULTS, crowd
 
 from mrmp.core import Grid, NetworkFaults, PolicyOptions, RobotSpec, Scenario, Timing
@@ -117,6 +117,10 @@ class ForgetfulSynchronized(Forgetful, SynchronizedPibtRobot):
     """Broken (as ``Forgetful``): a peer is taken to be where it was last heard of, as if it had not moved since."""
 
 
+class BoastfulSynchronized(Boastful, SynchronizedPibtRobot):
+    """Broken (as ``Boastful``): the news its beacon tells is stamped with the current step."""
+
+
 def run_with(brain, scenario):
     class Simulator(SynchronizedRoundsSimulator):
         robot_type = reliable_type = brain
@@ -134,12 +138,28 @@ def test_without_any_one_rule_the_fleet_stops_advancing_over_a_lossy_network(bra
     assert not broken.success and slowest_step <= 5  # some robot never got past its first steps in 2,000 ticks
 
 
-def test_a_robot_that_forgets_that_peers_move_decides_cells_that_others_decided():
+class DeafToNews(SynchronizedPibtRobot):
+    """A brain that takes in no news: it learns where a peer stands from that peer only."""
+
+    def _take_news(self, news):
+        pass
+
+
+def test_news_spares_robots_messages_to_and_waits_for_peers_that_cannot_be_near():
+    scenario = random_32(100, NetworkFaults())
+    told, _ = run_with(SynchronizedPibtRobot, scenario)
+    deaf, _ = run_with(DeafToNews, scenario)
+    assert told.success and deaf.success
+    assert told.network["messages"] < 0.8 * deaf.network["messages"]
+
+
+@pytest.mark.parametrize("brain", [ForgetfulSynchronized, BoastfulSynchronized])
+def test_a_robot_that_forgets_that_peers_move_or_tells_old_news_as_new_decides_cells_that_others_decided(brain):
     conflicts = 0
     for seed in range(2):
         scenario = random_32(100, LOSSY, seed=seed, max_ticks=300)
         assert run_with(SynchronizedPibtRobot, scenario)[0].network["conflicting_decisions"] == 0
-        broken, _ = run_with(ForgetfulSynchronized, scenario)
+        broken, _ = run_with(brain, scenario)
         assert broken.collisions == []  # two bodies never enter one cell: both wait
         conflicts += broken.network["conflicting_decisions"]
     assert conflicts > 0
