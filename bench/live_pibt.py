@@ -178,6 +178,8 @@ def run_before(source: Path, case: str, revision: str, time_scale: float) -> Non
     """Run ``case`` in a child process with the code under ``source`` first on its path."""
     environment = {**os.environ, "PYTHONPATH": os.pathsep.join([str(source), os.environ.get("PYTHONPATH", "")])}
     command = [sys.executable, __file__, "--cases", case, "--time-scale", str(time_scale), "--label", f"before ({revision})"]
+    if SYNCHRONIZER != "clock":  # named only when not the default, as for the policy
+        command += ["--synchronizer", SYNCHRONIZER]
     subprocess.run(command, env=environment, check=True)
 
 
