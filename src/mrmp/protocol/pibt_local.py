@@ -155,14 +155,13 @@ def _news_cells(message: NewsBeaconMessage) -> tuple[Cell, ...]:
 def _unpack_news_beacon(sender: int, seq: int, fields: Any, cells: tuple[Cell, ...]) -> NewsBeaconMessage:
     if len(cells) % 2:
         raise DecodeError("malformed", f"news beacon with {len(cells)} cells, not pairs")
-    news = tuple(((peer, step), place) for (peer, step), place in zip(cells[::2], cells[1::2], strict=True))
-    if any(peer < 0 or step < 0 for (peer, step), _ in news):
+    news = tuple((peer, place, step) for (peer, step), place in zip(cells[::2], cells[1::2], strict=True))
+    if any(peer < 0 or step < 0 for peer, _, step in news):
         raise DecodeError("malformed", "news of a negative robot or step")
     beacon = BEACON.unpack(sender, seq, fields, ())
     return NewsBeaconMessage(
-        sender, seq, beacon.step, beacon.present, beacon.goal, beacon.elapsed, beacon.tie, beacon.heading,
-        tuple((peer, place, step) for (peer, step), place in news),
-    )  # fmt: skip
+        sender, seq, beacon.step, beacon.present, beacon.goal, beacon.elapsed, beacon.tie, beacon.heading, news
+    )
 
 
 def _unpack_reserve(sender: int, seq: int, fields: Any, _: tuple[Cell, ...]) -> CallReserveMessage:

@@ -213,11 +213,11 @@ class LivePibtRobot(ReliablePibtRobot):
         self.held, self._gave_up, self._asked = held, False, []
         if held:
             self.stats["held"] += 1
-        beacons = super().begin_step(step, (), now)
+        super().begin_step(step, (), now)  # its one message, the step's beacon, goes out below: with news, by name
         self._news = self._fresh_news()
         lookout = tuple(self.possibly_within(self.radius + self.lookout))
-        out = [Outgoing(self._beacon(), lookout) if isinstance(item.message, BeaconMessage) else item for item in beacons]
-        self._beacon_to = {peer for item in out for peer in item.recipients or ()}
+        out = [Outgoing(self._beacon(), lookout)]
+        self._beacon_to = set(lookout)
         self._unknown = set(self.possibly_within(max(self.radius, RESERVE_RADIUS)))
         for peer, cell in self.crashed.items():
             self._obstacle(peer, cell)
