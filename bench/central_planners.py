@@ -43,7 +43,7 @@ def main() -> int:
         lower_bound = sum(shortest_steps(scenario))
         for planner in arguments.planners.split(","):
             plan = plan_with(planner, scenario, time_limit_s=arguments.time_limit)
-            if plan.solved:
+            if plan.solved and plan.paths is not None:
                 verdict = check_paths(scenario.grid, {robot.id: path for robot, path in zip(scenario.robots, plan.paths)})
                 ratio, makespan = f"{plan.sum_of_costs() / lower_bound:.3f}", str(plan.makespan())
                 judged = "ok" if not verdict else f"{len(verdict)} bad"

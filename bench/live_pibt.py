@@ -52,7 +52,7 @@ import time
 from io import BytesIO
 from pathlib import Path
 
-from mrmp.core import NetworkFaults, PolicyOptions, RobotSpec, Scenario
+from mrmp.core import Cell, NetworkFaults, PolicyOptions, RobotSpec, Scenario
 from mrmp.core.heading import Heading, right_turns
 from mrmp.core.result import RunResult
 from mrmp.io.scenario_file import load_scenario
@@ -123,7 +123,7 @@ def execution_bound(scenario: Scenario, time_scale: float) -> float:
     arrives). No live execution of those decisions can end sooner.
     """
     local = scenario.with_changes(policy=PolicyOptions(name="pibt", sequencing="local"), network=NetworkFaults())
-    paths = [[tuple(cell) for cell in robot.path] for robot in LocalRoundsSimulator(local).run().robots]
+    paths: list[list[Cell]] = [list(robot.path) for robot in LocalRoundsSimulator(local).run().robots]
     length = max(len(path) for path in paths)
     paths = [path + [path[-1]] * (length - len(path)) for path in paths]
     cell_seconds = scenario.timing.cell_time / time_scale

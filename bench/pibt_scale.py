@@ -90,45 +90,49 @@ def instances(maps: Path, name: str, agents: int) -> list[Scenario]:
 def measure(
     label: str, agents: int, scenarios: list[Scenario], out: Path | None, seeds: int = 1, policy: PolicyOptions | None = None
 ) -> None:
-    runs = []
     policy = policy or PolicyOptions(name="pibt")
+    qualities: list[float] = []  # SoC/LB of the runs that arrived
+    makespans: list[int] = []  # makespans of the runs that arrived
+    ms_per_step: list[float] = []
+    table_ms: list[float] = []
+    messages: list[float] = []  # per robot and step
     for scenario, offset in ((scenario, offset) for scenario in scenarios for offset in range(seeds)):
         run = scenario.with_changes(policy=policy, seed=scenario.seed + offset)
         result = pibt_simulator(run).run()
         if result.collisions:
             raise SystemExit(f"{label} N={agents}: the referee found collisions: {result.collisions[:3]}")
         steps = max(1, result.network["steps"])
-        runs.append(
-            {
-                "success": result.success,
-                "soc_lb": result.sum_of_costs / result.lower_bound if result.success and result.lower_bound else None,
-                "makespan": result.makespan if result.success else None,
-                "ms_per_step": 1000 * result.wall_time_s / steps,
-                "table_ms": 1000 * (result.planning_time_s or 0.0) / max(1, result.network["distance_tables"]),
-                "messages_per_robot_step": result.network["messages"] / (agents * steps),
-            }
-        )
-    solved = [run for run in runs if run["success"]]
+        if result.success:
+            if result.lower_bound:
+                qualities.append(result.sum_of_costs / result.lower_bound)
+            makespans.append(result.makespan)
+        ms_per_step.append(1000 * result.wall_time_s / steps)
+        table_ms.append(1000 * (result.planning_time_s or 0.0) / max(1, result.network["distance_tables"]))
+        messages.append(result.network["messages"] / (agents * steps))
+    success = len(makespans) / len(ms_per_step)
+    soc_lb = mean(qualities) if qualities else None
+    mean_makespan = mean(makespans) if makespans else None
+    lacam_cpp = LACAM_CPP.get((label, agents))
     row = {
         "map": label,
         "agents": agents,
-        "instances": len(runs),
-        "success": len(solved) / len(runs),
-        "soc_lb": mean(run["soc_lb"] for run in solved) if solved else None,
-        "makespan": mean(run["makespan"] for run in solved) if solved else None,
-        "ms_per_step": mean(run["ms_per_step"] for run in runs),
-        "table_ms": mean(run["table_ms"] for run in runs),
-        "messages_per_robot_step": mean(run["messages_per_robot_step"] for run in runs),
-        "lacam_cpp_soc_lb": LACAM_CPP.get((label, agents)),
+        "instances": len(ms_per_step),
+        "success": success,
+        "soc_lb": soc_lb,
+        "makespan": mean_makespan,
+        "ms_per_step": mean(ms_per_step),
+        "table_ms": mean(table_ms),
+        "messages_per_robot_step": mean(messages),
+        "lacam_cpp_soc_lb": lacam_cpp,
         "sequencing": policy.sequencing,
         "radius": policy.radius,
     }
-    quality = f"{row['soc_lb']:.3f}" if row["soc_lb"] is not None else "-"
-    makespan = f"{row['makespan']:.0f}" if row["makespan"] is not None else "-"
-    reference = f"{row['lacam_cpp_soc_lb']:.2f}" if row["lacam_cpp_soc_lb"] is not None else ""
+    quality = f"{soc_lb:.3f}" if soc_lb is not None else "-"
+    makespan = f"{mean_makespan:.0f}" if mean_makespan is not None else "-"
+    reference = f"{lacam_cpp:.2f}" if lacam_cpp is not None else ""
     print(
-        f"{label:<24} {agents:>5} {row['instances']:>4} {100 * row['success']:>7.0f}% {quality:>7} {makespan:>8}"
-        f" {row['ms_per_step']:>8.2f} {row['table_ms']:>8.3f} {row['messages_per_robot_step']:>8.2f} {reference:>9}",
+        f"{label:<24} {agents:>5} {len(ms_per_step):>4} {100 * success:>7.0f}% {quality:>7} {makespan:>8}"
+        f" {mean(ms_per_step):>8.2f} {mean(table_ms):>8.3f} {mean(messages):>8.2f} {reference:>9}",
         flush=True,
     )
     if out is not None:
