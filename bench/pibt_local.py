@@ -26,12 +26,13 @@ each ``-random-*.scen``, or its seeded random instances; the thesis
 scenarios first) instead of ``--only``. ``--reach-cap`` and ``--stall-slack``
 set how far a stalled robot's reach grows over a perfect network
 (:attr:`~mrmp.robot.pibt_local.LocalPibtRobot.reach_cap`,
-:attr:`~mrmp.robot.pibt_local.LocalPibtRobot.stall_slack`); ``--order``
+:attr:`~mrmp.robot.pibt_local.LocalPibtRobot.stall_slack`), ``--stall-from-best``
+what counts as a stall (:attr:`~mrmp.robot.pibt_local.LocalPibtRobot.stall_from_best`); ``--order``
 runs one order only.
 
 Usage: python bench/pibt_local.py [--maps DIR] [--only random-32-32-20:100,empty-32-32:400 | --scale] [--limit TICKS]
        [--radius R] [--loss P] [--duplicate P] [--delay-max TICKS] [--reach-cap R] [--stall-slack S]
-       [--driver-radius R] [--order driver|local]
+       [--driver-radius R] [--order driver|local] [--stall-from-best]
 """
 
 from __future__ import annotations
@@ -84,11 +85,15 @@ def main() -> int:
     parser.add_argument("--reach-cap", type=int, default=LocalPibtRobot.reach_cap, help="largest reach of a stalled robot")
     parser.add_argument("--stall-slack", type=int, default=LocalPibtRobot.stall_slack, help="stalled steps before reach grows")
     parser.add_argument("--order", choices=("driver", "local"), default=None, help="run one order only")
+    parser.add_argument(
+        "--stall-from-best", action="store_true", help="a stall is a step that sets no new record of nearness to the goal"
+    )
     arguments = parser.parse_args()
 
     class Robot(LocalPibtRobot):
         reach_cap = arguments.reach_cap
         stall_slack = arguments.stall_slack
+        stall_from_best = arguments.stall_from_best
 
     class Local(LocalRoundsSimulator):
         robot_type = Robot

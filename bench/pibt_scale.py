@@ -19,10 +19,11 @@ measured:
 Every line is also appended to ``--out`` (JSON lines) as it is measured.
 ``--seeds K`` runs every instance with seeds 0 to K-1 (the seed drives the robots' random tie-breaks;
 default 1), so "inst" counts instances times seeds. ``--reach-cap`` sets how far a stalled robot's reach
-grows with local sequencing (:attr:`~mrmp.robot.pibt_local.LocalPibtRobot.reach_cap`).
+grows with local sequencing (:attr:`~mrmp.robot.pibt_local.LocalPibtRobot.reach_cap`), ``--stall-from-best``
+what counts as a stall (:attr:`~mrmp.robot.pibt_local.LocalPibtRobot.stall_from_best`).
 
 Usage: python bench/pibt_scale.py [--maps DIR] [--only random-32-32-20,empty-32-32] [--seeds K] [--out FILE]
-       [--sequencing local|driver] [--radius R] [--reach-cap R]
+       [--sequencing local|driver] [--radius R] [--reach-cap R] [--stall-from-best]
 """
 
 from __future__ import annotations
@@ -152,12 +153,18 @@ def main() -> int:
     parser.add_argument(
         "--reach-cap", type=int, default=LocalPibtRobot.reach_cap, help="largest reach of a stalled robot (local order)"
     )
+    parser.add_argument(
+        "--stall-from-best",
+        action="store_true",
+        help="a stall is a step that sets no new record of nearness to the goal (local order)",
+    )
     arguments = parser.parse_args()
     if arguments.seeds < 1:
         parser.error(f"--seeds must be at least 1, not {arguments.seeds}")
     if arguments.reach_cap < 0:
         parser.error(f"--reach-cap must be at least 0, not {arguments.reach_cap}")
     LocalPibtRobot.reach_cap = arguments.reach_cap  # the policy table builds the robots: set on their class
+    LocalPibtRobot.stall_from_best = arguments.stall_from_best
     policy = PolicyOptions(name="pibt", sequencing=arguments.sequencing, radius=arguments.radius)
     only = {name for name in arguments.only.split(",") if name}
     print(

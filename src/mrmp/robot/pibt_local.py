@@ -21,9 +21,10 @@ then acts):
    of "the highest-priority robot that has not decided starts" (exactly that
    when the radius covers the map). A beacon reaches the robot's *reach*: the
    radio radius, grown by one cell for every step beyond ``stall_slack`` that
-   the robot has *stalled* (ended a step no nearer its goal, away from it), up
-   to ``reach_cap`` cells. So the robots around a robot that is stuck wait for
-   its call, which then pushes them in the order central PIBT would, farther
+   the robot has *stalled* (ended a step no nearer its goal, away from it; with
+   ``stall_from_best``, no nearer than it has ever been), up to ``reach_cap``
+   cells. So the robots around a robot that is stuck wait for its call,
+   which then pushes them in the order central PIBT would, farther
    than 2 cells; a robot that advances keeps the radio radius. The cap bounds
    what one robot sends in a step independently of the number of robots;
 3. an asked robot (priority inheritance, :class:`CallInheritMessage`) decides
@@ -158,6 +159,8 @@ class LocalPibtRobot(PibtRobot):
         self.reach = radius
         self._y_size = flat.y_size
         self._before = 0.0  # distance to the goal at the start of the step
+        self._nearest = 0.0  # the nearest it has been to ``_nearest_goal`` (with ``stall_from_best``)
+        self._nearest_goal: int | None = None
 
     # -- the step ------------------------------------------------------------------
 
@@ -219,6 +222,16 @@ class LocalPibtRobot(PibtRobot):
     """The largest reach a stalled robot's beacon and final reservation grow to (cells)."""
     stall_slack = 2
     """Steps a robot may stall before its reach grows beyond ``radius`` (one cell per further step)."""
+    stall_from_best = False
+    """Whether a step counts as a stall unless it ends nearer the goal than the robot has ever been.
+
+    False (the default): a stall is a step that ends no nearer the goal than
+    it began, so a robot that steps back and forth stalls every other step and
+    its reach stays at the radius. True: a stall is a step that sets no new
+    record since the goal was set, so such a robot's reach grows too. That
+    gets more jams in narrow corridors through, at two to three times the
+    messages (``docs/protocol.md``, "Limits of local sequencing").
+    """
 
     rotations = True
     """Take the cell of a robot busy in the robot's own call (PIBT's rotations): safe when every call ends in its step."""
@@ -372,8 +385,19 @@ class LocalPibtRobot(PibtRobot):
             self.target = None
         cell = super().finish_step()
         distance = self.flat.distances(self.goal)[cell]
-        self.stalled = 0 if cell == self.goal or distance < self._before else self.stalled + 1
+        self.stalled = 0 if self._progressed(distance) or cell == self.goal else self.stalled + 1
         return cell
+
+    def _progressed(self, distance: float) -> bool:
+        """Whether the step that ended ``distance`` from the goal made progress (see :attr:`stall_from_best`)."""
+        if not self.stall_from_best:
+            return distance < self._before
+        if self._nearest_goal != self.goal:  # the first step towards this goal: the record starts where it began
+            self._nearest_goal, self._nearest = self.goal, self._before
+        if distance < self._nearest:
+            self._nearest = distance
+            return True
+        return False
 
     # -- PIBT's call, by messages -------------------------------------------------------
 

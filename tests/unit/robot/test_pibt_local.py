@@ -1,6 +1,7 @@
 """PIBT sequenced by the robots themselves: safe in crowds, close to central PIBT, and every rule needed."""
 
 import random
+from pathlib import Path
 
 import pytest
 
@@ -8,6 +9,7 @@ from mrmp.centralized.pibt_step import PIBT
 from mrmp.core import Grid, NetworkFaults, PolicyOptions, RobotSpec, Scenario
 from mrmp.core.errors import InputError
 from mrmp.core.grid import connected_regions
+from mrmp.io import load_movingai_scenario
 from mrmp.protocol.messages import AnswerMessage, BeaconMessage
 from mrmp.protocol.pibt_local import NO_CLAIM, CallAckMessage, CallInheritMessage, CallReserveMessage
 from mrmp.robot.messaging import Outgoing
@@ -379,6 +381,57 @@ def test_the_reach_grows_one_cell_per_stalled_step_after_the_slack_up_to_the_cap
             assert robot.reach == min(robot.radius + max(0, before - robot.stall_slack), robot.reach_cap)
             seen.add(robot.reach)
     assert {2, 3, LocalPibtRobot.reach_cap} <= seen
+
+
+class RecordKeeping(LocalPibtRobot):
+    """Counts a stall unless a step ends nearer the goal than the robot has ever been."""
+
+    stall_from_best = True
+
+
+@pytest.mark.parametrize("brain", [LocalPibtRobot, RecordKeeping])
+def test_a_stall_is_a_step_without_progress_from_its_start_or_from_the_record(brain):
+    class Simulator(LocalRoundsSimulator):
+        robot_type = brain
+
+    simulator = Simulator(dead_ends(*DEAD_ENDS[0]))
+    robots = simulator.robots
+    nearest = [robot.flat.distances(robot.goal)[robot.present] for robot in robots]
+    expected = [0] * len(robots)
+    back_and_forth = 0  # steps nearer than they began, but no nearer than ever before
+    for _ in range(40):
+        began = [robot.flat.distances(robot.goal)[robot.present] for robot in robots]
+        simulator.step()
+        for index, robot in enumerate(robots):
+            distance = robot.flat.distances(robot.goal)[robot.present]
+            by_record = distance < nearest[index] or robot.at_goal
+            by_step = distance < began[index] or robot.at_goal
+            back_and_forth += by_step and not by_record
+            progressed = by_record if brain.stall_from_best else by_step
+            expected[index] = 0 if progressed else expected[index] + 1
+            nearest[index] = min(nearest[index], distance)
+        assert [robot.stalled for robot in robots] == expected
+    assert back_and_forth > 0  # the two counts part on this map
+
+
+@pytest.mark.slow
+def test_counting_stalls_from_the_record_gets_a_warehouse_jam_through():
+    """Seed 7 of warehouse-10-20-10-2-1 with 400 robots: the default jams in a corridor; records and a cap of 16 arrive."""
+    maps = Path(__file__).resolve().parents[3] / "maps"
+    name = "warehouse-10-20-10-2-1"
+    scenario = load_movingai_scenario(maps / f"{name}.map", maps / f"{name}-random-1.scen", 400)
+    scenario = scenario.with_changes(seed=7, max_ticks=500)
+
+    class Wider(RecordKeeping):
+        reach_cap = 16
+
+    class Simulator(LocalRoundsSimulator):
+        robot_type = Wider
+
+    jammed = LocalRoundsSimulator(scenario).run()
+    through = Simulator(scenario).run()
+    assert not jammed.success and jammed.collisions == []
+    assert through.success and through.collisions == []
 
 
 @pytest.mark.parametrize("seed", range(8))
