@@ -226,11 +226,12 @@ class LocalPibtRobot(PibtRobot):
     """Whether a step counts as a stall unless it ends nearer the goal than the robot has ever been.
 
     False (the default): a stall is a step that ends no nearer the goal than
-    it began, so a robot that steps back and forth stalls every other step and
-    its reach stays at the radius. True: a stall is a step that sets no new
-    record since the goal was set, so such a robot's reach grows too. That
-    gets more jams in narrow corridors through, at two to three times the
-    messages (``docs/protocol.md``, "Limits of local sequencing").
+    it began, so a robot that steps back and forth never stalls two steps in a
+    row and its reach stays at the radius. True: a stall is a step that
+    neither ends on the goal nor sets a new record of nearness since the goal
+    was set, so such a robot's reach grows too. That gets more jams in
+    narrow corridors through, at up to 2.7 times the messages
+    (``docs/protocol.md``, "Limits of local sequencing").
     """
 
     rotations = True
