@@ -35,8 +35,12 @@ follows them, knowing its peers only through their messages.
 **Crashed robots** (this rule is mrmp's own, not Hönig et al.'s). A robot the
 next move waits for and that has fallen *silent* (not heard for the driver's
 silence timeout: :attr:`~mrmp.policies.base.PeerState.silent`; with
-``crash_silence``, not heard for that long) is taken for crashed, standing for
-ever on its last heard Present and Next. The robot stops waiting for it:
+``crash_silence``, not heard for that long *while the robot waited for it*) is
+taken for crashed, standing for ever on its last heard Present and Next. The
+wait counts because a robot far away is heard rarely until the robot waits for
+it: only then does the robot's state reach it (a pull) and bring its answer, so
+news of it that is old when the wait begins says nothing of a crash. The robot
+stops waiting for it:
 
 * if the rest of its plan avoids those cells, it drops its dependencies on that
   robot (for as long as it stays silent) and goes on with its plan;
@@ -124,9 +128,10 @@ class PlanFollowingPolicy:
         docstring), for drivers with a silence timeout.
     crash_silence:
         Take a silent robot for crashed only once it has not been heard for this
-        long (the driver's time units; None: as soon as the driver marks it
-        silent). A longer wait costs time after a real crash and spares the
-        plan's order when a late robot is only slow to speak.
+        long while the robot waited for it (the driver's time units; None: as
+        soon as the driver marks it silent). A longer wait costs time after a
+        real crash and spares the plan's order when a late robot is only slow
+        to speak.
     follow_crashed:
         Wait for silent robots as for any other (the rule of Hönig et al.
         without mrmp's crash rule, module docstring): a robot crashed before a
@@ -165,6 +170,8 @@ class PlanFollowingPolicy:
         self.follow_crashed = follow_crashed
         self.answer_all_pulls = answer_all_pulls
         self.crash_silence = crash_silence
+        self._waiting_since: dict[tuple[int, int], float] = {}
+        """(move, robot) -> when the robot began waiting for ``robot`` before ``move`` (with ``crash_silence``)."""
         self._last_heard: dict[int, frozenset[Cell]] = {}
         self._waited_for = sorted({robot for needs in self.dependencies.values() for robot, _ in needs})
         self.dropped: set[int] = set()
@@ -227,9 +234,12 @@ class PlanFollowingPolicy:
             self._refused.add(decision.next)
         return decision
 
-    def _crashed(self, situation: Situation, peer: PeerState) -> bool:
-        """Whether ``peer`` is taken for crashed: silent (for ``crash_silence``, when set)."""
-        return peer.silent and (self.crash_silence is None or situation.now - peer.heard_at >= self.crash_silence)
+    def _crashed(self, situation: Situation, peer: PeerState, waiting_since: float) -> bool:
+        """Whether ``peer``, waited for since ``waiting_since``, is taken for crashed: silent (for ``crash_silence``,
+        when set, counted from the later of its last news and the start of the wait)."""
+        if self.crash_silence is None:
+            return peer.silent
+        return peer.silent and situation.now - max(peer.heard_at, waiting_since) >= self.crash_silence
 
     def _remember(self, situation: Situation) -> None:
         """Keep the last cells heard from each robot the plan waits for while it is not silent."""
@@ -247,7 +257,10 @@ class PlanFollowingPolicy:
         rest = set(self.moves[self.done :])
         for robot, progress in self.dependencies.get(self.done, ()):
             peer = situation.peers.get(robot)
-            if peer is None or not self._crashed(situation, peer) or situation.progress_of(robot) >= progress:
+            if peer is None or situation.progress_of(robot) >= progress:
+                continue
+            waiting_since = self._waiting_since.setdefault((self.done, robot), situation.now)
+            if not self._crashed(situation, peer, waiting_since):
                 continue
             if rest.isdisjoint(self._crashed_cells(peer)):
                 self.dropped.add(robot)

@@ -126,8 +126,38 @@ def test_off_its_plan_a_cell_refused_again_and_again_is_planned_around():
 def test_with_a_crash_silence_a_robot_silent_for_less_is_still_waited_for():
     policy = PlanFollowingPolicy([(0, 1), (0, 2), (0, 3)], {1: [(1, 1)]}, crash_silence=3.0)
     dead = PeerState(1, (2, 2), (2, 2), Heading.NORTH, False, 1, heard_at=1.0, silent=True)
+    assert step(policy, situation((0, 1), (0, 3), dead, now=1.0)).next == (0, 1)  # the wait begins as it is heard
     assert step(policy, situation((0, 1), (0, 3), dead, now=3.5)).next == (0, 1)
     assert step(policy, situation((0, 1), (0, 3), dead, now=4.0)).next == (0, 2)
+
+
+class CountsFromLastNews(PlanFollowingPolicy):
+    """Broken: takes a robot for crashed once its last news is ``crash_silence`` old, however short the wait."""
+
+    def _crashed(self, situation, peer, waiting_since):
+        return super()._crashed(situation, peer, -float("inf"))
+
+
+def waits_crash_silence_for_a_far_robot(policy_type):
+    """Robot 1 was last heard long ago, far away, when robot 0's next move begins to wait for it (a far robot is
+    heard rarely until a robot waits for it and pulls its state): robot 0 waits ``crash_silence`` from then."""
+    policy = policy_type([(0, 1), (0, 2), (0, 3)], {1: [(1, 1)]}, crash_silence=3.0)
+    far = PeerState(1, (3, 3), (3, 3), Heading.NORTH, False, 1, heard_at=0.0, silent=True)
+    choices = [step(policy, situation((0, 1), (0, 3), far, now=now)).next for now in (10.0, 12.9, 13.0)]
+    return choices == [(0, 1), (0, 1), (0, 2)]
+
+
+def test_a_crash_silence_counts_from_the_start_of_the_wait_not_from_news_old_by_then():
+    assert waits_crash_silence_for_a_far_robot(PlanFollowingPolicy)
+    assert not waits_crash_silence_for_a_far_robot(CountsFromLastNews)  # it drops robot 1 at once, at 10.0
+
+
+def test_a_crash_silence_counts_from_news_heard_during_the_wait():
+    policy = PlanFollowingPolicy([(0, 1), (0, 2), (0, 3)], {1: [(1, 1)]}, crash_silence=3.0)
+    assert step(policy, situation((0, 1), (0, 3), peer(1, (3, 3), 0), now=10.0)).next == (0, 1)
+    heard = PeerState(1, (3, 3), (3, 3), Heading.NORTH, False, 1, heard_at=11.0, silent=True)
+    assert step(policy, situation((0, 1), (0, 3), heard, now=13.5)).next == (0, 1)  # 2.5 s since its news
+    assert step(policy, situation((0, 1), (0, 3), heard, now=14.0)).next == (0, 2)
 
 
 def leaves_plan_when_a_dropped_robot_holds_its_cell(policy):
