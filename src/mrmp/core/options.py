@@ -33,6 +33,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
+from mrmp.core.body import BODY_NAMES, DEFAULT_BODY, DRIVEN_BODIES
 from mrmp.core.errors import InputError, Problem
 from mrmp.core.limits import MAX_RADIUS
 
@@ -119,7 +120,7 @@ def setting_types(options_type: type) -> dict[str, type]:
     >>> from mrmp.core.scenario import PolicyOptions
     >>> {name: kind.__name__ for name, kind in setting_types(PolicyOptions).items()}  # doctest: +NORMALIZE_WHITESPACE
     {'resolve': 'str', 'heading_aware': 'bool', 'radius': 'int', 'swap': 'bool', 'search': 'str', 'sequencing': 'str',
-     'synchronizer': 'str'}
+     'synchronizer': 'str', 'body': 'str'}
     """
     hints = typing.get_type_hints(options_type)
     return {field.name: hints[field.name] for field, _ in settings(options_type)}
@@ -225,6 +226,43 @@ def synchronizer_setting() -> Any:
         help="pibt (local sequencing, simulated or live): when a robot ends its step: clock (a time common to all) or "
         "local (once every robot within 2 cells has decided; a local synchronizer).",
         yaml_key="synchronizer", flag="--synchronizer", check=_one_of_synchronizers, choices=SYNCHRONIZERS,
+    )  # fmt: skip
+
+
+def _one_of_bodies(value: object) -> str | None:
+    if value not in BODY_NAMES:
+        return f"must be one of {', '.join(BODY_NAMES)}, got {value!r}"
+    if value not in DRIVEN_BODIES:
+        return (
+            f"{value} bodies are not simulated or driven yet (only {', '.join(DRIVEN_BODIES)}); "
+            "plan and judge them with the Python API (mrmp.centralized.lacam, body=...)"
+        )
+    return None
+
+
+def body_setting() -> Any:
+    """``body``: the body model robots plan for and drive (:data:`~mrmp.core.body.BODY_TABLE`).
+
+    >>> from dataclasses import dataclass
+    >>> @dataclass(frozen=True)
+    ... class Example:
+    ...     body: str = body_setting()
+    ...     def __post_init__(self) -> None:
+    ...         check_settings(self)
+    >>> Example(body="legs")
+    Traceback (most recent call last):
+    ...
+    mrmp.core.errors.InputError: policy.body: must be one of omni, thesis, turning, got 'legs'
+    >>> Example(body="turning")  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    mrmp.core.errors.InputError: policy.body: turning bodies are not simulated or driven yet (only omni); plan and judge them ...
+    """
+    return setting(
+        DEFAULT_BODY,
+        help="The body model robots plan for and drive: omni (any direction, turns free, the classic MAPF model; "
+        "the only one simulated so far: thesis and turning are planned for and judged through the Python API).",
+        yaml_key="body", flag="--body", check=_one_of_bodies, choices=BODY_NAMES,
     )  # fmt: skip
 
 

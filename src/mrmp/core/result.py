@@ -24,15 +24,24 @@ from dataclasses import dataclass, field
 from mrmp.core.cell import Cell
 from mrmp.core.heading import Heading
 
-COLLISION_KINDS = ("vertex", "swap", "obstacle", "off_grid", "jump")
+COLLISION_KINDS = ("vertex", "swap", "obstacle", "off_grid", "jump", "follow", "rotation", "action")
 """What the referee reports: two robots in one cell, two robots exchanging cells,
 a robot on a static obstacle, a robot off the grid, a robot moving more than one
-cell in one tick."""
+cell in one tick; and, by body model (:mod:`mrmp.sim.referee`): a robot entering
+a cell another robot left in the same tick (a body that never follows), robots
+moving round a cycle of three or more cells at once (a body without rotations),
+a robot doing what its headed body cannot do in one tick."""
 
 
 @dataclass(frozen=True)
 class Collision:
-    """One violation found by the referee at ``tick`` (the tick whose end state is wrong)."""
+    """One violation found by the referee at ``tick`` (the tick whose end state is wrong).
+
+    ``kind`` is one of :data:`COLLISION_KINDS`; ``robots`` and ``cells`` are the
+    robots involved and where (for ``follow``: the follower, then the robot it
+    followed, and the cell entered; for ``rotation``: the robots in cycle order
+    and the cells they left; see :mod:`mrmp.sim.referee`).
+    """
 
     kind: str
     tick: int

@@ -29,6 +29,7 @@ from mrmp.core.heading import Heading
 from mrmp.core.limits import MAX_DELAY_TICKS, MAX_ROBOTS, MAX_STEP_SECONDS, MAX_TICKS, at_most
 from mrmp.core.options import (
     RESOLUTIONS,
+    body_setting,
     check_settings,
     heading_aware_setting,
     radius_setting,
@@ -131,6 +132,7 @@ class PolicyOptions:
     search: str = search_setting()
     sequencing: str = sequencing_setting()
     synchronizer: str = synchronizer_setting()
+    body: str = body_setting()
 
     def __post_init__(self) -> None:
         check_settings(self)
