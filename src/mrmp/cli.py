@@ -212,9 +212,9 @@ def with_policy_flags(command: Callable[..., None]) -> Callable[..., None]:
     >>> def show(policy_settings: dict[str, Any]) -> None:
     ...     print(policy_settings)
     >>> list(inspect.signature(with_policy_flags(show)).parameters)
-    ['resolve', 'heading_aware', 'radius', 'swap', 'search', 'sequencing', 'synchronizer']
+    ['resolve', 'heading_aware', 'radius', 'swap', 'search', 'sequencing', 'synchronizer', 'body']
     >>> with_policy_flags(show)(radius=3)
-    {'resolve': None, 'heading_aware': None, 'radius': 3, 'swap': None, 'search': None, 'sequencing': None, 'synchronizer': None}
+    {'resolve': None, 'heading_aware': None, 'radius': 3, 'swap': None, 'search': None, 'sequencing': None, 'synchronizer': None, 'body': None}
     """
     types = setting_types(PolicyOptions)
     flags = [
@@ -520,6 +520,7 @@ def run(
     duplicate: Annotated[float | None, typer.Option(help="Probability that a message is duplicated.", show_default=SCENARIO_DEFAULT, rich_help_panel=FAULTS)] = None,
     reorder: Annotated[float | None, typer.Option(help="Probability that a message overtakes earlier ones.", show_default=SCENARIO_DEFAULT, rich_help_panel=FAULTS)] = None,
     json_path: Annotated[Path | None, typer.Option("--json", help="Write the whole result as JSON (- for stdout).", metavar="PATH|-", rich_help_panel=OUTPUT)] = None,
+    record: Annotated[Path | None, typer.Option("--record", help="Write the run for ROS 2 tools: OUT.mcap, or OUT.bag (a rosbag2 folder); needs the ros2 extra (docs/ros2.md).", metavar="OUT", rich_help_panel=OUTPUT)] = None,
     animate: Annotated[Path | None, typer.Option(help="Write an animation: .gif, .svg or .mp4 (needs ffmpeg).", rich_help_panel=OUTPUT)] = None,
     show_messages: Annotated[bool, typer.Option("--show-messages", help="Record each tick's messages and draw them in the --animate animation (and the --json result).", rich_help_panel=OUTPUT)] = False,
     goal_lines: Annotated[bool, typer.Option("--goal-lines", help="Draw a line from each robot to its goal in the --animate animation.", rich_help_panel=OUTPUT)] = False,
@@ -543,6 +544,7 @@ def run(
     request = RunRequest(
         None if json_path is None else str(json_path), animate, show_messages, watch, watch_fps, planner, time_limit, live, transport, time_scale,
         delay_ms, jitter, miss_line, results, kill or [], unsafe, goal_lines=goal_lines, colour_by=colour_by, speed=speed,
+        record=record,
     )
     console = Console(stderr=request.json_path == "-", highlight=False)
     try:
@@ -594,6 +596,7 @@ class RunRequest:
     goal_lines: bool = False
     colour_by: str | None = None
     speed: float = 1.0
+    record: Path | None = None
 
 
 def _validate_run(scenario: Scenario, request: RunRequest) -> None:
@@ -621,6 +624,12 @@ def _validate_run(scenario: Scenario, request: RunRequest) -> None:
     if request.show_messages:
         written = request.animate is not None or request.json_path is not None
         _check_show_messages(scenario, written, request.live, request.planner is not None)
+    if request.record is not None:
+        from mrmp.io.ros_export import export_problem
+
+        record_issue = export_problem(request.record)
+        if record_issue is not None:
+            raise InputError(Problem(str(request.record), record_issue))
     if request.watch and request.live:
         raise InputError(Problem("--watch", "live runs are not drawn in the terminal (--watch is for simulated runs)"))
     if request.watch:
@@ -647,7 +656,10 @@ def _validate_live(scenario: Scenario, request: RunRequest) -> None:
 
 def _simulated_run(scenario: Scenario, request: RunRequest, plan: PlanningResult | None, console: Console) -> RunResult:
     """Simulate ``scenario`` (following ``plan`` when given), drawn in the terminal with ``--watch``."""
-    record = request.show_messages
+    from mrmp.sim.simulator import records_messages
+
+    recorded = request.record is not None and (plan is not None or records_messages(scenario))  # --record: /mrmp/messages
+    record = request.show_messages or recorded
     if plan is not None:
         from mrmp.experiments.execution import execute_in_simulator
 
@@ -702,6 +714,11 @@ def _output_run(result: RunResult, scenario: Scenario, request: RunRequest, cons
                 colour_by=request.colour_by, speed=request.speed,
             )
             console.print(f"animation written to {request.animate}")
+        if request.record is not None:
+            from mrmp.io.ros_export import write_ros_export
+
+            kind = write_ros_export(result, scenario.grid, request.record, tick_seconds=result.tick_seconds or scenario.timing.cell_time)
+            console.print(f"{kind} written to {request.record}", markup=False)
     except (MrmpError, OSError) as error:
         Console(stderr=True).print(f"error: {error}", markup=False)
         raise typer.Exit(2) from None
@@ -832,6 +849,30 @@ def animate_command(
         Console(stderr=True).print(f"error: {error}", markup=False)
         raise typer.Exit(2) from None
     console.print(f"animation written to {out}", markup=False)
+
+
+@command("export")
+def export_command(
+    result_path: Annotated[Path, typer.Argument(metavar="RESULT", help="A run saved with mrmp run --json (it holds the map).")],
+    out: Annotated[Path, typer.Argument(metavar="OUT", help="OUT.mcap: an MCAP file (Foxglove); OUT.bag or a path without suffix: a rosbag2 folder (ros2 bag play).")],
+    tick_seconds: Annotated[float | None, typer.Option(help="Seconds per tick (a simulated run: its scenario's timing.cell_time).", show_default="the run's own (live), else 1")] = None,
+    cell_size: Annotated[float, typer.Option(help="Metres per cell: the map's resolution.")] = 1.0,
+) -> None:
+    """Export a saved run for ROS 2 tools: the map, each robot's poses, path and goal, its messages (docs/ros2.md)."""
+    from mrmp.io.results import read_result_json
+    from mrmp.io.ros_export import export_problem, write_ros_export
+
+    try:
+        out_issue = export_problem(out)
+        if out_issue is not None:
+            raise InputError(Problem(str(out), out_issue))
+        result, grid = read_result_json(result_path)
+        if grid is None:
+            raise InputError(Problem(str(result_path), "no map is stored with this run: save it with mrmp run --json"))
+        kind = write_ros_export(result, grid, out, tick_seconds, cell_size)
+    except InputError as error:
+        raise _fail(error.problems) from None
+    Console(highlight=False).print(f"{kind} written to {out}", markup=False)
 
 
 @command()

@@ -20,7 +20,7 @@ from mrmp.sim.policy_table import policy_names
 
 ROOT = Path(__file__).resolve().parents[3]
 EXAMPLES = ROOT / "examples"
-COMMANDS = ("run", "compare", "report", "animate", "bench", "validate", "agent", "referee")
+COMMANDS = ("run", "compare", "report", "animate", "export", "bench", "validate", "agent", "referee")
 runner = CliRunner()
 
 
