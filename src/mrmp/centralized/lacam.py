@@ -86,14 +86,21 @@ import random
 import time
 from collections import deque
 from collections.abc import Sequence
+from dataclasses import replace
 
 from mrmp.centralized.pibt_step import NO_CELL, PIBT
 from mrmp.centralized.plan import MapfProblem, PlanningResult, as_problem, tick_grid
 from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
+from mrmp.core.heading import Heading
 from mrmp.core.scenario import Scenario
+from mrmp.policies.pibt_rules import ahead_cell, turned
 from mrmp.search.distance import distance_table
-from mrmp.search.flat_grid import flat_grid
+from mrmp.search.flat_grid import FlatGrid, flat_grid
+from mrmp.search.heading_distance import heading_distances
+
+PLANNED_BODIES = ("omni", "turning")
+"""The bodies LaCAM plans for (:mod:`mrmp.core.body`)."""
 
 __all__ = ["lacam"]
 
@@ -151,6 +158,7 @@ def lacam(
     seed: int | None = 0,
     swap: bool = True,
     anytime: bool = False,
+    body: str = "omni",
 ) -> PlanningResult:
     """Plan every robot with LaCAM (Okumura, AAAI 2023): quick, complete, suboptimal.
 
@@ -188,6 +196,17 @@ def lacam(
         search space is exhausted (the plan is then optimal for LaCAM*'s
         cost, which counts in each tick every robot not resting at its goal).
         Off by default: the first solution is returned.
+    body:
+        The body planned for (:mod:`mrmp.core.body`): ``omni`` (the classic
+        model above) or ``turning`` (LoRR's ``MAPF_T``): configurations are then
+        every robot's ``(cell, heading)`` state, a low-level node constrains a
+        robot to one of its four actions (forward, wait, a quarter turn either
+        way), PIBT plans with the rules of bodies that turn in place
+        (:class:`~mrmp.centralized.pibt_step.PIBT`'s ``turning_y_size``), the
+        distances are ``(cell, heading)`` tables in ticks, and the result
+        carries every robot's headings. The completeness argument above holds
+        in this model too (the queues enumerate every combination of actions;
+        swap is off, since a pull needs a backward move the body does not have).
 
     Returns
     -------
@@ -217,7 +236,15 @@ def lacam(
     ('solved', 1, 2)
     >>> lacam(Grid(2, 2), cells[:3], cells[1:], max_nodes=1).status
     'limit'
+
+    With ``turning`` bodies a robot facing NORTH turns before it drives EAST:
+
+    >>> turning = lacam(Grid(1, 3), [(0, 0)], [(0, 2)], body="turning")
+    >>> turning.paths, [heading.name for heading in turning.headings[0]]
+    ((((0, 0), (0, 0), (0, 1), (0, 2)),), ['NORTH', 'EAST', 'EAST', 'EAST'])
     """
+    if body not in PLANNED_BODIES:
+        raise ValueError(f"lacam plans for the bodies {', '.join(PLANNED_BODIES)}, not {body!r}")
     start_time = time.perf_counter()
     deadline = None if time_limit_s is None else start_time + time_limit_s
     instance = as_problem(problem, starts, goals)
@@ -228,7 +255,11 @@ def lacam(
     for robot_id, start, goal, table in zip(instance.ids, instance.starts, instance.goals, tables):
         if not table.reachable(start):
             return _result("infeasible", start_time, 0, f"robot {robot_id} cannot reach its goal {goal} from {start}")
-    search = _Search(instance, [table.as_list() for table in tables], seed, swap, anytime)
+    if body == "turning":
+        distances = [heading_distances(plain, goal, 1.0, both_ways=True) for goal in instance.goals]
+        search: _Search = _TurningSearch(instance, distances, seed, False, anytime)
+    else:
+        search = _Search(instance, [table.as_list() for table in tables], seed, swap, anytime)
     stopped = search.run(deadline, time_limit_s, max_nodes)
     return search.result(start_time, stopped)
 
@@ -247,15 +278,38 @@ class _Search:
         neighbours = self.flat.neighbours
         self.goal_config = tuple(self.flat.index(cell) for cell in instance.goals)
         self.rng = random.Random(seed) if seed is not None else None
-        self.pibt = PIBT(neighbours, distances, list(self.goal_config), swap=swap, rng=self.rng, rotations=False)
-        self.candidates = [(*row, cell) for cell, row in enumerate(neighbours)]
+        self.pibt = self._generator(neighbours, distances, swap)
+        self.candidates = self._candidates(self.flat)
         self.scale = 1.0 / (self.flat.size + 1)
-        start_config = tuple(self.flat.index(cell) for cell in instance.starts)
+        start_config = self._start(instance)
         root = self._make_node(start_config, None)
         self.stack: deque[_Node] = deque((root,))
         self.explored: dict[tuple[int, ...], _Node] = {start_config: root}
         self.goal_node: _Node | None = None
         self.iterations = 0
+
+    # -- what a configuration is (a cell per robot; :class:`_TurningSearch`: a state) ---------
+
+    def _generator(self, neighbours: Sequence[tuple[int, ...]], distances: list[list[float]], swap: bool) -> PIBT:
+        return PIBT(neighbours, distances, list(self.goal_config), swap=swap, rng=self.rng, rotations=False)
+
+    def _candidates(self, flat: FlatGrid) -> list[tuple[int, ...]]:
+        """For every cell, the cells a robot on it may have at the next tick."""
+        return [(*row, cell) for cell, row in enumerate(flat.neighbours)]
+
+    def _start(self, instance: MapfProblem) -> tuple[int, ...]:
+        return tuple(self.flat.index(cell) for cell in instance.starts)
+
+    def _cell(self, item: int) -> int:
+        """The cell of one robot's entry of a configuration."""
+        return item
+
+    def _complete(self, config: tuple[int, ...], target: list[int], order: Sequence[int]) -> tuple[int, ...] | None:
+        """PIBT completes the constrained ``target`` into the next configuration, or fails."""
+        return tuple(target) if self.pibt.generate(config, target, order) else None
+
+    def _headings(self, configs: list[tuple[int, ...]]) -> tuple[tuple[Heading, ...], ...] | None:
+        return None
 
     # -- costs and nodes -------------------------------------------------------------
 
@@ -265,15 +319,18 @@ class _Search:
 
     def _edge_cost(self, before: tuple[int, ...], after: tuple[int, ...]) -> int:
         goal_config = self.goal_config
-        return sum(1 for robot in self.robot_range if not (before[robot] == after[robot] == goal_config[robot]))
+        cell = self._cell
+        return sum(
+            1 for robot in self.robot_range if not (cell(before[robot]) == cell(after[robot]) == goal_config[robot])
+        )
 
     def _priorities(self, config: tuple[int, ...], parent: _Node | None) -> list[float]:
         """PIBT's dynamic priorities: distance scaled below 1 at the start, +1 per step away from the goal."""
         if parent is None:
             return [self.distances[robot][config[robot]] * self.scale for robot in self.robot_range]
-        old, goal_config = parent.priorities, self.goal_config
+        old, goal_config, cell = parent.priorities, self.goal_config, self._cell
         return [
-            old[robot] + 1 if config[robot] != goal_config[robot] else old[robot] - int(old[robot])
+            old[robot] + 1 if cell(config[robot]) != goal_config[robot] else old[robot] - int(old[robot])
             for robot in self.robot_range
         ]
 
@@ -340,13 +397,16 @@ class _Search:
         if self.anytime and goal_node is not None and node.f >= goal_node.f:
             self.stack.popleft()
             return True
-        if goal_node is None and node.config == self.goal_config:
+        if goal_node is None and self._at_goals(node.config):
             self.goal_node = node
             return True
         if not node.tree:
             self.stack.popleft()
             return True
         return False
+
+    def _at_goals(self, config: tuple[int, ...]) -> bool:
+        return config == self.goal_config
 
     def _successor(self, node: _Node) -> tuple[int, ...] | None:
         """Take ``node``'s next low-level node, queue its children, and let PIBT complete its constraints."""
@@ -363,9 +423,7 @@ class _Search:
         while constraint is not None and constraint[0] > 0:
             target[constraint[1]] = constraint[2]
             constraint = constraint[3]
-        if not self.pibt.generate(node.config, target, node.order):
-            return None
-        return tuple(target)
+        return self._complete(node.config, target, node.order)
 
     # -- the result ----------------------------------------------------------------------
 
@@ -382,12 +440,57 @@ class _Search:
             configs.append(cursor.config)
             cursor = cursor.parent
         configs.reverse()
-        cell = self.flat.cell
-        paths = tuple(tuple(cell(config[robot]) for config in configs) for robot in self.robot_range)
+        cell, own = self.flat.cell, self._cell
+        paths = tuple(tuple(cell(own(config[robot])) for config in configs) for robot in self.robot_range)
         if not self.anytime:
             message = f"first solution after {iterations} iterations"
         elif stopped:
             message = f"best solution when the {stopped} (LaCAM*, cost {goal_node.g})"
         else:
             message = f"optimal for LaCAM*'s cost {goal_node.g} (search space exhausted)"
-        return _result("solved", start_time, nodes, message, paths)
+        result = _result("solved", start_time, nodes, message, paths)
+        headings = self._headings(configs)
+        return result if headings is None else replace(result, headings=headings)
+
+
+class _TurningSearch(_Search):
+    """LaCAM for ``turning`` bodies: a configuration holds every robot's state ``4 * cell + heading - 1``."""
+
+    def _generator(self, neighbours: Sequence[tuple[int, ...]], distances: list[list[float]], swap: bool) -> PIBT:
+        return PIBT(
+            neighbours, distances, list(self.goal_config), rng=self.rng, rotations=False, turning_y_size=self.flat.y_size
+        )
+
+    def _candidates(self, flat: FlatGrid) -> list[tuple[int, ...]]:
+        """For every state, its successors: forward (when free), wait, a quarter turn clockwise and counter-clockwise."""
+        table: list[tuple[int, ...]] = []
+        for cell in range(len(flat.neighbours)):
+            for heading in (1, 2, 3, 4):
+                ahead = ahead_cell(flat.neighbours, cell, heading, flat.y_size)
+                turns = (4 * cell + turned(heading, 1) - 1, 4 * cell + turned(heading, -1) - 1)
+                forward = (4 * ahead + heading - 1,) if ahead >= 0 else ()
+                table.append((*forward, 4 * cell + heading - 1, *turns))
+        return table
+
+    def _start(self, instance: MapfProblem) -> tuple[int, ...]:
+        return tuple(4 * self.flat.index(cell) + int(heading) - 1 for cell, heading in zip(instance.starts, instance.headings))
+
+    def _cell(self, item: int) -> int:
+        return item >> 2
+
+    def _at_goals(self, config: tuple[int, ...]) -> bool:
+        return all(state >> 2 == goal for state, goal in zip(config, self.goal_config))
+
+    def _complete(self, config: tuple[int, ...], target: list[int], order: Sequence[int]) -> tuple[int, ...] | None:
+        cells = [state >> 2 for state in config]
+        headings = [(state & 3) + 1 for state in config]
+        next_headings = [0] * len(config)
+        for robot, state in enumerate(target):
+            if state != NO_CELL:
+                target[robot], next_headings[robot] = state >> 2, (state & 3) + 1
+        if not self.pibt.generate(cells, target, order, headings, next_headings):
+            return None
+        return tuple(4 * cell + heading - 1 for cell, heading in zip(target, next_headings))
+
+    def _headings(self, configs: list[tuple[int, ...]]) -> tuple[tuple[Heading, ...], ...] | None:
+        return tuple(tuple(Heading((config[robot] & 3) + 1) for config in configs) for robot in self.robot_range)

@@ -66,7 +66,13 @@ from collections.abc import Mapping, Sequence
 from mrmp.centralized.plan import tick_grid
 from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
-from mrmp.policies.pibt_rules import sorted_candidates, swap_possible, swap_required
+from mrmp.policies.pibt_rules import (
+    sorted_candidates,
+    swap_possible,
+    swap_required,
+    turning_action,
+    turning_candidates,
+)
 from mrmp.search.distance import DistanceTable, distance_table
 from mrmp.search.flat_grid import flat_grid
 
@@ -113,6 +119,27 @@ class PIBT:
         of an ancestor in its own chain), and constraints that form such a
         cycle fail; central plans are then executable by robots moving one at
         a time (:mod:`mrmp.centralized.dependencies`).
+    turning_y_size:
+        Plan for bodies that turn in place (the ``turning`` body of
+        :mod:`mrmp.core.body`, LoRR's ``MAPF_T``), on a grid of this many
+        columns (``y_size``; 0, the default: bodies that move in any
+        direction). ``distances`` are then ``(cell, heading)`` tables in ticks
+        (:func:`~mrmp.search.heading_distance.heading_distances`, ``both_ways``,
+        entry ``4 * cell + heading - 1``) and :meth:`generate` takes every
+        robot's heading. PIBT then chooses every robot's next *cell* among all
+        its neighbours, ranked with their turns
+        (:func:`~mrmp.policies.pibt_rules.turning_candidates`), as the
+        Start-Kit of the League of Robot Runners does
+        (MAPF-Competition/Start-Kit, ``default_planner``): a robot given the
+        cell ahead drives there, any other robot turns toward its cell or
+        waits (:func:`~mrmp.policies.pibt_rules.turning_action`) and stays;
+        last, a forward move into the cell of a robot that does not drive on
+        out of it is cancelled (the robot waits, facing it), and so on down the
+        chain of robots following it (the Start-Kit's ``moveCheck``). A robot
+        pushed by priority inheritance never takes the cell of a robot already
+        moving, as the decentralized robots decide. Needs ``swap`` off and
+        ``rotations`` off, so that no cycle of robots follows round a loop of
+        cells.
 
     Notes
     -----
@@ -145,6 +172,7 @@ class PIBT:
     __slots__ = (
         "_distances",
         "_goals",
+        "_headings",
         "_neighbours",
         "_occ_next",
         "_occ_now",
@@ -153,6 +181,7 @@ class PIBT:
         "rotations",
         "swap",
         "tie_penalties",
+        "turning_y_size",
     )
 
     def __init__(
@@ -165,9 +194,12 @@ class PIBT:
         rng: random.Random | None = None,
         tie_penalties: bool = False,
         rotations: bool = True,
+        turning_y_size: int = 0,
     ) -> None:
         if len(distances) != len(goals):
             raise ValueError(f"{len(distances)} distance lists for {len(goals)} goals")
+        if turning_y_size and (swap or rotations):
+            raise ValueError("bodies that turn in place need swap and rotations off")
         self._neighbours = list(neighbours)
         self._distances = list(distances)
         self._goals = list(goals)
@@ -178,6 +210,8 @@ class PIBT:
         self.swap = swap
         self.tie_penalties = tie_penalties
         self.rotations = rotations
+        self.turning_y_size = turning_y_size
+        self._headings: Sequence[int] = ()
 
     @property
     def clean(self) -> bool:
@@ -221,7 +255,14 @@ class PIBT:
             target[robot] = cell
         return target if self.generate(current, target, order) else None
 
-    def generate(self, current: Sequence[int], target: list[int], order: Sequence[int]) -> bool:
+    def generate(
+        self,
+        current: Sequence[int],
+        target: list[int],
+        order: Sequence[int],
+        headings: Sequence[int] = (),
+        next_headings: list[int] | None = None,
+    ) -> bool:
         """Fill ``target`` (``NO_CELL`` where free, a flat cell where constrained) in place.
 
         This is ``set_new_config`` of LaCAM: check that the constrained cells
@@ -237,6 +278,13 @@ class PIBT:
             ``current`` or a neighbour of it), or :data:`NO_CELL`. Filled in.
         order:
             Robot indices, highest priority first.
+        headings:
+            For bodies that turn in place (``turning_y_size``): every robot's
+            heading (1-4).
+        next_headings:
+            For bodies that turn in place: one entry per robot, its constrained
+            next heading or 0; filled in with every robot's next heading (a
+            moving robot keeps its heading; a staying one waits or turns a quarter).
 
         Returns
         -------
@@ -258,6 +306,7 @@ class PIBT:
         count = len(current)
         success = True
         goals = self._goals
+        self._headings = headings
         for robot in range(count):
             occ_now[current[robot]] = robot
         self._settled = {current[robot] for robot in range(count) if current[robot] == goals[robot]}
@@ -283,16 +332,75 @@ class PIBT:
                     success = False
                     break
         for robot in range(count):
-            occ_now[current[robot]] = NO_AGENT
             cell = target[robot]
             if cell != NO_CELL:
                 occ_next[cell] = NO_AGENT
+        if success and self.turning_y_size:
+            success = self._act(current, target, next_headings if next_headings is not None else [0] * count)
+        for robot in range(count):
+            occ_now[current[robot]] = NO_AGENT
         return success
+
+    # -- bodies that turn in place ------------------------------------------------------
+
+    def _act(self, current: Sequence[int], target: list[int], next_headings: list[int]) -> bool:
+        """Turn PIBT's cells into actions (class docstring); ``False`` when a constrained forward move is cancelled.
+
+        Constrained robots have their next heading in ``next_headings``
+        already; every other entry is filled in. ``target`` ends as every
+        robot's cell at the next tick.
+        """
+        headings, neighbours, y_size, distances = self._headings, self._neighbours, self.turning_y_size, self._distances
+        constrained = [heading != 0 for heading in next_headings]
+        for robot, cell in enumerate(target):
+            if constrained[robot]:
+                continue
+            here, heading = current[robot], headings[robot]
+            facing = turning_action(neighbours, here, heading, cell, distances[robot], y_size)
+            next_headings[robot] = facing
+            if cell != here and facing != heading:
+                target[robot] = here  # turns toward its cell this tick
+        return self._cancel_blocked(current, target, constrained)
+
+    def _cancel_blocked(self, current: Sequence[int], target: list[int], constrained: Sequence[bool]) -> bool:
+        """Cancel every forward move into a cell whose robot stays; ``False`` if a constrained one is among them."""
+        occ_now = self._occ_now
+        drives: list[bool | None] = [None] * len(current)  # None: not decided yet
+        for first in range(len(current)):
+            chain: list[int] = []
+            robot, verdict = first, True
+            while drives[robot] is None:
+                if target[robot] == current[robot] or robot in chain:
+                    verdict = False
+                    break
+                chain.append(robot)
+                occupant = occ_now[target[robot]]
+                if occupant == NO_AGENT:
+                    break
+                robot = occupant
+            else:
+                verdict = bool(drives[robot])
+            if not chain and drives[first] is None:
+                drives[first] = False
+            for robot in chain:
+                drives[robot] = verdict
+        for robot, drive in enumerate(drives):
+            if not drive and target[robot] != current[robot]:
+                if constrained[robot]:
+                    return False
+                target[robot] = current[robot]
+        return True
 
     # -- PIBT proper ------------------------------------------------------------
 
     def _sorted_candidates(self, robot: int, current: Sequence[int], target: list[int]) -> tuple[list[int], int]:
         """Robot's candidate cells, best first, and the robot to pull (or ``NO_AGENT``)."""
+        if self.turning_y_size:
+            here = current[robot]
+            table = self._distances[robot]
+            return turning_candidates(
+                self._neighbours, here, self._headings[robot], table, self.turning_y_size, None, self._random
+            ), NO_AGENT
         candidates = sorted_candidates(
             self._neighbours,
             current[robot],
@@ -336,6 +444,9 @@ class PIBT:
                 ):
                     k += 1  # the robots following from the occupant end in our cell: a rotation
                     continue
+                if stack and self.turning_y_size and self._closes_cycle(occupant, cell, target):
+                    k += 1
+                    continue
                 occ_next[cell] = robot
                 target[robot] = cell
                 if occupant != NO_AGENT and occupant != robot and target[occupant] == NO_CELL:
@@ -363,6 +474,17 @@ class PIBT:
                     break
 
     # -- rotations ------------------------------------------------------------------
+
+    def _closes_cycle(self, occupant: int, cell: int, target: list[int]) -> bool:
+        """Bodies that turn in place: whether a pushed robot taking ``cell`` could close a cycle (``occupant`` moves).
+
+        The last robot of a cycle to decide was pushed and takes the cell of a
+        robot that decided to move (``docs/protocol.md``, "Planning for
+        ``turning`` bodies"); the decentralized robots apply the same rule
+        (:class:`~mrmp.robot.pibt_robot.PibtRobot`), which needs no knowledge
+        of the whole chain.
+        """
+        return occupant != NO_AGENT and target[occupant] != NO_CELL and target[occupant] != cell
 
     def _leads_to(self, first: int, robot: int, current: Sequence[int], target: list[int]) -> bool:
         """Whether following moves from ``first`` (each robot into the cell of the next) reach ``robot``.

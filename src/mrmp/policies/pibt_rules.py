@@ -231,3 +231,136 @@ def swap_possible(
             return False
         pusher_cell, puller_cell = puller_cell, onward
     return False
+
+
+# -- bodies that turn in place (``turning``, LoRR's MAPF_T) ---------------------------------------
+
+_STEPS = {1: (1, 0), 2: (0, 1), 3: (-1, 0), 4: (0, -1)}
+"""The change of ``(x, y)`` of a move in heading ``1`` to ``4`` (NORTH, EAST, SOUTH, WEST)."""
+
+
+def ahead_cell(neighbours: Sequence[tuple[int, ...]], here: int, heading: int, y_size: int) -> int:
+    """The free flat cell straight ahead of ``here`` in ``heading``, or :data:`NO_CELL`.
+
+    >>> ahead_cell([(1,), (0, 2), (1,)], 1, int(Heading.EAST), 3), ahead_cell([(1,), (0, 2), (1,)], 2, int(Heading.EAST), 3)
+    (2, -1)
+    """
+    dx, dy = _STEPS[heading]
+    cell = here + dx * y_size + dy
+    return cell if cell in neighbours[here] else NO_CELL
+
+
+def turned(heading: int, quarters: int) -> int:
+    """``heading`` after ``quarters`` quarter turns clockwise (negative: counter-clockwise).
+
+    >>> turned(int(Heading.NORTH), 1), turned(int(Heading.NORTH), -1)
+    (2, 4)
+    """
+    return (heading - 1 + quarters) % 4 + 1
+
+
+def heading_toward(neighbours: Sequence[tuple[int, ...]], here: int, cell: int, y_size: int) -> int:
+    """The heading (1-4) in which ``cell``, a neighbour of ``here``, lies.
+
+    >>> heading_toward([(1,), (0, 2), (1,)], 1, 2, 3), heading_toward([(1,), (0, 2), (1,)], 1, 0, 3)
+    (2, 4)
+    """
+    for facing in (1, 2, 3, 4):
+        if ahead_cell(neighbours, here, facing, y_size) == cell:
+            return facing
+    raise ValueError(f"cell {cell} is not a neighbour of {here}")
+
+
+def turning_candidates(
+    neighbours: Sequence[tuple[int, ...]],
+    here: int,
+    heading: int,
+    table: Sequence[float],
+    y_size: int,
+    cell_costs: Sequence[float] | None = None,
+    noise: Callable[[], float] | None = None,
+) -> list[int]:
+    """PIBT's candidate cells for a body that turns in place, best first: its neighbours and its own cell.
+
+    A ``turning`` body (LoRR's ``MAPF_T``; :mod:`mrmp.core.body`) drives only
+    to the cell ahead; PIBT (Okumura et al., IJCAI 2019) still chooses among
+    all its neighbours, as the PIBT of the League of Robot Runners' Start-Kit
+    does (MAPF-Competition/Start-Kit, ``default_planner``: next *locations*,
+    then a forward move or a turn toward them): a robot given a cell it does not
+    face turns toward it and stays this tick
+    (:func:`turning_action`). Here the ranking counts the turns: a neighbour in
+    heading ``d`` costs the quarter turns from ``heading`` to ``d``, plus its
+    entry cost, plus ``table[4 * cell + d - 1]`` (``table`` the robot's
+    ``(cell, heading)`` distances in ticks,
+    :func:`~mrmp.search.heading_distance.heading_distances` with
+    ``both_ways`` and a turn costing one tick); staying costs one tick plus
+    ``table`` at ``(here, heading)``. Ties go to fewer turns (the cell ahead
+    first), then to staying; ``noise`` breaks the rest as in
+    :func:`sorted_candidates`.
+
+    >>> corridor = [(1,), (0, 2), (1,)]                 # 0-1-2 along y, goal 2
+    >>> table = [9.0] * 12
+    >>> table[4 * 2: 4 * 3] = [0.0] * 4                 # on the goal, any heading
+    >>> table[4 * 1: 4 * 2] = [2.0, 1.0, 2.0, 3.0]       # at 1: facing EAST one tick
+    >>> turning_candidates(corridor, 1, int(Heading.EAST), table, 3)
+    [2, 1, 0]
+    >>> turning_candidates(corridor, 1, int(Heading.NORTH), table, 3)   # turn toward 2 first
+    [2, 1, 0]
+    >>> turning_candidates(corridor, 2, int(Heading.NORTH), table, 3)   # on the goal: stay
+    [2, 1]
+    """
+    ranked: list[tuple[float, int, float, int]] = [(round(1.0 + table[4 * here + heading - 1], 9), 1, 0.0, here)]
+    for facing in (1, 2, 3, 4):
+        cell = ahead_cell(neighbours, here, facing, y_size)
+        if cell == NO_CELL:
+            continue
+        quarters = (facing - heading) % 4
+        turns = min(quarters, 4 - quarters)
+        entry = cell_costs[cell] if cell_costs is not None else 1.0
+        ranked.append((round(turns + entry + table[4 * cell + facing - 1], 9), 2 * turns, 0.0, cell))
+    if noise is not None:
+        ranked = [(cost, turns, noise(), cell) for cost, turns, _, cell in ranked]
+    ranked.sort()
+    return [cell for *_, cell in ranked]
+
+
+def turning_action(
+    neighbours: Sequence[tuple[int, ...]],
+    here: int,
+    heading: int,
+    chosen: int,
+    table: Sequence[float],
+    y_size: int,
+) -> int:
+    """The heading a ``turning`` body that PIBT gave ``chosen`` ends its tick with; it drives on only when it keeps it.
+
+    ``chosen`` ahead: it keeps ``heading`` and drives there. ``chosen`` another
+    neighbour: it turns a quarter toward it, and stays (for a cell behind it,
+    the way whose heading ``table`` ranks better, clockwise on ties).
+    ``chosen == here``: it waits, or turns a quarter when that brings its goal
+    nearer by ``table`` (waiting on ties, then clockwise). This is the Start-Kit's
+    ``getAction`` (MAPF-Competition/Start-Kit, ``default_planner``), with the
+    turns of a stay added.
+
+    >>> corridor = [(1,), (0, 2), (1,)]
+    >>> table = [9.0] * 12
+    >>> table[4 * 1: 4 * 2] = [2.0, 1.0, 2.0, 3.0]       # at 1: EAST is best, WEST worst
+    >>> turning_action(corridor, 1, int(Heading.EAST), 2, table, 3)   # ahead: keeps EAST and drives
+    2
+    >>> turning_action(corridor, 1, int(Heading.NORTH), 1, table, 3)  # stays: a quarter toward EAST
+    2
+    >>> turning_action(corridor, 1, int(Heading.EAST), 0, table, 3)   # 0 is behind: SOUTH (clockwise) first
+    3
+    """
+    if chosen == here:
+        options = (heading, turned(heading, 1), turned(heading, -1))
+        return min(options, key=lambda facing: round(table[4 * here + facing - 1], 9))
+    wanted = heading_toward(neighbours, here, chosen, y_size)
+    quarters = (wanted - heading) % 4
+    if quarters == 0:
+        return heading
+    if quarters == 2:
+        clockwise, counter = turned(heading, 1), turned(heading, -1)
+        return counter if table[4 * here + counter - 1] < table[4 * here + clockwise - 1] else clockwise
+    return turned(heading, 1 if quarters == 1 else -1)
+

@@ -56,7 +56,7 @@ class FlatMap(FlatGrid):
         self.grid = grid
         self.entry_costs: list[float] | None = self.costs if grid.has_costs else None
         self._tables: dict[int, list[float]] = {}
-        self._heading_tables: dict[tuple[int, float], list[float]] = {}
+        self._heading_tables: dict[tuple[int, float, bool], list[float]] = {}
         self.table_seconds = 0.0
 
     def distances(self, goal: int) -> list[float]:
@@ -68,9 +68,10 @@ class FlatMap(FlatGrid):
             self.table_seconds += time.perf_counter() - started
             self._tables[goal] = table
         return table
-    def heading_distances(self, goal: int, turn_cost: float) -> list[float]:
+    def heading_distances(self, goal: int, turn_cost: float, both_ways: bool = False) -> list[float]:
         """For every state (flat cell ``i``, heading ``h``), at ``4 * i + h - 1``, the heading-aware
-        cost to reach the flat cell ``goal`` when a right turn costs ``turn_cost``
+        cost to reach the flat cell ``goal`` when a right turn (a quarter turn either way, with
+        ``both_ways``) costs ``turn_cost``
         (:func:`~mrmp.search.heading_distance.heading_distances`), computed once per goal and kept.
 
         >>> from mrmp.core.grid import Grid
@@ -78,11 +79,11 @@ class FlatMap(FlatGrid):
         >>> flat.heading_distances(2, 0.5)[:4]    # from (0, 0) facing NORTH, EAST, SOUTH, WEST
         [2.5, 2.0, 3.5, 3.0]
         """
-        key = (goal, turn_cost)
+        key = (goal, turn_cost, both_ways)
         table = self._heading_tables.get(key)
         if table is None:
             started = time.perf_counter()
-            table = heading_distances(self.grid, self.cell(goal), turn_cost)
+            table = heading_distances(self.grid, self.cell(goal), turn_cost, both_ways)
             self.table_seconds += time.perf_counter() - started
             self._heading_tables[key] = table
         return table

@@ -15,6 +15,12 @@ heading ``h`` (1-4) is entry ``4 * i + h - 1``; blocked and unreachable states a
 ``inf``. Policy ``pibt`` with ``heading_aware`` ranks its candidate cells with it
 (:func:`mrmp.policies.pibt_rules.heading_candidates`).
 
+With ``both_ways`` a body turns a quarter either way (the ``turning`` body of
+:mod:`mrmp.core.body`, LoRR's ``MAPF_T``), so a change of heading costs
+``min(r, 4 - r)`` quarter turns instead of ``r`` right turns; with
+``turn_cost=1`` the table counts the ticks of MAPF_T's actions (forward, turn,
+wait), the distance of the ``(cell, heading)`` search that LoRR's planners use.
+
 Examples
 --------
 A 1x3 corridor, goal at its east end (0, 2); a right turn costs half a cell:
@@ -28,6 +34,12 @@ A 1x3 corridor, goal at its east end (0, 2); a right turn costs half a cell:
 (2.0, 2.5, 3.0)
 >>> at((0, 2), Heading.SOUTH)
 0.0
+
+Turning either way, facing WEST costs two quarter turns, facing NORTH one:
+
+>>> table = heading_distances(Grid(1, 3), (0, 2), turn_cost=1.0, both_ways=True)
+>>> at((0, 0), Heading.EAST), at((0, 0), Heading.NORTH), at((0, 0), Heading.WEST)
+(2.0, 3.0, 4.0)
 """
 
 from __future__ import annotations
@@ -42,9 +54,11 @@ __all__ = ["heading_distances"]
 
 _TURNS = [[right_turns(facing, moving) for moving in HEADINGS] for facing in HEADINGS]
 """``_TURNS[h - 1][d - 1]``: right turns from facing ``h`` to facing ``d``."""
+_QUARTERS = [[min(turns, 4 - turns) for turns in row] for row in _TURNS]
+"""``_QUARTERS[h - 1][d - 1]``: quarter turns either way from facing ``h`` to facing ``d``."""
 
 
-def heading_distances(grid: Grid, goal: Cell, turn_cost: float) -> list[float]:
+def heading_distances(grid: Grid, goal: Cell, turn_cost: float, both_ways: bool = False) -> list[float]:
     """The least cost from every ``(cell, heading)`` state of ``grid`` to ``goal`` (module docstring).
 
     Parameters
@@ -55,6 +69,8 @@ def heading_distances(grid: Grid, goal: Cell, turn_cost: float) -> list[float]:
         The goal cell; any heading on it counts as arrived.
     turn_cost:
         The cost of one right turn, in the unit of entry costs (``turn_time / cell_time``).
+    both_ways:
+        The body turns a quarter either way at ``turn_cost`` each (module docstring).
 
     Raises
     ------
@@ -74,7 +90,8 @@ def heading_distances(grid: Grid, goal: Cell, turn_cost: float) -> list[float]:
         table[4 * goal_index + heading] = 0.0
         queue.append((0.0, 4 * goal_index + heading))
     deltas = [heading.delta for heading in HEADINGS]
-    turns = [[_TURNS[facing][moving] * turn_cost for moving in range(4)] for facing in range(4)]
+    counts = _QUARTERS if both_ways else _TURNS
+    turns = [[counts[facing][moving] * turn_cost for moving in range(4)] for facing in range(4)]
     while queue:
         cost, state = heapq.heappop(queue)
         if cost > table[state]:
