@@ -36,7 +36,7 @@ from mrmp.core.scenario import PolicyOptions, Scenario
 from mrmp.experiments.run_options import FLAG_NAMES, apply_run_options, parse_range
 from mrmp.io import load_movingai_scenario, load_scenario, validate_file, write_result_json
 from mrmp.live.transport_table import TRANSPORTS
-from mrmp.sim.policy_table import policy_entry, policy_names
+from mrmp.sim.policy_table import body_problem, policy_entry, policy_names
 from mrmp.sim.simulator import TickObserver, simulate
 
 if TYPE_CHECKING:
@@ -609,6 +609,9 @@ def _validate_run(scenario: Scenario, request: RunRequest) -> None:
         raise InputError(Problem("--unsafe", f"{entry.name} always enters cells through the safety layer; it has no unsafe form"))
     if request.live and entry.live_driver is None and not planned:
         raise InputError(Problem("--policy", f"{entry.name} {entry.not_live}"))
+    body_issue = body_problem(scenario, live=request.live, planned=planned)
+    if body_issue is not None:
+        raise InputError(body_issue)
     if planned:
         _positive(request.time_limit, "--time-limit", MAX_RUN_SECONDS, "seconds")
     time_scale_checked(request.time_scale)
@@ -1000,6 +1003,9 @@ def agent(
         entry = policy_entry(scenario.policy.name)
         if entry.live_driver is None:
             raise InputError(Problem("--policy", f"{entry.name} {entry.not_live}"))
+        body_issue = body_problem(scenario, live=True)
+        if body_issue is not None:
+            raise InputError(body_issue)
         ids = [spec.id for spec in scenario.robots]
         if robot not in ids:
             raise InputError(Problem("--robot", f"no robot has the id {robot!r} in {scenario_path}"))

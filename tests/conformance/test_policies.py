@@ -20,14 +20,23 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
 from mrmp.core import Grid, NetworkFaults, PolicyOptions, RobotSpec, Scenario
+from mrmp.core.body import DEFAULT_BODY, body_model
+from mrmp.core.heading import Heading
 from mrmp.core.scenario import scenario_problems
 from mrmp.sim.policy_table import policy_entry, policy_names
 from mrmp.sim.referee import check_paths
 from mrmp.sim.simulator import simulate
 
 
+def body_policy(policy, resolve, body):
+    """The policy options of a run of ``policy`` in ``body``'s model (bodies other than omni: pibt's driver sequencing)."""
+    if body == DEFAULT_BODY:
+        return PolicyOptions(name=policy, resolve=resolve)
+    return PolicyOptions(name=policy, resolve=resolve, body=body, sequencing="driver")
+
+
 @st.composite
-def scenarios(draw, policy):
+def scenarios(draw, policy, body=DEFAULT_BODY):
     x_size, y_size = draw(st.integers(3, 8)), draw(st.integers(3, 8))
     rng = random.Random(draw(st.integers(0, 10**6)))
     cells = [(x, y) for x in range(x_size) for y in range(y_size)]
@@ -37,7 +46,8 @@ def scenarios(draw, policy):
     count = draw(st.integers(1, max(1, min(6, len(free) // 3))))
     starts = rng.sample(free, count)
     goals = rng.sample(free, count)
-    robots = tuple(RobotSpec(f"r{i}", s, g) for i, (s, g) in enumerate(zip(starts, goals)))
+    headings = [Heading(rng.randint(1, 4)) for _ in starts]
+    robots = tuple(RobotSpec(f"r{i}", s, g, heading=h) for i, (s, g, h) in enumerate(zip(starts, goals, headings)))
     faults = draw(
         st.sampled_from(
             [
@@ -52,7 +62,7 @@ def scenarios(draw, policy):
         grid,
         robots,
         network=faults,
-        policy=PolicyOptions(name=policy, resolve=resolve),
+        policy=body_policy(policy, resolve, body),
         safety=rng.random() < 0.6,
         seed=rng.randrange(1000),
     )
@@ -75,19 +85,19 @@ def pairwise_violations(grid, paths):
     return found
 
 
-@pytest.mark.parametrize("policy", policy_names())
-def test_policy_conformance(policy):
-    check_policy(policy)
+@pytest.mark.parametrize(("policy", "body"), [(name, body) for name in policy_names() for body in policy_entry(name).bodies])
+def test_policy_conformance(policy, body):
+    check_policy(policy, body=body)
 
 
-def check_policy(policy, max_examples=80):
-    """Run the conformance checks on ``max_examples`` drawn scenarios of the table's policy ``policy``."""
+def check_policy(policy, max_examples=80, body=DEFAULT_BODY):
+    """Run the conformance checks on ``max_examples`` drawn scenarios of the table's policy ``policy`` in ``body``'s model."""
     assert policy_entry(policy).name == policy
 
     @settings(max_examples=max_examples, derandomize=True, deadline=None, suppress_health_check=[HealthCheck.too_slow])
     @given(data=st.data())
     def conforms(data):
-        check_run(data.draw(scenarios(policy)))
+        check_run(data.draw(scenarios(policy, body)))
 
     conforms()
 
@@ -100,8 +110,10 @@ def check_run(scenario):
     paths = {robot.id: robot.path for robot in result.robots}
     assert {len(path) for path in paths.values()} == {result.ticks + 1}
     assert all(robot.path[0] == robot.start for robot in result.robots)
-    # the referee's findings are exactly what an independent judge finds
-    assert check_paths(scenario.grid, paths) == result.collisions
+    # the referee's findings are exactly what an independent judge finds, in the run's body model
+    body = body_model(scenario.policy.body)
+    headings = {robot.id: robot.headings for robot in result.robots} if body.headed else None
+    assert check_paths(scenario.grid, paths, headings, body) == result.collisions
     assert {(c.kind, c.tick) for c in result.collisions if c.kind in ("vertex", "swap")} == pairwise_violations(
         scenario.grid, paths
     )

@@ -50,7 +50,7 @@ from dataclasses import dataclass
 
 from mrmp.core.heading import Heading, right_turns
 
-__all__ = ["BODY_NAMES", "BODY_TABLE", "DEFAULT_BODY", "DRIVEN_BODIES", "BodyModel", "body_model"]
+__all__ = ["BODY_NAMES", "BODY_TABLE", "DEFAULT_BODY", "BodyModel", "body_model"]
 
 
 @dataclass(frozen=True)
@@ -162,12 +162,6 @@ BODY_NAMES: tuple[str, ...] = tuple(BODY_TABLE)
 
 DEFAULT_BODY = "omni"
 """The body a scenario names when it names none: the model every earlier figure assumed."""
-
-DRIVEN_BODIES: tuple[str, ...] = ("omni",)
-"""The bodies the simulators and the live fleet run so far. The others are planned for
-(:func:`~mrmp.centralized.lacam.lacam` and :func:`~mrmp.centralized.pibt_plan.pibt_plan`
-take ``body="turning"``) and judged (:func:`~mrmp.sim.referee.check_paths`,
-:func:`~mrmp.centralized.body_time.execution_seconds`) through the Python API."""
 
 
 def body_model(name: str) -> BodyModel:

@@ -33,7 +33,7 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import Any
 
-from mrmp.core.body import BODY_NAMES, DEFAULT_BODY, DRIVEN_BODIES
+from mrmp.core.body import BODY_NAMES, DEFAULT_BODY
 from mrmp.core.errors import InputError, Problem
 from mrmp.core.limits import MAX_RADIUS
 
@@ -230,14 +230,7 @@ def synchronizer_setting() -> Any:
 
 
 def _one_of_bodies(value: object) -> str | None:
-    if value not in BODY_NAMES:
-        return f"must be one of {', '.join(BODY_NAMES)}, got {value!r}"
-    if value not in DRIVEN_BODIES:
-        return (
-            f"{value} bodies are not simulated or driven yet (only {', '.join(DRIVEN_BODIES)}); "
-            "plan and judge them with the Python API (mrmp.centralized.lacam, body=...)"
-        )
-    return None
+    return None if value in BODY_NAMES else f"must be one of {', '.join(BODY_NAMES)}, got {value!r}"
 
 
 def body_setting() -> Any:
@@ -253,15 +246,12 @@ def body_setting() -> Any:
     Traceback (most recent call last):
     ...
     mrmp.core.errors.InputError: policy.body: must be one of omni, thesis, turning, got 'legs'
-    >>> Example(body="turning")  # doctest: +ELLIPSIS
-    Traceback (most recent call last):
-    ...
-    mrmp.core.errors.InputError: policy.body: turning bodies are not simulated or driven yet (only omni); plan and judge them ...
     """
     return setting(
         DEFAULT_BODY,
-        help="The body model robots plan for and drive: omni (any direction, turns free, the classic MAPF model; "
-        "the only one simulated so far: thesis and turning are planned for and judged through the Python API).",
+        help="The body model robots plan for and drive: omni (any direction, turns free: the classic MAPF model) or "
+        "turning (LoRR's MAPF_T: forward, a quarter turn either way, or wait; pibt with sequencing: driver, simulated). "
+        "thesis is known to the referee and the execution bound only.",
         yaml_key="body", flag="--body", check=_one_of_bodies, choices=BODY_NAMES,
     )  # fmt: skip
 

@@ -44,7 +44,7 @@ from mrmp.live.results import ideal_makespan, live_result
 from mrmp.live.transport import LiveFaults
 from mrmp.live.transport_entry import FleetLayout
 from mrmp.live.transport_table import FAULTS, TRANSPORTS
-from mrmp.sim.policy_table import policy_entry
+from mrmp.sim.policy_table import body_problem, policy_entry
 
 
 @dataclass(frozen=True)
@@ -126,6 +126,9 @@ def run_live(
     """
     ids = [robot.id for robot in scenario.robots]
     _check(options, ids)
+    body_issue = body_problem(scenario, live=True)
+    if body_issue is not None:
+        raise InputError(body_issue)
     files = _write_run_files(scenario, options, ids)
     session = random.SystemRandom().randrange(1, 2**31)
     layout = FleetLayout.on_loopback(ids, fleet=f"mrmp/{session}")

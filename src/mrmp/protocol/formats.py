@@ -57,6 +57,7 @@ from mrmp.protocol.messages import (
     ReplyMessage,
     ReserveMessage,
     StateMessage,
+    StayMessage,
 )
 from mrmp.protocol.wire import DecodeError, WireFormat, register
 
@@ -73,6 +74,7 @@ __all__ = [
     "REPLY",
     "RESERVE",
     "STATE",
+    "STAY",
 ]
 
 _ARRIVED, _MOVING, _CLAIMING = 0x01, 0x02, 0x04
@@ -192,6 +194,9 @@ INHERIT = register(_step_cell_format(5, InheritMessage))
 ANSWER = register(WireFormat(6, AnswerMessage, "!IB", lambda m: (m.step, int(m.moved)), _unpack_answer))
 RESERVE = register(_step_cell_format(7, ReserveMessage))
 PULL = register(_step_cell_format(8, PullMessage))
+STAY = register(
+    WireFormat(16, StayMessage, "!I", lambda m: (m.step,), lambda sender, seq, fields, _: StayMessage(sender, seq, *fields))
+)
 
 
 # -- Causal-PIBT's lock messages ----------------------------------------------------------------

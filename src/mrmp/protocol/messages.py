@@ -14,7 +14,8 @@ request for a cell and its answer, :class:`ReleaseMessage` and
 :class:`ReleaseAckMessage` its release of a cell and the acknowledgement, :class:`HandoffMessage`
 a robot's commitment to leave its cell in the current tick (the lockstep model's following). :class:`BeaconMessage`,
 :class:`InheritMessage`, :class:`AnswerMessage`, :class:`ReserveMessage` and
-:class:`PullMessage` carry decentralized PIBT (:mod:`mrmp.robot.pibt_robot`).
+:class:`PullMessage` carry decentralized PIBT (:mod:`mrmp.robot.pibt_robot`), and
+:class:`StayMessage` too for bodies that turn in place.
 :class:`LockRequestMessage`, :class:`LockGrantMessage`,
 :class:`LockReleaseMessage` and :class:`LockAckMessage` make one activation of
 Causal-PIBT atomic among the robots near the one activating
@@ -229,6 +230,15 @@ class ReserveMessage(PibtMessage):
     seq: int
     step: int
     cell: Cell
+
+
+@dataclass(frozen=True, slots=True)
+class StayMessage(PibtMessage):
+    """Bodies that turn in place: the sender does not leave its cell this step, so the recipient, which reserved it, stays too."""
+
+    sender: int
+    seq: int
+    step: int
 
 
 @dataclass(frozen=True, slots=True)

@@ -27,6 +27,21 @@ conversation:
 4. :meth:`PibtRobot.finish_step`: every robot has decided; it moves to the
    cell it reserved.
 
+**Bodies that turn in place** (``turning``: LoRR's ``MAPF_T``,
+:mod:`mrmp.core.body`) drive only to the cell ahead. With ``turning`` on, a
+robot ranks all its neighbours with the turns toward them
+(:func:`~mrmp.policies.pibt_rules.turning_candidates`), as the central
+generator does (:class:`mrmp.centralized.pibt_step.PIBT` with
+``turning_y_size``); once decided it drives on when its cell is ahead, and
+otherwise turns toward it or waits and stays
+(:func:`~mrmp.policies.pibt_rules.turning_action`). A robot that stays tells
+the robot that reserved its cell (:class:`StayMessage`), which then stays too
+and tells the robot that reserved *its* cell, and so on down the chain: the
+central generator's cancellation, by messages. A robot planned by priority
+inheritance never takes the cell of a robot already moving (so no cycle of
+robots can follow one another round a loop), and there is no swap technique
+(it walks a robot backwards).
+
 Its decisions equal those of :class:`mrmp.centralized.pibt_step.PIBT` given
 the same priorities, when robots start in priority order and every message of
 a round arrives before the next round (the synchronous rounds of
@@ -76,7 +91,14 @@ import random
 from collections import Counter
 
 from mrmp.core.heading import Heading
-from mrmp.policies.pibt_rules import heading_candidates, sorted_candidates, swap_possible, swap_required
+from mrmp.policies.pibt_rules import (
+    heading_candidates,
+    sorted_candidates,
+    swap_possible,
+    swap_required,
+    turning_action,
+    turning_candidates,
+)
 from mrmp.protocol.messages import (
     AnswerMessage,
     BeaconMessage,
@@ -85,6 +107,7 @@ from mrmp.protocol.messages import (
     PibtMessage,
     PullMessage,
     ReserveMessage,
+    StayMessage,
 )
 from mrmp.robot.messaging import Handlers, Outgoing
 from mrmp.search.flat_map import FlatMap
@@ -133,6 +156,10 @@ class PibtRobot:
         cells of robots standing on their goals after free ones) before the
         random tie-break (not with ``heading_aware``, which ranks by its own costs). None
         (the default) turns them on exactly when ``rng`` is given.
+    turning:
+        The body turns in place (``turning``; module docstring): candidates
+        ranked by :meth:`~mrmp.search.flat_map.FlatMap.heading_distances` with a
+        quarter turn either way costing one tick; needs ``swap`` off.
     """
 
     def __init__(
@@ -150,9 +177,12 @@ class PibtRobot:
         turn_cost: float = 0.5,
         rng: random.Random | None = None,
         tie_penalties: bool | None = None,
+        turning: bool = False,
     ) -> None:
         if radius < MIN_RADIUS:
             raise ValueError(f"radius {radius} is below {MIN_RADIUS}: robots two cells apart could take the same cell")
+        if turning and swap:
+            raise ValueError("bodies that turn in place have no swap technique: it walks a robot backwards")
         self.index = index
         self.present = start
         self.goal = goal
@@ -165,10 +195,15 @@ class PibtRobot:
         self.turn_cost = turn_cost
         self._noise = rng.random if rng is not None else None
         self.tie_penalties = rng is not None if tie_penalties is None else tie_penalties
+        self.turning = turning
         self.elapsed = 0
         self.step = 0
         self.seq = 0
         self.target: int | None = None
+        self.next_heading = heading  # turning: the heading at the end of this step
+        self.drives = False  # turning: whether the robot drives to ``target`` this step (else it stays)
+        self._stays_owed: list[int] = []
+        self._staying: set[int] = set()  # turning: robots that told this one they stay, this step
         self.dropped: Counter[str] = Counter()
         # what this step's messages told the robot
         self._occupants: dict[int, int] = {}
@@ -212,6 +247,10 @@ class PibtRobot:
         """Start step ``step``: forget the last step's view and announce cell, goal and priority."""
         self.step = step
         self.target = None
+        self.next_heading = self.heading
+        self.drives = False
+        self._stays_owed = []
+        self._staying = set()
         self._waiting = self._parent = self._pulled = None
         self._occupants = {self.present: self.index}
         self._goals = {self.index: self.goal}
@@ -255,7 +294,7 @@ class PibtRobot:
         inform = self.informing.get(message)
         if inform is not None:
             inform(self, message)
-            return False
+            return bool(self._stays_owed)
         self._control.append(message)
         return True
 
@@ -271,6 +310,8 @@ class PibtRobot:
         cell = self.flat.index(message.cell)
         self._reserved[cell] = message.sender
         self._targets[message.sender] = cell
+        if self.turning and cell == self.present and message.sender != self.index and self.decided and not self.drives:
+            self._stays_owed.append(message.sender)  # it would drive into a robot that stays
 
     def receive_beacons(self, beacons: list[BeaconMessage]) -> None:
         """Take in this step's beacons, each delivered exactly once (a perfect network), in one call.
@@ -293,10 +334,13 @@ class PibtRobot:
 
     def act(self) -> list[Outgoing]:
         """Act on the requests and answers of this round; return what to send."""
-        if not self._control:
-            return []
-        control, self._control = self._control, []
         out: list[Outgoing] = []
+        if self._stays_owed:
+            owed, self._stays_owed = self._stays_owed, []
+            out.extend(Outgoing(StayMessage(self.index, self._seq(), self.step), (taker,)) for taker in owed)
+        if not self._control:
+            return out
+        control, self._control = self._control, []
         requests = self.requests
         for message in control:
             handler = requests.get(message)
@@ -330,6 +374,13 @@ class PibtRobot:
             self._next += 1  # backtracking: the pushed robot stays; try the next cell
             self._continue(out)
 
+    @requests.on(StayMessage)
+    def _take_stay(self, message: StayMessage, out: list[Outgoing]) -> None:
+        self._staying.add(message.sender)  # it may come before the answer of the same robot: kept for the decision
+        if self.drives and self._occupants.get(self.target) == message.sender:  # type: ignore[arg-type]
+            self.drives = False  # the robot ahead stays: so does this one, facing it
+            self._tell_taker(out)
+
     @requests.on(PullMessage)
     def _take_pull(self, message: PullMessage, out: list[Outgoing]) -> None:
         cell = self.flat.index(message.cell)
@@ -345,6 +396,13 @@ class PibtRobot:
 
     def finish_step(self) -> int:
         """Move to the reserved cell (or stay, when undecided); update heading and priority; return the cell."""
+        if self.turning:
+            if self.target is not None and self.drives:
+                self.present = self.target
+            if self.target is not None:
+                self.heading = self.next_heading
+            self.elapsed = 0 if self.present == self.goal else self.elapsed + 1
+            return self.present
         target = self.target if self.target is not None else self.present
         if target != self.present:
             cells = self.flat.cells
@@ -365,7 +423,17 @@ class PibtRobot:
     def _begin_call(self, out: list[Outgoing]) -> None:
         flat = self.flat
         distances = flat.distances(self.goal)
-        if self.heading_aware:
+        if self.turning:
+            candidates = turning_candidates(
+                flat.neighbours,
+                self.present,
+                int(self.heading),
+                flat.heading_distances(self.goal, 1.0, both_ways=True),
+                flat.y_size,
+                flat.entry_costs,
+                self._noise,
+            )
+        elif self.heading_aware:
             candidates = heading_candidates(
                 flat.neighbours,
                 self.present,
@@ -402,6 +470,9 @@ class PibtRobot:
             if occupant is not None and targets.get(occupant) == here:
                 self._next += 1  # the occupant moves into our cell: taking its cell would swap
                 continue
+            if self.turning and self._closes_cycle(occupant, cell):
+                self._next += 1
+                continue
             self._reserve(cell, out)
             if occupant is not None and occupant != self.index and occupant not in targets:
                 self._waiting = occupant  # priority inheritance
@@ -413,6 +484,8 @@ class PibtRobot:
         self._finish(False, out)
 
     def _finish(self, moved: bool, out: list[Outgoing]) -> None:
+        if self.turning:
+            self._settle_turn(moved, out)
         pulled = self._pulled
         if moved and self._next == 0 and pulled is not None:
             here = self.present
@@ -423,6 +496,38 @@ class PibtRobot:
         if self._parent is not None:
             out.append(Outgoing(AnswerMessage(self.index, self._seq(), self.step, moved), (self._parent,)))
             self._parent = None
+
+    def _closes_cycle(self, occupant: int | None, cell: int) -> bool:
+        """Whether taking ``cell`` (of ``occupant``) could close a cycle: this robot is pushed, ``occupant`` moves.
+
+        Of the robots of a cycle, each taking the next one's cell, the last to
+        decide was pushed (its cell was reserved while it had not decided) and
+        takes the cell of one that has decided to move (``docs/protocol.md``).
+        """
+        return (
+            self._parent is not None
+            and occupant is not None
+            and occupant != self.index
+            and self._targets.get(occupant, cell) != cell
+        )
+
+    def _settle_turn(self, moved: bool, out: list[Outgoing]) -> None:
+        """Decided: drive on to the cell ahead, or turn toward the cell (or wait) and stay, telling whoever took this one."""
+        assert self.target is not None
+        here, heading = self.present, int(self.heading)
+        flat = self.flat
+        table = flat.heading_distances(self.goal, 1.0, both_ways=True)
+        facing = turning_action(flat.neighbours, here, heading, self.target, table, flat.y_size)
+        self.next_heading = Heading(facing)
+        self.drives = self.target != here and facing == heading and self._occupants.get(self.target) not in self._staying
+        if not self.drives and moved:  # on a failure the robot that pushed this one hears it in the answer
+            self._tell_taker(out)
+
+    def _tell_taker(self, out: list[Outgoing]) -> None:
+        """Send a :class:`StayMessage` to the robot that reserved this robot's cell, if one did."""
+        taker = self._reserved.get(self.present)
+        if taker is not None and taker != self.index and self._targets.get(taker) == self.present:
+            out.append(Outgoing(StayMessage(self.index, self._seq(), self.step), (taker,)))
 
     def _swap_partner(self, candidates: list[int], distances: list[float]) -> int | None:
         """``is_swap_required_and_possible`` on what the robot heard: the robot to pull, or None."""

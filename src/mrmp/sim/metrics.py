@@ -18,22 +18,39 @@ from __future__ import annotations
 import math
 from collections.abc import Sequence
 
+from mrmp.core.body import body_model
 from mrmp.core.grid import Grid
 from mrmp.core.limits import MAX_TICKS
 from mrmp.core.scenario import Scenario
 from mrmp.search.distance import distance_table
+from mrmp.search.heading_distance import heading_distances
 
 
 def shortest_steps(scenario: Scenario) -> list[int]:
-    """Each robot's shortest path length in moves (ignoring costs and other robots).
+    """Each robot's shortest path length in its body's ticks (ignoring costs and other robots).
 
-    Unreachable goals count as 0 (validation reports them before a run).
+    Moves, for bodies that turn as they move (``omni``, and the thesis's
+    lockstep ticks); moves and quarter turns from its start heading for bodies
+    that turn in place (``turning``: a ``(cell, heading)`` search,
+    :func:`~mrmp.search.heading_distance.heading_distances`). Unreachable goals
+    count as 0 (validation reports them before a run).
+
+    >>> from mrmp.core import Grid, PolicyOptions, RobotSpec, Scenario
+    >>> ahead = Scenario(Grid(1, 3), (RobotSpec("A", (0, 0), (0, 2)),))        # facing NORTH, goal to the EAST
+    >>> shortest_steps(ahead), shortest_steps(ahead.with_changes(policy=PolicyOptions(name="pibt", body="turning")))
+    ([2], [3])
     """
     grid = scenario.grid
     unit = Grid(grid.x_size, grid.y_size, grid.blocked_cells()) if grid.has_costs else grid
+    turning = body_model(scenario.policy.body).turns_in_place
     lengths = []
     for robot in scenario.robots:
-        distance = distance_table(unit, robot.goal).distance(robot.start)
+        if turning:
+            x, y = robot.start
+            table = heading_distances(unit, robot.goal, 1.0, both_ways=True)
+            distance = table[4 * (x * unit.y_size + y) + int(robot.heading) - 1]
+        else:
+            distance = distance_table(unit, robot.goal).distance(robot.start)
         lengths.append(int(distance) if math.isfinite(distance) else 0)
     return lengths
 

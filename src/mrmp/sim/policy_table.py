@@ -40,6 +40,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any, Protocol
 
+from mrmp.core.body import DEFAULT_BODY
 from mrmp.core.errors import InputError, Problem
 from mrmp.core.result import RunResult
 from mrmp.core.scenario import PolicyOptions, Scenario, Timing
@@ -109,6 +110,9 @@ class PolicyEntry:
         Its bodies always enter cells through the safety layer (it has no ``--unsafe`` form).
     records_messages:
         Its simulator can keep a message log (``--show-messages``).
+    bodies:
+        The body models (:mod:`mrmp.core.body`) its robots plan for and its
+        simulator drives.
     """
 
     name: str
@@ -122,6 +126,7 @@ class PolicyEntry:
     live_note: str = ""
     always_guarded: bool = False
     records_messages: bool = False
+    bodies: tuple[str, ...] = (DEFAULT_BODY,)
 
     @property
     def per_robot(self) -> bool:
@@ -169,6 +174,10 @@ def pibt_simulator(scenario: Scenario, on_tick: TickObserver | None = None) -> R
     'SynchronizedRoundsSimulator'
     """
     options = options_from(PibtOptions, scenario.policy)
+    if scenario.policy.body != DEFAULT_BODY and (options.sequencing, options.synchronizer) != ("driver", "clock"):
+        raise InputError(
+            Problem("policy.body", f"{scenario.policy.body} bodies run with sequencing: driver so far (not local sequencing)")
+        )
     if options.sequencing == "local":
         return STEP_ENDS[options.synchronizer](scenario, on_tick=on_tick)
     if options.synchronizer != "clock":
@@ -213,6 +222,7 @@ POLICY_TABLE: dict[str, PolicyEntry] = {
             "pibt runs live with local sequencing, whatever policy.sequencing says"
             " (no driver can order live processes; sequencing: driver is the simulator's)"
         ),
+        bodies=(DEFAULT_BODY, "turning"),
     ),
     "causal": PolicyEntry(
         "causal",
@@ -251,6 +261,36 @@ def policy_entry(name: str) -> PolicyEntry:
         raise InputError(
             Problem("policy.name", f"unknown policy {name!r}; known: {', '.join(policy_names())}")
         ) from None
+
+
+def body_problem(scenario: Scenario, *, live: bool = False, planned: bool = False) -> Problem | None:
+    """Why ``scenario``'s robots cannot run in its body model this way, or None when they can.
+
+    A policy runs the bodies of its entry's :attr:`~PolicyEntry.bodies`, in
+    the simulator; live fleets and the execution of central plans drive
+    ``omni`` bodies only so far.
+
+    >>> from mrmp.core import Grid, RobotSpec
+    >>> robots = (RobotSpec("A", (0, 0), (0, 1)),)
+    >>> turning = Scenario(Grid(1, 2), robots, policy=PolicyOptions(name="pibt", body="turning", sequencing="driver"))
+    >>> body_problem(turning) is None
+    True
+    >>> print(body_problem(turning, live=True))
+    policy.body: turning bodies are not driven live yet (only omni)
+    >>> print(body_problem(turning.with_changes(policy=PolicyOptions(name="astar", body="turning"))))
+    policy.body: astar plans for omni bodies, not turning
+    """
+    body = scenario.policy.body
+    if body == DEFAULT_BODY:
+        return None
+    if live:
+        return Problem("policy.body", f"{body} bodies are not driven live yet (only {DEFAULT_BODY})")
+    if planned:
+        return Problem("policy.body", f"central plans are executed by {DEFAULT_BODY} bodies only so far, not {body}")
+    entry = policy_entry(scenario.policy.name)
+    if body not in entry.bodies:
+        return Problem("policy.body", f"{entry.name} plans for {', '.join(entry.bodies)} bodies, not {body}")
+    return None
 
 
 def make_policy(options: PolicyOptions, timing: Timing | None = None) -> Policy:

@@ -16,6 +16,13 @@ previous round, then acts on them. A step runs as follows:
    serves them one after the other and charges time per group;
 3. every robot moves to the cell it reserved; the referee checks the move.
 
+**Bodies.** With ``policy.body: turning`` (LoRR's ``MAPF_T``,
+:mod:`mrmp.core.body`) the robots plan as bodies that turn in place
+(:class:`~mrmp.robot.pibt_robot.PibtRobot`'s ``turning``; no swap technique):
+in a step a robot drives to the cell ahead, turns a quarter, or waits, each
+lasting one cell time, and the referee judges every step by that body's rules
+(actions, following, no rotation).
+
 **Faults.** Messages cross a link layer with acknowledgements and
 retransmission (automatic repeat request): each try is lost, duplicated,
 delayed or reordered as the scenario's network says (one draw of
@@ -48,6 +55,7 @@ from collections import Counter
 from collections.abc import Container, Sequence
 from operator import attrgetter
 
+from mrmp.core.body import body_model
 from mrmp.core.faults import message_fates
 from mrmp.core.heading import right_turns
 from mrmp.core.result import RobotResult, RunResult
@@ -120,6 +128,8 @@ class RoundsSimulator:
         grid = scenario.grid
         self.flat = FlatMap(grid)
         flat = self.flat
+        self.body = body_model(options.body)
+        turning = self.body.turns_in_place
         self.robots: list[PibtRobot] = []
         for index, spec in enumerate(scenario.robots):
             goal = flat.index(spec.goal)
@@ -134,14 +144,15 @@ class RoundsSimulator:
                     tie=int(distance) if distance != float("inf") else 0,
                     heading=spec.heading,
                     radius=options.radius,
-                    swap=options.swap,
+                    swap=options.swap and not turning,
                     heading_aware=options.heading_aware,
                     turn_cost=scenario.timing.turn_time / scenario.timing.cell_time,
                     rng=stream_random(scenario.seed, Stream.TIES, index) if random_ties else None,
                     tie_penalties=tie_penalties,
+                    **({"turning": True} if turning else {}),
                 )
             )
-        self.referee = Referee(grid, [spec.id for spec in scenario.robots])
+        self.referee = Referee(grid, [spec.id for spec in scenario.robots], self.body)
         self.lengths = shortest_steps(scenario)
         self.max_ticks = scenario.max_ticks or self._default_max_ticks()
         self.tick = 0
@@ -185,7 +196,9 @@ class RoundsSimulator:
         """
         started = time.perf_counter()
         robots = self.robots
-        self.referee.check_start([spec.start for spec in self.scenario.robots])
+        self.referee.check_start(
+            [spec.start for spec in self.scenario.robots], [spec.heading for spec in self.scenario.robots]
+        )
         collecting = gc.isenabled()
         gc.disable()
         try:
@@ -242,6 +255,8 @@ class RoundsSimulator:
         cell_time, turn_time = timing.cell_time, timing.turn_time
         results, durations = self._results, self._durations
         before = [cells[robot.present] for robot in robots]
+        headings_before = [robot.heading for robot in robots]
+        turns_in_place = self.body.turns_in_place
         for robot in robots:
             index = robot.index
             result = results[index]
@@ -250,7 +265,11 @@ class RoundsSimulator:
             if moves and (movers is None or index in movers):
                 was = robot.present
                 robot.finish_step()
-                if robot.present != was:
+                if turns_in_place:  # every action lasts a cell time: forward (its entry cost), a quarter turn, a wait
+                    result.turns += int(robot.heading != heading)
+                    if robot.present != was and cost is not None:
+                        duration = cell_time * cost(cells[robot.present])
+                elif robot.present != was:
                     turns = right_turns(heading, robot.heading)
                     result.turns += turns
                     entry = cell_time * cost(cells[robot.present]) if cost is not None else cell_time
@@ -259,7 +278,10 @@ class RoundsSimulator:
             result.headings.append(robot.heading)
             durations[index].append(duration)
         after = [cells[robot.present] for robot in robots]
-        self.referee.check_tick(self.tick, before, after)
+        if self.body.headed:
+            self.referee.check_tick(self.tick, before, after, headings_before, [robot.heading for robot in robots])
+        else:
+            self.referee.check_tick(self.tick, before, after)
         self._count_goals()
         if self.on_tick is not None:
             self.on_tick(self.tick, after)

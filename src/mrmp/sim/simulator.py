@@ -49,6 +49,7 @@ from collections import Counter
 from collections.abc import Sequence
 
 from mrmp.core.cell import Cell
+from mrmp.core.errors import InputError
 from mrmp.core.heading import Heading, right_turns
 from mrmp.core.result import RobotResult, RunResult
 from mrmp.core.scenario import NetworkFaults, Scenario
@@ -58,7 +59,7 @@ from mrmp.protocol.messages import Message
 from mrmp.robot.robot import Outgoing, Robot
 from mrmp.sim.goals import GoalBook
 from mrmp.sim.metrics import default_max_ticks, network_slowdown, shortest_steps
-from mrmp.sim.policy_table import POLICY_TABLE, make_policy, policy_entry
+from mrmp.sim.policy_table import POLICY_TABLE, body_problem, make_policy, policy_entry
 from mrmp.sim.referee import Referee
 from mrmp.sim.spatial import SpatialIndex
 from mrmp.sim.ticking import TickObserver, run_result, run_ticks, scenario_network, send_counted
@@ -451,6 +452,9 @@ def simulate(
     [('A', 'B', 'claim'), ('A', 'B', 'handoff'), ('A', 'B', 'release'), ('A', 'B', 'state'),
      ('B', 'A', 'reply'), ('B', 'A', 'state')]
     """
+    problem = body_problem(scenario, planned=policies is not None)
+    if problem is not None:
+        raise InputError(problem)
     entry = policy_entry(scenario.policy.name) if policies is None else None
     if entry is not None and not entry.per_robot:
         if record_decisions:

@@ -1,0 +1,50 @@
+"""``--body``: a run in the turning model where it is planned for, a one-line refusal everywhere else."""
+
+from __future__ import annotations
+
+import json
+from pathlib import Path
+
+import pytest
+from typer.testing import CliRunner
+
+from mrmp.cli import app
+
+ROOT = Path(__file__).resolve().parents[3]
+CROWD = ROOT / "examples" / "causal-32.yaml"
+runner = CliRunner()
+
+
+def invoke(*args: object):
+    return runner.invoke(app, [str(arg) for arg in args])
+
+
+def test_pibt_runs_turning_bodies_and_the_result_is_judged_in_their_model() -> None:
+    result = invoke("run", CROWD, "--policy", "pibt", "--body", "turning", "--sequencing", "driver", "--json", "-")
+    assert result.exit_code == 0, result.output
+    run = json.loads(result.stdout)
+    assert run["success"] and run["collisions"] == []
+    for robot in run["robots"]:  # one action per tick: forward in the heading kept, or a turn in place
+        cells, headings = robot["path"], robot["headings"]
+        for tick in range(1, len(cells)):
+            assert cells[tick] == cells[tick - 1] or headings[tick] == headings[tick - 1]
+
+
+@pytest.mark.parametrize(
+    ("flags", "reason"),
+    [
+        (["--policy", "astar", "--body", "turning"], "policy.body: astar plans for omni bodies, not turning"),
+        (["--policy", "pibt", "--body", "turning"], "policy.body: turning bodies run with sequencing: driver so far"),
+        (
+            ["--policy", "pibt", "--body", "turning", "--sequencing", "driver", "--live"],
+            "policy.body: turning bodies are not driven live yet (only omni)",
+        ),
+        (["--body", "turning", "--planner", "lacam"], "policy.body: central plans are executed by omni bodies only"),
+        (["--body", "wheels"], "must be one of omni, thesis, turning, got 'wheels'"),
+    ],
+)
+def test_a_body_that_cannot_run_that_way_is_refused_in_one_line(flags: list[str], reason: str) -> None:
+    result = invoke("run", CROWD, *flags)
+    assert result.exit_code == 2, result.output
+    lines = [line for line in result.output.splitlines() if line.strip()]
+    assert len(lines) == 1 and reason in lines[0] and "Traceback" not in result.output
