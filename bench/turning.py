@@ -1,8 +1,8 @@
-"""The price of turning: PIBT and LaCAM planned for ``omni`` and for ``turning`` bodies, side by side.
+"""The price of turning: the central planners for ``omni`` and for ``turning`` bodies, side by side.
 
-For random-32-32-20 (N = 100..400) and warehouse-10-20-10-2-1 (N = 300),
-MovingAI scenario random-1, the first N agents, every robot starting to face
-NORTH, this prints for each planner and body:
+For random-32-32-20 (N = 20, 40 and 100..400) and warehouse-10-20-10-2-1 (N =
+300), MovingAI scenario random-1, the first N agents, every robot starting to
+face NORTH, this prints for each planner and body:
 
 * ``SoC/LB``: the plan's sum of costs over the lower bound *of its body*: for
   ``omni`` the sum of shortest path lengths, for ``turning`` the sum of every
@@ -18,8 +18,11 @@ NORTH, this prints for each planner and body:
 PIBT is the central one-step-per-tick planner (:mod:`mrmp.centralized.pibt_plan`),
 the reference of the fleet's decentralized ``pibt``; LaCAM is
 :mod:`mrmp.centralized.lacam` (the swap technique on for ``omni``; ``turning``
-bodies cannot walk backwards, so it is off there). Counts are deterministic
-(seed 0); the planning seconds are printed for orientation only.
+bodies cannot walk backwards, so it is off there); pp is prioritized planning
+(:mod:`mrmp.centralized.prioritized`, scenario order) and CBS
+(:mod:`mrmp.centralized.cbs`, optimal) runs up to :data:`CBS_MOST` robots.
+Counts are deterministic (seed 0); the planning seconds are printed for
+orientation only.
 
 Usage: python bench/turning.py [--cases random-32-32-20:100,warehouse-10-20-10-2-1:300] [--time-limit 60]
 """
@@ -31,9 +34,11 @@ from collections.abc import Sequence
 from pathlib import Path
 
 from mrmp.centralized.body_time import execution_seconds
+from mrmp.centralized.cbs import cbs
 from mrmp.centralized.lacam import lacam
 from mrmp.centralized.pibt_plan import pibt_plan
 from mrmp.centralized.plan import PlanningResult
+from mrmp.centralized.prioritized import prioritized
 from mrmp.core.body import body_model
 from mrmp.core.grid import Grid
 from mrmp.core.heading import Heading
@@ -45,8 +50,11 @@ from mrmp.sim.referee import check_paths
 
 MAPS = Path(__file__).resolve().parent.parent / "maps"
 CASES = (
-    "random-32-32-20:100,random-32-32-20:200,random-32-32-20:300,random-32-32-20:400,warehouse-10-20-10-2-1:300"
+    "random-32-32-20:20,random-32-32-20:40,random-32-32-20:100,random-32-32-20:200,random-32-32-20:300,"
+    "random-32-32-20:400,warehouse-10-20-10-2-1:300"
 )
+CBS_MOST = 20
+"""CBS plans only fleets this small (it is exponential in the robots that meet)."""
 TURNING = body_model("turning")
 TICK = Timing(cell_time=1.0, turn_time=1.0)
 
@@ -100,10 +108,14 @@ def main() -> int:
         starts, goals = [robot.start for robot in robots], [robot.goal for robot in robots]
         for body in ("omni", "turning"):
             bound = lower_bound(grid, starts, goals, body)
+            limit = arguments.time_limit
             plans = {
                 "pibt": pibt_plan(grid, starts, goals, body=body),
-                "lacam": lacam(grid, starts, goals, body=body, swap=body == "omni", time_limit_s=arguments.time_limit),
+                "pp": prioritized(grid, starts, goals, body=body, time_limit_s=limit),
+                "lacam": lacam(grid, starts, goals, body=body, swap=body == "omni", time_limit_s=limit),
             }
+            if len(starts) <= CBS_MOST:
+                plans["cbs"] = cbs(grid, starts, goals, body=body, time_limit_s=limit)
             for planner, plan in plans.items():
                 print(f"{name:<24} {size:>4} {planner:<8} {body:<8} {bound:>6.0f} {row(grid, plan, body, bound)}", flush=True)
     return 0

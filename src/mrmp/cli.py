@@ -390,6 +390,11 @@ def _cell(cell: tuple[int, int]) -> str:
     return f"({cell[0]},{cell[1]})"
 
 
+def _body_note(body: str) -> str:
+    """`` (turning bodies)`` after a figure of a run whose bodies are not the default ones, else nothing."""
+    return "" if body == "omni" else f" ({body} bodies)"
+
+
 def print_result(result: RunResult, console: Console) -> None:
     """Print the per-robot table and the summary line."""
     table = Table(title=f"{result.scenario or 'run'}: policy {result.policy}, seed {result.seed}")
@@ -440,7 +445,8 @@ def print_result(result: RunResult, console: Console) -> None:
     else:
         console.print(
             f"{verdict} ({result.stop_reason} at tick {result.ticks}): makespan {result.makespan} ticks "
-            f"({result.time_makespan_s:.1f} s), sum of costs {result.sum_of_costs}, lower bound {result.lower_bound}, "
+            f"({result.time_makespan_s:.1f} s), sum of costs {result.sum_of_costs} ({result.time_sum_of_costs_s:.1f} s), "
+            f"lower bound {result.lower_bound}{_body_note(result.body)}, "
             f"collisions: {len(result.collisions)}, messages {result.messages}, wall time {result.wall_time_s:.3f} s"
         )
     if result.plan_sum_of_costs is not None:

@@ -63,7 +63,9 @@ not implemented): there the limits apply.
 robot's first tick from which it stays at its goal, summed. With
 ``heading_aware=True`` one tick is one move forward, one right turn in place or
 a wait (see :mod:`mrmp.centralized.space_time_astar`), and CBS is optimal for
-that time model.
+that time model; with ``body="turning"`` (LoRR's ``MAPF_T``,
+:mod:`mrmp.core.body`) a tick may also be a left turn, and CBS is optimal for
+those bodies.
 
 **Limits and statuses.** The search stops at ``max_nodes`` generated
 constraint-tree nodes or after ``time_limit_s`` seconds, whichever comes first,
@@ -126,6 +128,7 @@ from mrmp.core.scenario import Scenario
 __all__ = [
     "DEFAULT_MAX_NODES",
     "DEFAULT_TIME_LIMIT_S",
+    "PLANNED_BODIES",
     "Conflict",
     "all_conflicts",
     "cbs",
@@ -139,6 +142,8 @@ DEFAULT_MAX_NODES = 100_000
 """Constraint-tree nodes CBS generates at most unless told otherwise."""
 DEFAULT_TIME_LIMIT_S = 60.0
 """Seconds CBS plans at most unless told otherwise."""
+PLANNED_BODIES = ("omni", "turning")
+"""The bodies CBS and prioritized planning plan for (:mod:`mrmp.core.body`)."""
 
 _Constraint = tuple[str, Cell, int] | tuple[str, Cell, Cell, int]
 """A CBS constraint: ``("v", cell, t)`` forbids ``cell`` at tick ``t``; ``("e", u, v, t)``
@@ -368,6 +373,7 @@ def mdd_layers(
     *,
     heading_aware: bool = False,
     heading: Heading = Heading.NORTH,
+    both_ways: bool = False,
 ) -> tuple[frozenset[Cell], ...]:
     """The cells of every path of exactly ``cost`` ticks from ``start`` to ``goal``, tick by tick.
 
@@ -389,7 +395,7 @@ def mdd_layers(
     )
 
     if heading_aware:
-        table = heading_distance_table(tick_grid(grid), goal)
+        table = heading_distance_table(tick_grid(grid), goal, both_ways)
 
         def estimate(state: tuple[Cell, int]) -> float:
             return table.get((state[0], Heading(state[1])), float("inf"))
@@ -397,6 +403,8 @@ def mdd_layers(
         def successors(state: tuple[Cell, int]) -> list[tuple[Cell, int]]:
             cell, facing = state
             moves = [(cell, facing), (cell, facing % 4 + 1)]
+            if both_ways:
+                moves.append((cell, (facing - 2) % 4 + 1))
             ahead = Heading(facing).ahead(cell)
             if grid.is_free(ahead):
                 moves.append((ahead, facing))
@@ -449,6 +457,7 @@ def cbs(
     time_limit_s: float | None = DEFAULT_TIME_LIMIT_S,
     heading_aware: bool = False,
     improved: bool = True,
+    body: str = "omni",
 ) -> PlanningResult:
     """Plan every robot with Conflict-Based Search (Sharon et al. 2015): least sum of costs without rotations.
 
@@ -471,6 +480,10 @@ def cbs(
         Use the optimality-preserving improvements (cardinal conflicts first,
         the conflict-graph heuristic, bypass; see the module docstring).
         ``False`` runs the original CBS: split the first conflict in time.
+    body:
+        The body planned for (:data:`PLANNED_BODIES`): ``omni`` (the turn model
+        of ``heading_aware``), or ``turning``: one tick is one move forward, a
+        quarter turn either way, or a wait (``heading_aware`` is then implied).
 
     Returns
     -------
@@ -493,9 +506,12 @@ def cbs(
     >>> r.status, r.nodes, r.message
     ('limit', 5, 'node limit of 5 reached')
     """
+    if body not in PLANNED_BODIES:
+        raise ValueError(f"cbs plans for the bodies {', '.join(PLANNED_BODIES)}, not {body!r}")
     began = time.perf_counter()
     instance = as_problem(problem, starts, goals)
-    search = _ConflictSearch(instance, began, time_limit_s, max_nodes, heading_aware, improved)
+    turning = body == "turning"
+    search = _ConflictSearch(instance, began, time_limit_s, max_nodes, heading_aware or turning, improved, turning)
     proof = infeasibility_proof(instance)
     if proof is not None:
         return search.result("infeasible", proof, 0)
@@ -536,8 +552,10 @@ class _ConflictSearch:
         max_nodes: int | None,
         heading_aware: bool,
         improved: bool,
+        both_ways: bool = False,
     ) -> None:
         self.instance = instance
+        self.both_ways = both_ways
         self.grid = instance.grid
         self.count = len(instance)
         self.began = began
@@ -661,6 +679,7 @@ class _ConflictSearch:
             _reservations(constraints),
             heading_aware=self.heading_aware,
             heading=instance.headings[index],
+            both_ways=self.both_ways,
             avoid=_avoidance(paths, index),
             deadline=self.deadline,
         )
@@ -678,6 +697,7 @@ class _ConflictSearch:
                 _reservations(node.constraints[robot]),
                 heading_aware=self.heading_aware,
                 heading=instance.headings[robot],
+                both_ways=self.both_ways,
             )
             node.mdds[robot] = layers
         return layers

@@ -56,7 +56,7 @@ from __future__ import annotations
 import time
 from collections.abc import Sequence
 
-from mrmp.centralized.cbs import infeasibility_proof
+from mrmp.centralized.cbs import PLANNED_BODIES, infeasibility_proof
 from mrmp.centralized.plan import (
     MapfProblem,
     PlanningResult,
@@ -128,6 +128,7 @@ def prioritized(
     max_time: int | None = None,
     time_limit_s: float | None = None,
     heading_aware: bool = False,
+    body: str = "omni",
 ) -> PlanningResult:
     """Plan the robots one by one in priority order (Silver 2005; Erdmann & Lozano-Perez 1987).
 
@@ -148,6 +149,11 @@ def prioritized(
         (``None``: no limit).
     heading_aware:
         Plan with the turn model (one tick per move forward or right turn).
+    body:
+        The body planned for (:data:`~mrmp.centralized.cbs.PLANNED_BODIES`):
+        ``omni`` (the turn model of ``heading_aware``), or ``turning`` (LoRR's
+        ``MAPF_T``: one tick per move forward, quarter turn either way, or wait;
+        ``heading_aware`` implied).
 
     Returns
     -------
@@ -171,12 +177,15 @@ def prioritized(
     >>> r.status, r.sum_of_costs(), r.planner
     ('solved', 6, 'pp')
     """
+    if body not in PLANNED_BODIES:
+        raise ValueError(f"pp plans for the bodies {', '.join(PLANNED_BODIES)}, not {body!r}")
     began = time.perf_counter()
     instance = as_problem(problem, starts, goals)
     proof = infeasibility_proof(instance)
     if proof is not None:
         return PlanningResult("infeasible", None, time.perf_counter() - began, "pp", message=proof)
-    planner = _Prioritized(instance, began, time_limit_s, max_time, heading_aware)
+    turning = body == "turning"
+    planner = _Prioritized(instance, began, time_limit_s, max_time, heading_aware or turning, turning)
     return planner.run(priority_order(instance, order))
 
 
@@ -184,9 +193,16 @@ class _Prioritized:
     """One run of prioritized planning: plan each robot in turn around the paths reserved before it."""
 
     def __init__(
-        self, instance: MapfProblem, began: float, time_limit_s: float | None, max_time: int | None, heading_aware: bool
+        self,
+        instance: MapfProblem,
+        began: float,
+        time_limit_s: float | None,
+        max_time: int | None,
+        heading_aware: bool,
+        both_ways: bool = False,
     ) -> None:
         self.instance = instance
+        self.both_ways = both_ways
         self.began = began
         self.time_limit_s = time_limit_s
         self.deadline = None if time_limit_s is None else began + time_limit_s
@@ -223,6 +239,7 @@ class _Prioritized:
             self.reservations,
             heading_aware=self.heading_aware,
             heading=instance.headings[index],
+            both_ways=self.both_ways,
             max_time=self.max_time,
             deadline=self.deadline,
         )

@@ -30,14 +30,18 @@ _HEADING_AWARE = ("cbs", "pp")
 
 
 def plan_with(name: str, scenario: Scenario, time_limit_s: float) -> PlanningResult:
-    """Plan ``scenario`` with the planner ``name`` (heading-aware when the scenario's policy asks for it).
+    """Plan ``scenario`` with the planner ``name``, for its policy's body (heading-aware when the policy asks for it).
 
     Raises
     ------
     KeyError
         If ``name`` is not in :data:`PLANNER_NAMES`.
+    ValueError
+        If the planner does not plan for the scenario's body (every one plans
+        for ``omni`` and ``turning``).
     """
     planner = PLANNERS[name]
+    body = scenario.policy.body
     if name in _HEADING_AWARE:
-        return planner(scenario, time_limit_s=time_limit_s, heading_aware=scenario.policy.heading_aware)
-    return planner(scenario, time_limit_s=time_limit_s, seed=derive_seed(scenario.seed, Stream.PLANNER))
+        return planner(scenario, time_limit_s=time_limit_s, heading_aware=scenario.policy.heading_aware, body=body)
+    return planner(scenario, time_limit_s=time_limit_s, seed=derive_seed(scenario.seed, Stream.PLANNER), body=body)

@@ -50,7 +50,11 @@ cell forward into the cell ahead. So one tick is one move *or* one right turn,
 and a robot changes direction only after spending ticks turning in place. The
 heuristic is the exact static distance over ``(cell, heading)`` states
 (:func:`heading_distance_table`). Reservations still speak of cells: a robot
-turning in place occupies its cell like a waiting one.
+turning in place occupies its cell like a waiting one. With ``both_ways`` a
+robot may also turn a quarter counter-clockwise in a tick: the ``turning`` body
+(LoRR's ``MAPF_T``, :mod:`mrmp.core.body`), whose following rule (a robot may
+enter a cell as its occupant drives out of it, never round a cycle) is the one
+the move entries above enforce.
 
 Examples
 --------
@@ -292,17 +296,20 @@ def hop_distance_table(grid: Grid, goal: Cell) -> DistanceTable:
 
 
 @lru_cache(maxsize=64)
-def heading_distance_table(grid: Grid, goal: Cell) -> dict[tuple[Cell, Heading], int]:
+def heading_distance_table(grid: Grid, goal: Cell, both_ways: bool = False) -> dict[tuple[Cell, Heading], int]:
     """Ticks from every ``(cell, heading)`` to ``goal`` under the turn model, on the static grid.
 
-    One tick moves one cell ahead or turns right once; the goal may be reached
-    facing any heading. Computed by a breadth-first search backwards from the
-    four goal states (Moore 1959). States that cannot reach the goal are left
-    out. Entry costs are ignored. Cached per grid and goal.
+    One tick moves one cell ahead or turns right once (``both_ways``: or left
+    once); the goal may be reached facing any heading. Computed by a
+    breadth-first search backwards from the four goal states (Moore 1959).
+    States that cannot reach the goal are left out. Entry costs are ignored.
+    Cached per grid, goal and turn model.
 
     >>> table = heading_distance_table(Grid(1, 3), (0, 2))
     >>> table[((0, 0), Heading.EAST)], table[((0, 0), Heading.NORTH)], table[((0, 0), Heading.SOUTH)]
     (2, 3, 5)
+    >>> heading_distance_table(Grid(1, 3), (0, 2), both_ways=True)[((0, 0), Heading.SOUTH)]
+    3
     """
     distances: dict[tuple[Cell, Heading], int] = {}
     queue: deque[tuple[Cell, Heading]] = deque()
@@ -316,6 +323,8 @@ def heading_distance_table(grid: Grid, goal: Cell) -> dict[tuple[Cell, Heading],
         dx, dy = heading.delta
         behind = (cell[0] - dx, cell[1] - dy)
         predecessors = [(Heading((int(heading) - 2) % 4 + 1), cell)]  # turned right into `heading`
+        if both_ways:
+            predecessors.append((Heading(int(heading) % 4 + 1), cell))  # turned left into `heading`
         if grid.is_free(behind):
             predecessors.append((heading, behind))
         for previous_heading, previous_cell in predecessors:
@@ -334,6 +343,7 @@ def space_time_astar(
     *,
     heading_aware: bool = False,
     heading: Heading = Heading.NORTH,
+    both_ways: bool = False,
     max_time: int | None = None,
     avoid: Reservations | None = None,
     deadline: float | None = None,
@@ -358,6 +368,8 @@ def space_time_astar(
         one right turn in place, or a wait.
     heading:
         The robot's heading at tick 0 (heading-aware mode only).
+    both_ways:
+        Heading-aware mode: a tick may also be a left turn (``turning`` bodies).
     max_time:
         The horizon: no state later than this tick is searched; ``None`` for
         no horizon (the search is still finite, see the module docstring).
@@ -408,6 +420,12 @@ def space_time_astar(
     ((0, 0), (0, 0), (0, 1), (0, 2))
     >>> [h.name for h in result.headings]
     ['NORTH', 'EAST', 'EAST', 'EAST']
+
+    Facing EAST, a body that turns both ways turns left once toward NORTH, not right three times:
+
+    >>> turning = space_time_astar(grid, (0, 0), (1, 0), heading_aware=True, heading=Heading.EAST, both_ways=True)
+    >>> [h.name for h in turning.headings]
+    ['EAST', 'NORTH', 'NORTH']
     """
     if not grid.is_free(start):
         raise ValueError(f"start {start} is not a free cell")
@@ -415,7 +433,7 @@ def space_time_astar(
         raise ValueError(f"goal {goal} is not a free cell")
     if deadline is not None and time.perf_counter() > deadline:  # before the distance table, as long as a search
         return SpaceTimeResult("deadline", None, None, 0)
-    search = _SpaceTimeSearch(grid, goal, reservations or Reservations(), avoid, heading_aware)
+    search = _SpaceTimeSearch(grid, goal, reservations or Reservations(), avoid, heading_aware, both_ways)
     start_facing = int(heading) if heading_aware else 0
     if search.hopeless(start, start_facing):
         return SpaceTimeResult("unreachable", None, None, 0)
@@ -431,15 +449,22 @@ class _SpaceTimeSearch:
     """
 
     def __init__(
-        self, grid: Grid, goal: Cell, reservations: Reservations, avoid: Reservations | None, heading_aware: bool
+        self,
+        grid: Grid,
+        goal: Cell,
+        reservations: Reservations,
+        avoid: Reservations | None,
+        heading_aware: bool,
+        both_ways: bool = False,
     ) -> None:
         self.grid = grid
         self.goal = goal
         self.reservations = reservations
         self.avoid = avoid
         self.heading_aware = heading_aware
+        self.both_ways = both_ways
         if heading_aware:
-            heading_table = heading_distance_table(grid, goal)
+            heading_table = heading_distance_table(grid, goal, both_ways)
             self.estimate = lambda cell, facing: heading_table.get((cell, Heading(facing)), math.inf)
         else:
             hop = hop_distance_table(grid, goal).distance
@@ -493,10 +518,12 @@ class _SpaceTimeSearch:
         return SpaceTimeResult("horizon" if cut_by_horizon else "unreachable", None, None, expansions)
 
     def _moves(self, cell: Cell, facing: int) -> list[tuple[Cell, int]]:
-        """The ``(cell, facing)`` pairs one tick can lead to: wait, (turn right,) move."""
+        """The ``(cell, facing)`` pairs one tick can lead to: wait, (turn right, turn left,) move."""
         if self.heading_aware:
             ahead = Heading(facing).ahead(cell)
             moves = [(cell, facing), (cell, facing % 4 + 1)]
+            if self.both_ways:
+                moves.append((cell, (facing - 2) % 4 + 1))
             if self.grid.is_free(ahead):
                 moves.append((ahead, facing))
             return moves

@@ -124,6 +124,10 @@ class RunResult:
     ``record_messages`` carries its ``message_log``: for each tick (index 0,
     the start, is empty) the ``(sender id, recipient id, kind)`` of every
     message sent during that tick; ``None`` when messages were not recorded.
+    ``body`` names the body model the robots planned for and were judged in
+    (:mod:`mrmp.core.body`); a robot's ``time_s`` counts its body's actions in
+    seconds, so ``time_makespan_s`` and ``time_sum_of_costs_s`` are the
+    makespan and the sum of costs in the body's seconds, beside the ticks.
     """
 
     scenario: str
@@ -145,6 +149,7 @@ class RunResult:
     plan_makespan: int | None = None
     lifelong: bool = False
     message_log: list[list[tuple[str, str, str]]] | None = None
+    body: str = "omni"
 
     @property
     def all_arrived(self) -> bool:
@@ -177,6 +182,11 @@ class RunResult:
     def time_makespan_s(self) -> float:
         """The largest time a robot's body needed until it settled (moves, turns, waits)."""
         return max((robot.time_s for robot in self.robots), default=0.0)
+
+    @property
+    def time_sum_of_costs_s(self) -> float:
+        """The sum over robots of the time each robot's body needed until it settled (moves, turns, waits)."""
+        return sum(robot.time_s for robot in self.robots)
 
     @property
     def messages(self) -> int:

@@ -43,7 +43,8 @@ RESULTS_CSV = "results.csv"
 """The table inside a benchmark's output folder."""
 
 RESULT_FIELDS: tuple[str, ...] = (
-    "success", "stop_reason", "ticks", "makespan", "sum_of_costs", "lower_bound", "time_makespan_s", "messages",
+    "success", "stop_reason", "ticks", "makespan", "sum_of_costs", "lower_bound", "time_makespan_s",
+    "time_sum_of_costs_s", "messages",
     "network", "wall_time_s", "planning_time_s", "plan_bytes", "throughput", "collisions", "soc_over_lb",
     "robots_arrived", "goals_reached", "steps", "wall_time_per_step_s", "messages_per_robot_move",
 )  # fmt: skip

@@ -101,8 +101,9 @@ _RESULT_FIELDS: dict[str, tuple[str, bool]] = {  # name -> (kind, required when 
     "wall_time_per_step_s": (_NUMBER, True),
     "messages_per_robot_move": (_NUMBER, False),
 }
-_OPTIONAL_FIELDS: dict[str, str] = {"bench": _TEXT, "instance": _INT}
-"""Fields a record may lack: the benchmark's name, a generated map's instance number."""
+_OPTIONAL_FIELDS: dict[str, str] = {"bench": _TEXT, "instance": _INT, "time_sum_of_costs_s": _NUMBER}
+"""Fields a record may lack: the benchmark's name, a generated map's instance number, the sum of costs in seconds
+(recorded since bodies were named)."""
 _KINDS = ("decentralized", "centralized")
 
 
@@ -181,6 +182,7 @@ class BenchRecord:
     sum_of_costs: int | None = None
     lower_bound: int | None = None
     time_makespan_s: float | None = None
+    time_sum_of_costs_s: float | None = None
     messages: int | None = None
     network: Mapping[str, Any] | None = None
     wall_time_s: float | None = None

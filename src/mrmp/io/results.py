@@ -80,7 +80,7 @@ def result_to_dict(result: RunResult, grid: Grid | None = None) -> dict[str, Any
     dict
         Keys ``format``, ``scenario``, ``policy``, ``seed``, ``success``,
         ``stop_reason``, ``ticks``, ``makespan``, ``sum_of_costs``,
-        ``lower_bound``, ``time_makespan_s``, ``messages``, ``network``,
+        ``lower_bound``, ``time_makespan_s``, ``time_sum_of_costs_s``, ``body``, ``messages``, ``network``,
         ``wall_time_s``, ``collisions`` (each ``{kind, tick, robots, cells}``),
         ``robots`` (each ``{id, start, goal, arrived, arrival_tick, cost, steps,
         turns, waits, messages_sent, bytes_sent, time_s, path, headings}``),
@@ -106,6 +106,8 @@ def result_to_dict(result: RunResult, grid: Grid | None = None) -> dict[str, Any
         "sum_of_costs": result.sum_of_costs,
         "lower_bound": result.lower_bound,
         "time_makespan_s": result.time_makespan_s,
+        "time_sum_of_costs_s": result.time_sum_of_costs_s,
+        "body": result.body,
         "messages": result.messages,
         "network": dict(result.network),
         "wall_time_s": result.wall_time_s,
@@ -306,6 +308,7 @@ def result_from_dict(data: Mapping[str, Any], source: str = "result") -> RunResu
         plan_sum_of_costs=fields.get("plan_sum_of_costs", (int, type(None)), "an integer or null", None),
         plan_makespan=fields.get("plan_makespan", (int, type(None)), "an integer or null", None),
         lifelong=fields.get("lifelong", bool, "true or false", False),
+        body=fields.get("body", str, "a string", "omni"),
         message_log=_message_log(fields.get("message_log", (list, type(None)), "a list of ticks or null", None), source),
     )
 

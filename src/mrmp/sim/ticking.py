@@ -160,5 +160,6 @@ def run_result(
         wall_time_s=wall_time,
         network=network,
         lifelong=scenario.lifelong,
+        body=scenario.policy.body,
         **extra,
     )
