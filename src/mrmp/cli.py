@@ -544,13 +544,14 @@ def run(
     miss_line: Annotated[float, typer.Option(help="Probability that a body misses a grid line.", rich_help_panel=LIVE)] = 0.0,
     results: Annotated[Path | None, typer.Option(help="Folder for the robots' traces and reports (mrmp agent's --results, for the whole fleet).", show_default="a new temporary folder", rich_help_panel=LIVE)] = None,
     kill: Annotated[list[str] | None, typer.Option(help="Kill robot ID's process S wall-clock seconds after the fleet's start (repeatable).", metavar="ID@S", show_default=False, rich_help_panel=LIVE)] = None,
+    ros2: Annotated[bool, typer.Option("--ros2", help="Every robot process publishes its pose and state on ROS 2 topics (DDS, domain ROS_DOMAIN_ID; the ros2 extra; docs/ros2.md).", rich_help_panel=LIVE)] = False,
 ) -> None:
     """Run a scenario (lockstep simulator, or --live processes) and report what happened."""
     # --resolve, --heading-aware, --radius, --swap and --search come from PolicyOptions' fields (with_policy_flags)
     request = RunRequest(
         None if json_path is None else str(json_path), animate, show_messages, watch, watch_fps, planner, time_limit, live, transport, time_scale,
         delay_ms, jitter, miss_line, results, kill or [], unsafe, goal_lines=goal_lines, colour_by=colour_by, speed=speed,
-        record=record,
+        record=record, ros2=ros2,
     )
     console = Console(stderr=request.json_path == "-", highlight=False)
     try:
@@ -603,6 +604,7 @@ class RunRequest:
     colour_by: str | None = None
     speed: float = 1.0
     record: Path | None = None
+    ros2: bool = False
 
 
 def _validate_run(scenario: Scenario, request: RunRequest) -> None:
@@ -641,6 +643,10 @@ def _validate_run(scenario: Scenario, request: RunRequest) -> None:
             raise InputError(Problem(str(request.record), record_issue))
     if request.watch and request.live:
         raise InputError(Problem("--watch", "live runs are not drawn in the terminal (--watch is for simulated runs)"))
+    if request.ros2 and not request.live:
+        raise InputError(Problem("--ros2", "publishes the robots of a live run: add --live"))
+    if request.ros2:
+        _ros2_domain()
     if request.watch:
         _positive(request.watch_fps, "--watch-fps")
 
@@ -699,6 +705,7 @@ def _live_run(scenario: Scenario, request: RunRequest, plan: PlanningResult | No
         kill=parse_kills(request.kill),
         seed=scenario.seed,
         plan=plan,
+        ros2=request.ros2,
     )
     from mrmp.viz.progress import LiveProgressLine
 
@@ -989,6 +996,7 @@ def agent(
     plan: Annotated[Path | None, typer.Option(help="Follow this robot's share of a central plan (plan-<index>.json).", show_default="none: the policy decides")] = None,
     seed: Annotated[int, typer.Option(help="Seed of the body's and the fault injector's randomness.")] = 0,
     timeout: Annotated[float, typer.Option(help="Give up after this many seconds.")] = 600.0,
+    ros2: Annotated[bool, typer.Option("--ros2", help="Publish this robot's pose and state on ROS 2 topics (DDS, domain ROS_DOMAIN_ID; the ros2 extra; docs/ros2.md).")] = False,
     scenario_option: Annotated[Path | None, typer.Option("--scenario", hidden=True, help="SCENARIO, as an option.")] = None,
 ) -> None:
     """Run one robot of a fleet as this process (one command per robot, on its own computer)."""
@@ -1012,6 +1020,7 @@ def agent(
         body_issue = body_problem(scenario, live=True)
         if body_issue is not None:
             raise InputError(body_issue)
+        domain = _ros2_domain() if ros2 else None
         ids = [spec.id for spec in scenario.robots]
         if robot not in ids:
             raise InputError(Problem("--robot", f"no robot has the id {robot!r} in {scenario_path}"))
@@ -1043,6 +1052,7 @@ def agent(
                 timeout=_positive(timeout, "--timeout", MAX_RUN_SECONDS, "seconds"),
             ),
             plan=plan,
+            ros2_domain=domain,
         )
         if plan is not None:
             from mrmp.io.plans import read_share
@@ -1052,6 +1062,21 @@ def agent(
     except InputError as error:
         raise _fail(error.problems) from None
     raise typer.Exit(0 if report.arrived else 1)
+
+
+def _ros2_domain() -> int:
+    """The ROS 2 domain of ``--ros2`` (``ROS_DOMAIN_ID``), once its package is known to be there."""
+    import os
+
+    from mrmp.live.ros2_topics import DOMAIN_VARIABLE, ros2_domain, ros2_problem
+
+    missing = ros2_problem()
+    if missing is not None:
+        raise InputError(Problem("--ros2", missing))
+    try:
+        return ros2_domain(os.environ)
+    except ValueError as error:
+        raise InputError(Problem(DOMAIN_VARIABLE, str(error).removeprefix(f"{DOMAIN_VARIABLE}: "))) from None
 
 
 @command()

@@ -69,6 +69,8 @@ class LiveOptions:
     kill: Mapping[str, float] = field(default_factory=dict)
     seed: int = 0
     plan: PlanningResult | None = None
+    ros2: bool = False
+    """Every robot publishes its pose and state on ROS 2 topics (``mrmp agent --ros2``; domain ``ROS_DOMAIN_ID``)."""
 
 
 @dataclass(frozen=True)
@@ -219,6 +221,7 @@ def _agent_arguments(options: LiveOptions, files: _RunFiles, session: int, timeo
         f"--timeout={timeout}",
         f"--listen-time={options.timing.listen_time}",
         *([] if options.guarded else ["--unsafe"]),
+        *(["--ros2"] if options.ros2 else []),
     ]
 
 

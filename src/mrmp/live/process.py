@@ -19,6 +19,7 @@ from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from mrmp.core.cell import Cell
 from mrmp.core.errors import InputError, Problem
 from mrmp.core.scenario import Scenario
 from mrmp.core.seeds import Stream, derive_seed, stream_random
@@ -30,6 +31,7 @@ from mrmp.live.body import OccupancyRecorder, SimulatedBody
 from mrmp.live.causal_agent import CausalAgent
 from mrmp.live.pibt_agent import PibtAgent
 from mrmp.live.referee import IntervalReferee
+from mrmp.live.ros2_topics import Ros2Publisher
 from mrmp.live.transport import ConnectedTransport, LiveFaults, Transport, is_loopback
 from mrmp.live.transport_table import FAULTS, TransportSpec
 from mrmp.policies.plan_following import PlanFollowingPolicy
@@ -152,6 +154,8 @@ class AgentOptions:
     timing: AgentTiming = field(default_factory=AgentTiming)
     plan: Path | None = None
     """This robot's share of a central plan (``mrmp.io.plans.write_share``)."""
+    ros2_domain: int | None = None
+    """Publish the robot's pose and state on ROS 2 topics in this domain (:mod:`mrmp.live.ros2_topics`); None: not."""
 
 
 def _per_robot_agent(
@@ -239,7 +243,12 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
     report_path = options.results / f"agent-{index}.json"
     trace = TraceWriter(options.results / f"trace-{index}.jsonl", index)
     transport: Transport | None = None
+    ros2: Ros2Publisher | None = None
     try:
+        sink: OccupancySink = trace.write
+        if options.ros2_domain is not None:
+            ros2 = Ros2Publisher(spec.id, spec.start, spec.heading, domain=options.ros2_domain)
+            sink = _both(trace.write, ros2.occupancy)
         transport = opened = options.transport.open(index, len(scenario.robots))
         transport = FAULTS.wrap(opened, options.faults, seed=derive_seed(options.seed, Stream.LIVE_FAULTS, index))
         body = SimulatedBody(
@@ -251,7 +260,7 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
             jitter=options.jitter,
             miss_line=options.miss_line,
             rng=stream_random(options.seed, Stream.BODY, index),
-            recorder=OccupancyRecorder(trace.write),
+            recorder=OccupancyRecorder(sink),
         )
         sealer = Sealer(options.key, options.session)
         opener = Opener(options.key, options.session, fleet_size=len(scenario.robots))
@@ -268,8 +277,24 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
         if transport is not None:
             transport.close()
         trace.close()
+        if ros2 is not None:
+            ros2.close()
     write_json(report_path, report.as_dict())
     return report
+
+
+OccupancySink = Callable[[str, Cell, float], None]
+"""Where a body's ground-truth events go (:class:`~mrmp.live.body.OccupancyRecorder`)."""
+
+
+def _both(first: OccupancySink, second: OccupancySink) -> OccupancySink:
+    """An occupancy sink that hands every event to ``first``, then to ``second``."""
+
+    def sink(event: str, cell: Cell, t: float) -> None:
+        first(event, cell, t)
+        second(event, cell, t)
+
+    return sink
 
 
 PROFILE_VARIABLE = "MRMP_PROFILE"
