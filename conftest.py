@@ -1,5 +1,8 @@
 """Doctests run from the repository's root, so that their examples can name ``examples/`` and ``maps/``.
 
+Without the optional extra ``ros2`` the module of ROS 2's DDS types is left out
+of the doctests (it imports ``cyclonedds``); the tests that need it skip.
+
 Property tests (hypothesis) have no per-example deadline: a wall-clock limit
 would make them fail on a loaded machine, and the project asserts counts, never
 durations.
@@ -7,6 +10,7 @@ durations.
 
 from __future__ import annotations
 
+import importlib.util
 from pathlib import Path
 
 import pytest
@@ -14,6 +18,9 @@ from _pytest.doctest import DoctestItem
 from hypothesis import settings
 
 ROOT = Path(__file__).resolve().parent
+
+collect_ignore = [] if importlib.util.find_spec("cyclonedds") else ["src/mrmp/live/ros2_types.py"]
+"""Without the ``ros2`` extra, the module of DDS types cannot be imported for its doctests (the rest of mrmp can)."""
 
 settings.register_profile("mrmp", deadline=None)
 settings.load_profile("mrmp")

@@ -997,6 +997,8 @@ def agent(
     seed: Annotated[int, typer.Option(help="Seed of the body's and the fault injector's randomness.")] = 0,
     timeout: Annotated[float, typer.Option(help="Give up after this many seconds.")] = 600.0,
     ros2: Annotated[bool, typer.Option("--ros2", help="Publish this robot's pose and state on ROS 2 topics (DDS, domain ROS_DOMAIN_ID; the ros2 extra; docs/ros2.md).")] = False,
+    drive: Annotated[str, typer.Option(help="The body: simulated, or ros2 (a robot's ROS 2 driver: Twist on /robot_<id>/cmd_vel, odometry from /robot_<id>/odom; docs/ros2.md).", metavar="simulated|ros2")] = "simulated",
+    drive_wait: Annotated[float, typer.Option(help="With --drive ros2: seconds to wait for the driver's first odometry.")] = 30.0,
     scenario_option: Annotated[Path | None, typer.Option("--scenario", hidden=True, help="SCENARIO, as an option.")] = None,
 ) -> None:
     """Run one robot of a fleet as this process (one command per robot, on its own computer)."""
@@ -1021,6 +1023,9 @@ def agent(
         if body_issue is not None:
             raise InputError(body_issue)
         domain = _ros2_domain() if ros2 else None
+        if drive not in ("simulated", "ros2"):
+            raise InputError(Problem("--drive", f"must be simulated or ros2, got {drive!r}"))
+        drive_domain = _ros2_domain() if drive == "ros2" else 0
         ids = [spec.id for spec in scenario.robots]
         if robot not in ids:
             raise InputError(Problem("--robot", f"no robot has the id {robot!r} in {scenario_path}"))
@@ -1053,6 +1058,9 @@ def agent(
             ),
             plan=plan,
             ros2_domain=domain,
+            drive=drive,
+            drive_domain=drive_domain,
+            drive_wait=_positive(drive_wait, "--drive-wait", MAX_RUN_SECONDS, "seconds"),
         )
         if plan is not None:
             from mrmp.io.plans import read_share

@@ -27,10 +27,12 @@ from mrmp.io.lifetime import STOP_SIGNALS, release_held_signals, watch_parent
 from mrmp.io.live_files import TraceReader, TraceWriter, write_json
 from mrmp.io.plans import read_share, read_share_dependents
 from mrmp.live.agent import Agent, AgentReport, AgentTiming
-from mrmp.live.body import OccupancyRecorder, SimulatedBody
+from mrmp.live.body import Body, LineCountingBody, OccupancyRecorder, SimulatedBody
 from mrmp.live.causal_agent import CausalAgent
+from mrmp.live.diff_drive import body_geometry
 from mrmp.live.pibt_agent import PibtAgent
 from mrmp.live.referee import IntervalReferee
+from mrmp.live.ros2_driver import Ros2Driver, odometry_topic
 from mrmp.live.ros2_topics import Ros2Publisher
 from mrmp.live.transport import ConnectedTransport, LiveFaults, Transport, is_loopback
 from mrmp.live.transport_table import FAULTS, TransportSpec
@@ -156,13 +158,20 @@ class AgentOptions:
     """This robot's share of a central plan (``mrmp.io.plans.write_share``)."""
     ros2_domain: int | None = None
     """Publish the robot's pose and state on ROS 2 topics in this domain (:mod:`mrmp.live.ros2_topics`); None: not."""
+    drive: str = "simulated"
+    """The body: ``simulated`` (:class:`~mrmp.live.body.SimulatedBody`), or ``ros2``: a robot's ROS 2 driver
+    (:mod:`mrmp.live.ros2_driver`)."""
+    drive_domain: int = 0
+    """With ``drive="ros2"``: the ROS 2 domain of the robot's driver."""
+    drive_wait: float = 30.0
+    """With ``drive="ros2"``: seconds to wait for the driver's first odometry before giving up."""
 
 
 def _per_robot_agent(
     scenario: Scenario,
     index: int,
     transport: Transport,
-    body: SimulatedBody,
+    body: Body,
     sealer: Sealer,
     opener: Opener,
     options: AgentOptions,
@@ -179,7 +188,7 @@ def _causal_agent(
     scenario: Scenario,
     index: int,
     transport: Transport,
-    body: SimulatedBody,
+    body: Body,
     sealer: Sealer,
     opener: Opener,
     options: AgentOptions,
@@ -193,7 +202,7 @@ def _pibt_agent(
     scenario: Scenario,
     index: int,
     transport: Transport,
-    body: SimulatedBody,
+    body: Body,
     sealer: Sealer,
     opener: Opener,
     options: AgentOptions,
@@ -204,7 +213,7 @@ def _pibt_agent(
 
 
 LiveDriver = Callable[
-    [Scenario, int, Transport, SimulatedBody, Sealer, Opener, "AgentOptions", "PlanFollowingPolicy | None"],
+    [Scenario, int, Transport, Body, Sealer, Opener, "AgentOptions", "PlanFollowingPolicy | None"],
     "Agent | CausalAgent | PibtAgent",
 ]
 
@@ -244,6 +253,7 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
     trace = TraceWriter(options.results / f"trace-{index}.jsonl", index)
     transport: Transport | None = None
     ros2: Ros2Publisher | None = None
+    driver: Ros2Driver | None = None
     try:
         sink: OccupancySink = trace.write
         if options.ros2_domain is not None:
@@ -251,17 +261,22 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
             sink = _both(trace.write, ros2.occupancy)
         transport = opened = options.transport.open(index, len(scenario.robots))
         transport = FAULTS.wrap(opened, options.faults, seed=derive_seed(options.seed, Stream.LIVE_FAULTS, index))
-        body = SimulatedBody(
-            spec.start,
-            spec.heading,
-            scenario.grid,
-            scenario.timing,
-            time_scale=options.time_scale,
-            jitter=options.jitter,
-            miss_line=options.miss_line,
-            rng=stream_random(options.seed, Stream.BODY, index),
-            recorder=OccupancyRecorder(sink),
-        )
+        body: Body
+        if options.drive == "ros2":
+            driver = Ros2Driver(spec.id, spec.start, spec.heading, domain=options.drive_domain, wheel_base=1.0)
+            body = _ros2_body(driver, scenario, index, options, OccupancyRecorder(sink))
+        else:
+            body = SimulatedBody(
+                spec.start,
+                spec.heading,
+                scenario.grid,
+                scenario.timing,
+                time_scale=options.time_scale,
+                jitter=options.jitter,
+                miss_line=options.miss_line,
+                rng=stream_random(options.seed, Stream.BODY, index),
+                recorder=OccupancyRecorder(sink),
+            )
         sealer = Sealer(options.key, options.session)
         opener = Opener(options.key, options.session, fleet_size=len(scenario.robots))
         agent = LIVE_DRIVERS[driver_kind(scenario, following_plan=policy is not None)](
@@ -279,8 +294,32 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
         trace.close()
         if ros2 is not None:
             ros2.close()
+        if driver is not None:
+            driver.close()
     write_json(report_path, report.as_dict())
     return report
+
+
+CELL_SIZE = 1.0
+"""Metres per cell of a ROS 2 body (``docs/ros2.md``)."""
+LINE_WIDTH = 0.1
+"""Metres of a grid line under a ROS 2 body's sensor."""
+
+
+def _ros2_body(
+    driver: Ros2Driver, scenario: Scenario, index: int, options: AgentOptions, recorder: OccupancyRecorder
+) -> LineCountingBody:
+    """A line-counting body (the thesis's) driven over ROS 2, at the scenario's timing and the run's time scale."""
+    spec = scenario.robots[index]
+    cell_seconds = scenario.timing.cell_time / options.time_scale
+    turn_seconds = scenario.timing.turn_time / options.time_scale
+    speed, wheel_base, settle_seconds = body_geometry(cell_seconds, turn_seconds, CELL_SIZE, LINE_WIDTH)
+    driver.wheel_base = wheel_base
+    if not driver.wait_for_odometry(options.drive_wait):
+        topic = odometry_topic(spec.id).removeprefix("rt")
+        reason = f"no odometry on {topic} within {options.drive_wait:g} s: is the robot's ROS 2 driver running?"
+        raise InputError(Problem("--drive", reason))
+    return LineCountingBody(driver, spec.start, spec.heading, speed, turn_seconds, settle_seconds, recorder)
 
 
 OccupancySink = Callable[[str, Cell, float], None]

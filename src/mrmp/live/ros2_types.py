@@ -5,8 +5,10 @@ ROS 2 puts a message type ``pkg/msg/Name`` on DDS as the IDL struct
 "Topic and Service name mapping to DDS"), with CDR encoding. These
 dataclasses give those structs field for field (``builtin_interfaces/Time``,
 ``std_msgs/Header``, ``std_msgs/String``, ``geometry_msgs/Point``,
-``Quaternion``, ``Pose``, ``PoseStamped``), so that ``ros2 topic echo`` reads
-what a robot writes. This module imports ``cyclonedds`` (the optional extra
+``Quaternion``, ``Pose``, ``PoseStamped``, ``Vector3``, ``Twist``,
+``PoseWithCovariance``, ``TwistWithCovariance``, ``nav_msgs/Odometry``), so
+that ``ros2 topic echo`` reads what a robot writes, and a robot's ROS 2 driver
+reads what it answers. This module imports ``cyclonedds`` (the optional extra
 ``ros2``); only :mod:`mrmp.live.ros2_topics` imports it, when asked to publish.
 
 Examples
@@ -19,11 +21,30 @@ True
 """
 
 from dataclasses import dataclass  # no postponed annotations: cyclonedds reads the field types themselves
+from typing import TYPE_CHECKING
 
 from cyclonedds.idl import IdlStruct
-from cyclonedds.idl.types import float64, int32, uint32
+from cyclonedds.idl.types import array, float64, int32, uint32
 
-__all__ = ["Header", "Point", "Pose", "PoseStamped", "Quaternion", "String", "Time"]
+if TYPE_CHECKING:
+    Covariance = list[float]
+else:
+    Covariance = array[float64, 36]  # a row-major 6x6 covariance, as IDL double[36]
+
+__all__ = [
+    "Header",
+    "Odometry",
+    "Point",
+    "Pose",
+    "PoseStamped",
+    "PoseWithCovariance",
+    "Quaternion",
+    "String",
+    "Time",
+    "Twist",
+    "TwistWithCovariance",
+    "Vector3",
+]
 
 
 @dataclass
@@ -82,3 +103,46 @@ class PoseStamped(IdlStruct, typename="geometry_msgs::msg::dds_::PoseStamped_"):
 
     header: Header
     pose: Pose
+
+
+@dataclass
+class Vector3(IdlStruct, typename="geometry_msgs::msg::dds_::Vector3_"):
+    """``geometry_msgs/msg/Vector3``."""
+
+    x: float64
+    y: float64
+    z: float64
+
+
+@dataclass
+class Twist(IdlStruct, typename="geometry_msgs::msg::dds_::Twist_"):
+    """``geometry_msgs/msg/Twist``: linear (m/s) and angular (rad/s) velocity, in the body's frame."""
+
+    linear: Vector3
+    angular: Vector3
+
+
+@dataclass
+class PoseWithCovariance(IdlStruct, typename="geometry_msgs::msg::dds_::PoseWithCovariance_"):
+    """``geometry_msgs/msg/PoseWithCovariance``."""
+
+    pose: Pose
+    covariance: Covariance
+
+
+@dataclass
+class TwistWithCovariance(IdlStruct, typename="geometry_msgs::msg::dds_::TwistWithCovariance_"):
+    """``geometry_msgs/msg/TwistWithCovariance``."""
+
+    twist: Twist
+    covariance: Covariance
+
+
+@dataclass
+class Odometry(IdlStruct, typename="nav_msgs::msg::dds_::Odometry_"):
+    """``nav_msgs/msg/Odometry``: the pose in ``header.frame_id`` (``odom``), the twist in ``child_frame_id``."""
+
+    header: Header
+    child_frame_id: str
+    pose: PoseWithCovariance
+    twist: TwistWithCovariance
