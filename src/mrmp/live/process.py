@@ -27,7 +27,7 @@ from mrmp.io.lifetime import STOP_SIGNALS, release_held_signals, watch_parent
 from mrmp.io.live_files import TraceReader, TraceWriter, write_json
 from mrmp.io.plans import read_share, read_share_dependents
 from mrmp.live.agent import Agent, AgentReport, AgentTiming
-from mrmp.live.body import Body, LineCountingBody, OccupancyRecorder, SimulatedBody
+from mrmp.live.body import Body, OccupancyRecorder, OdometryLineBody, SimulatedBody
 from mrmp.live.causal_agent import CausalAgent
 from mrmp.live.diff_drive import body_geometry
 from mrmp.live.pibt_agent import PibtAgent
@@ -308,8 +308,8 @@ LINE_WIDTH = 0.1
 
 def _ros2_body(
     driver: Ros2Driver, scenario: Scenario, index: int, options: AgentOptions, recorder: OccupancyRecorder
-) -> LineCountingBody:
-    """A line-counting body (the thesis's) driven over ROS 2, at the scenario's timing and the run's time scale."""
+) -> OdometryLineBody:
+    """A line-counting body (the thesis's, its turns ended by odometry) driven over ROS 2, at the scenario's timing."""
     spec = scenario.robots[index]
     cell_seconds = scenario.timing.cell_time / options.time_scale
     turn_seconds = scenario.timing.turn_time / options.time_scale
@@ -319,7 +319,7 @@ def _ros2_body(
         topic = odometry_topic(spec.id).removeprefix("rt")
         reason = f"no odometry on {topic} within {options.drive_wait:g} s: is the robot's ROS 2 driver running?"
         raise InputError(Problem("--drive", reason))
-    return LineCountingBody(driver, spec.start, spec.heading, speed, turn_seconds, settle_seconds, recorder)
+    return OdometryLineBody(driver, spec.start, spec.heading, speed, turn_seconds, settle_seconds, recorder)
 
 
 OccupancySink = Callable[[str, Cell, float], None]

@@ -1,10 +1,10 @@
 """A robot body over ROS 2: wheel speeds out as ``geometry_msgs/Twist``, odometry in, grid lines seen from it.
 
-``mrmp agent --drive ros2`` gives the robot a
-:class:`~mrmp.live.body.LineCountingBody`, the body of a real Khepera III
-(thesis sections 2.3 and 3.6: timed right turns, then forward until a grid
-line is crossed), whose driver is this :class:`Ros2Driver` instead of the
-robot's own board. It implements :class:`~mrmp.live.body.KheperaDriver` over
+``mrmp agent --drive ros2`` gives the robot an
+:class:`~mrmp.live.body.OdometryLineBody`, the body of a real Khepera III
+(thesis sections 2.3 and 3.6: right turns, then forward until a grid line is
+crossed; its turns ended by odometry rather than by a clock), whose driver is
+this :class:`Ros2Driver` instead of the robot's own board. It implements :class:`~mrmp.live.body.KheperaDriver` over
 DDS, as a ROS 2 node would:
 
 * ``set_speeds(left, right)``: a ``geometry_msgs/msg/Twist`` on
@@ -14,7 +14,10 @@ DDS, as a ROS 2 node would:
   ``/robot_<id>/odom``, in frame ``odom`` from where the robot started (REP
   105), turned into the map frame (:func:`~mrmp.live.diff_drive.odometry_in_map`):
   whether a line across its way lies under the robot's centre
-  (:func:`~mrmp.live.diff_drive.on_grid_line`).
+  (:func:`~mrmp.live.diff_drive.on_grid_line`), or was crossed since the last
+  reading (the sensor latches a line it passed between two readings, as a
+  sensor sampled faster than the robot's control loop would have seen it);
+* ``map_pose()``: the same odometry as a pose, for the body's turns.
 
 So any robot whose ROS 2 driver takes ``cmd_vel`` and publishes ``odom`` can be
 the body of an ``mrmp agent``; :mod:`mrmp.live.ros2_robot` is such a robot,
@@ -106,6 +109,7 @@ class Ros2Driver:
         self.line_width = line_width
         self.odometry: tuple[float, float, float] | None = None
         """The last odometry pose, ``(x, y, yaw)`` in frame ``odom``; None before the first."""
+        self._last_line: tuple[bool, int] | None = None  # the axis and the cell along it at the last line reading
         self.commands = 0
         self._participant: Any = DomainParticipant(domain)
         participant = self._participant
@@ -123,9 +127,16 @@ class Ros2Driver:
         self.commands += 1
 
     def line_detected(self) -> bool:
-        """Whether the last odometry puts a grid line across the robot's way under its centre."""
+        """Whether a grid line across the robot's way is under its centre, or was crossed since the last reading."""
         pose = self.map_pose()
-        return pose is not None and on_grid_line(*pose, self.cell_size, self.line_width)
+        if pose is None:
+            return False
+        east, north, yaw = pose
+        along_east = abs(math.cos(yaw)) >= abs(math.sin(yaw))
+        reading = (along_east, math.floor((east if along_east else north) / self.cell_size))
+        crossed = self._last_line is not None and self._last_line[0] == along_east and self._last_line[1] != reading[1]
+        self._last_line = reading
+        return crossed or on_grid_line(east, north, yaw, self.cell_size, self.line_width)
 
     def stop(self) -> None:
         """Command a zero twist."""
