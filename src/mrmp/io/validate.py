@@ -1,4 +1,4 @@
-"""Check any input file mrmp reads -- a YAML scenario, a ``.map`` or a ``.scen`` -- and list its problems.
+"""Check any input file mrmp reads (a YAML scenario, a ``.map``, a ``.scen``, a LoRR problem ``.json``) and list its problems.
 
 Unlike the loaders, :func:`validate_file` never raises for bad input: it
 returns every problem it found (an empty list means the file is fine).
@@ -24,6 +24,7 @@ from pathlib import Path
 from mrmp.core.errors import InputError, Problem
 from mrmp.core.scenario import Scenario, scenario_problems
 from mrmp.io._files import PathLike, file_problem
+from mrmp.io.lorr import read_lorr_problem
 from mrmp.io.movingai import ScenEntry, read_map, read_scen_entries, scen_map_problems
 from mrmp.io.scenario_file import load_scenario
 
@@ -96,7 +97,9 @@ def validate_file(path: PathLike, known_policies: Sequence[str] | None = None) -
     ----------
     path:
         A scenario (``.yaml`` / ``.yml``), a MovingAI map (``.map``) or a
-        MovingAI agent list (``.scen``). A ``.scen`` file is checked against the
+        MovingAI agent list (``.scen``), or a League of Robot Runners problem
+        (``.json``, :mod:`mrmp.io.lorr`, with the map, agents and tasks files it
+        names). A ``.scen`` file is checked against the
         map each of its lines names, looked up in the ``.scen`` file's folder:
         sizes must match, and every start and goal must be a free cell, unique
         in the file, with the goal reachable from the start.
@@ -119,6 +122,9 @@ def validate_file(path: PathLike, known_policies: Sequence[str] | None = None) -
             return []
         if suffix == ".scen":
             return _scen_problems(file)
+        if suffix == ".json":
+            read_lorr_problem(file)
+            return []
     except InputError as error:
         return list(error.problems)
-    return [Problem(str(file), f"unknown file type {file.suffix or '(none)'!r}: expected .yaml, .yml, .map or .scen")]
+    return [Problem(str(file), f"unknown file type {file.suffix or '(none)'!r}: expected .yaml, .yml, .map, .scen or .json")]
