@@ -25,7 +25,9 @@ from __future__ import annotations
 import os
 import stat
 import tempfile
+from collections.abc import Callable
 from pathlib import Path
+from typing import IO
 
 from mrmp.core.errors import InputError, Problem
 from mrmp.core.limits import MAX_INPUT_FILE_BYTES
@@ -130,16 +132,23 @@ def _current_umask() -> int:
 def atomic_write_text(path: PathLike, text: str) -> None:
     """Write ``text`` to ``path`` so that readers see the old file or the whole new one, never a part.
 
-    The text goes to a temporary file in the same folder, is flushed to disk,
-    and then replaces ``path`` with :func:`os.replace`. Missing parent folders
-    are created.
+    The text is written as UTF-8 with ``\\n`` line endings by :func:`atomic_write`.
 
-    Parameters
-    ----------
-    path:
-        The file to create or replace.
-    text:
-        Its new content, written as UTF-8 with ``\\n`` line endings.
+    Raises
+    ------
+    InputError
+        If the folder cannot be created or the file cannot be written.
+    """
+    atomic_write(path, lambda handle: handle.write(text.encode("utf-8")))
+
+
+def atomic_write(path: PathLike, write: Callable[[IO[bytes]], object]) -> None:
+    """Call ``write`` on a new file so that readers of ``path`` see the old file or the whole new one, never a part.
+
+    ``write`` fills a temporary file in the same folder (opened for bytes), which
+    is flushed to disk and then replaces ``path`` with :func:`os.replace`.
+    Missing parent folders are created; on any failure, or an interrupt, the
+    temporary file is removed and ``path`` is left as it was.
 
     Raises
     ------
@@ -154,8 +163,8 @@ def atomic_write_text(path: PathLike, text: str) -> None:
         raise InputError(Problem(str(path), f"cannot write the file: {error.strerror or error}")) from None
     temporary = Path(name)
     try:
-        with os.fdopen(descriptor, "w", encoding="utf-8", newline="\n") as handle:
-            handle.write(text)
+        with os.fdopen(descriptor, "wb") as handle:
+            write(handle)
             handle.flush()
             os.fsync(handle.fileno())
         os.chmod(temporary, 0o666 & ~_current_umask())

@@ -27,10 +27,9 @@ not an export format: name a .mcap file, or a .bag (or suffix-less) folder for r
 from __future__ import annotations
 
 import importlib.util
-import os
 import shutil
 import tempfile
-from collections.abc import Callable, Iterator
+from collections.abc import Iterator
 from contextlib import contextmanager
 from pathlib import Path
 from typing import IO, Any, Literal
@@ -38,7 +37,7 @@ from typing import IO, Any, Literal
 from mrmp.core.errors import InputError, Problem
 from mrmp.core.grid import Grid
 from mrmp.core.result import RunResult
-from mrmp.io._files import PathLike, _current_umask
+from mrmp.io._files import PathLike, atomic_write
 from mrmp.io.ros_messages import ROS_TYPES, Topic, message_definition, run_messages, run_topics
 
 ExportKind = Literal["mcap", "rosbag2"]
@@ -223,7 +222,7 @@ def write_mcap(result: RunResult, grid: Grid, path: PathLike, tick_seconds: floa
         writer.add_metadata("mrmp", _metadata(result, grid))
         writer.finish()
 
-    _atomic_file(target, write)
+    atomic_write(target, write)
 
 
 def write_rosbag2(
@@ -305,34 +304,6 @@ def _rosbags_message(typestore: Any, ros_type: str, fields: dict[str, Any]) -> A
 
 
 # -- whole or nothing -------------------------------------------------------------------------
-
-
-def _atomic_file(target: Path, write: Callable[[IO[bytes]], None]) -> None:
-    """Call ``write`` on a temporary file beside ``target``, then move it over ``target``.
-
-    Raises
-    ------
-    InputError
-        If the folder or the file cannot be written.
-    """
-    try:
-        target.parent.mkdir(parents=True, exist_ok=True)
-        descriptor, name = tempfile.mkstemp(dir=target.parent, prefix=f".{target.name}.", suffix=".tmp")
-    except OSError as error:
-        raise InputError(Problem(str(target), f"cannot write the file: {error.strerror or error}")) from None
-    temporary = Path(name)
-    try:
-        with os.fdopen(descriptor, "wb") as handle:
-            write(handle)
-            handle.flush()
-            os.fsync(handle.fileno())
-        os.chmod(temporary, 0o666 & ~_current_umask())
-        os.replace(temporary, target)
-    except BaseException as error:
-        temporary.unlink(missing_ok=True)
-        if isinstance(error, OSError):
-            raise InputError(Problem(str(target), f"cannot write the file: {error.strerror or error}")) from None
-        raise
 
 
 @contextmanager
