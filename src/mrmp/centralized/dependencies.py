@@ -54,15 +54,21 @@ from mrmp.core.cell import Cell
 from mrmp.core.errors import MrmpError
 
 __all__ = [
+    "Needs",
     "PlanDeadlockError",
     "Rotation",
     "action_dependencies",
     "action_dependents",
     "check_executable",
     "find_rotations",
+    "leaving_dependencies",
     "plan_moves",
     "rotations_at",
+    "strict_dependencies",
 ]
+
+Needs = list[dict[int, list[tuple[int, int]]]]
+"""Per robot, per move index, the ``(robot, move or progress)`` pairs the move waits for."""
 
 
 class PlanDeadlockError(MrmpError, ValueError):
@@ -210,6 +216,57 @@ def plan_moves(path: Sequence[Cell]) -> tuple[list[Cell], list[int]]:
     return cells, ticks
 
 
+def leaving_dependencies(paths: Sequence[Sequence[Cell]]) -> tuple[list[list[Cell]], list[list[int]], Needs]:
+    """Every robot's moves, the tick of each, and per move the ``(robot, move)`` moves out of its target cell it waits for.
+
+    Move ``k`` of robot ``i`` entering cell ``c`` at tick ``t`` waits for every
+    other robot ``j`` that stood on ``c`` at some tick before ``t``: for ``j``'s
+    move out of ``c`` after its last visit before ``t`` (named by its index in
+    ``j``'s moves). Not checked: a rotation or a swap makes it cyclic.
+
+    Raises
+    ------
+    ValueError
+        If the plan makes a robot enter a cell another robot never leaves
+        afterwards (the plan collides).
+    """
+    moves_and_ticks = [plan_moves(path) for path in paths]
+    visits: dict[Cell, list[tuple[int, int]]] = {}
+    for robot, path in enumerate(paths):
+        for tick, cell in enumerate(path):
+            visits.setdefault(cell, []).append((tick, robot))
+    for cell_visits in visits.values():
+        cell_visits.sort()
+    dependencies: Needs = []
+    for robot, (cells, ticks) in enumerate(moves_and_ticks):
+        needs: dict[int, list[tuple[int, int]]] = {}
+        for move, (cell, tick) in enumerate(zip(cells, ticks)):
+            last_visit: dict[int, int] = {}
+            for visit_tick, other in visits[cell]:
+                if visit_tick >= tick:
+                    break
+                if other != robot:
+                    last_visit[other] = visit_tick
+            for other, visit_tick in sorted(last_visit.items()):
+                other_ticks = moves_and_ticks[other][1]
+                leaving = next((index for index, t in enumerate(other_ticks) if t > visit_tick), None)
+                if leaving is None:
+                    raise ValueError(f"robot {robot} enters {cell} at tick {tick} but robot {other} never leaves it")
+                needs.setdefault(move, []).append((other, leaving))
+        dependencies.append(needs)
+    return [cells for cells, _ in moves_and_ticks], [ticks for _, ticks in moves_and_ticks], dependencies
+
+
+def strict_dependencies(needs: Sequence[Mapping[int, Sequence[tuple[int, int]]]]) -> Needs:
+    """The graph of :func:`leaving_dependencies` in the form of :func:`action_dependencies`: ``(robot, progress)``.
+
+    Waiting for a move to start becomes waiting for it to be completed
+    (progress one more than its index): the same edges between moves, so one
+    form is acyclic when the other is.
+    """
+    return [{move: [(other, index + 1) for other, index in waits] for move, waits in robot.items()} for robot in needs]
+
+
 def action_dependencies(
     paths: Sequence[Sequence[Cell]], *, following: bool = False
 ) -> tuple[list[list[Cell]], list[dict[int, list[tuple[int, int]]]]]:
@@ -239,39 +296,15 @@ def action_dependencies(
         If the dependencies form a cycle (a rotation or swap, or a collision),
         so that the robots following them would wait for each other for ever.
     """
-    moves_and_ticks = [plan_moves(path) for path in paths]
-    visits: dict[Cell, list[tuple[int, int]]] = {}
-    for robot, path in enumerate(paths):
-        for tick, cell in enumerate(path):
-            visits.setdefault(cell, []).append((tick, robot))
-    for cell_visits in visits.values():
-        cell_visits.sort()
-    dependencies: list[dict[int, list[tuple[int, int]]]] = []
-    follows: list[tuple[int, int, int]] = []  # (robot, move, position in its needs): same-tick dependencies
-    for robot, (cells, ticks) in enumerate(moves_and_ticks):
-        needs: dict[int, list[tuple[int, int]]] = {}
-        for move, (cell, tick) in enumerate(zip(cells, ticks)):
-            last_visit: dict[int, int] = {}
-            for visit_tick, other in visits[cell]:
-                if visit_tick >= tick:
-                    break
-                if other != robot:
-                    last_visit[other] = visit_tick
-            for other, visit_tick in sorted(last_visit.items()):
-                other_ticks = moves_and_ticks[other][1]
-                leaving = next((index for index, t in enumerate(other_ticks) if t > visit_tick), None)
-                if leaving is None:
-                    raise ValueError(f"robot {robot} enters {cell} at tick {tick} but robot {other} never leaves it")
-                needs.setdefault(move, []).append((other, leaving + 1))
-                if other_ticks[leaving] == tick:
-                    follows.append((robot, move, len(needs[move]) - 1))
-        dependencies.append(needs)
-    moves = [cells for cells, _ in moves_and_ticks]
-    check_executable(moves, dependencies, [ticks for _, ticks in moves_and_ticks])
-    if following:
-        for robot, move, position in follows:
-            other, progress = dependencies[robot][move][position]
-            dependencies[robot][move][position] = (other, progress - 1)
+    moves, ticks, leaving = leaving_dependencies(paths)
+    dependencies = strict_dependencies(leaving)
+    check_executable(moves, dependencies, ticks)
+    if following:  # a move that starts in the tick the leader's move out starts waits only until the leader is ready
+        for robot, needs in enumerate(leaving):
+            for move, waits in needs.items():
+                for position, (other, index) in enumerate(waits):
+                    if ticks[other][index] == ticks[robot][move]:
+                        dependencies[robot][move][position] = (other, index)
     return moves, dependencies
 
 
