@@ -15,18 +15,16 @@ MOST_SECONDS = 300.0
 
 
 def main() -> int:
-    from cyclonedds.core import Policy, Qos  # here, not above: the test suite imports this module for its doctests
-    from cyclonedds.domain import DomainParticipant
+    from cyclonedds.domain import DomainParticipant  # here, not above: the test suite imports this module for its doctests
     from cyclonedds.sub import DataReader
     from cyclonedds.topic import Topic
-    from cyclonedds.util import duration
 
     from mrmp.live import ros2_types
-    from mrmp.live.ros2_topics import HISTORY, pose_topic, state_topic
+    from mrmp.live.ros2_topics import HISTORY, pose_topic, published_qos, state_topic
 
     domain, out, ids = int(sys.argv[1]), sys.argv[2], sys.argv[3].split(",")
     participant = DomainParticipant(domain)
-    qos = Qos(Policy.Reliability.Reliable(duration(seconds=1)), Policy.Durability.TransientLocal, Policy.History.KeepLast(HISTORY))
+    qos = published_qos()
     readers = []
     for robot in ids:
         readers.append((robot, DataReader(participant, Topic(participant, pose_topic(robot), ros2_types.PoseStamped), qos=qos)))

@@ -10,14 +10,13 @@ from __future__ import annotations
 
 import json
 import math
-import os
-import random
 import signal
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+from dds_loopback import loopback_environment
 
 pytest.importorskip("cyclonedds", reason="needs the ros2 extra (cyclonedds): pip install -e '.[ros2]'")
 
@@ -26,18 +25,11 @@ from mrmp.io.ros_messages import cell_position
 from mrmp.live.diff_drive import odometry_in_map, yaw_heading
 
 ROOT = Path(__file__).resolve().parents[2]
-LOOPBACK_DDS = """<CycloneDDS><Domain id="any"><General><Interfaces><NetworkInterface address="127.0.0.1"/></Interfaces>
-<AllowMulticast>false</AllowMulticast></General><Discovery><ParticipantIndex>auto</ParticipantIndex>
-<MaxAutoParticipantIndex>40</MaxAutoParticipantIndex><Peers><Peer address="127.0.0.1"/></Peers></Discovery></Domain></CycloneDDS>
-"""
 
 
 @pytest.fixture
 def dds_environment(tmp_path: Path) -> dict[str, str]:
-    config = tmp_path / "cyclonedds.xml"
-    config.write_text(LOOPBACK_DDS, encoding="utf-8")
-    domain = random.Random(os.getpid() + 1).randrange(1, 200)
-    return dict(os.environ, CYCLONEDDS_URI=config.as_uri(), ROS_DOMAIN_ID=str(domain))
+    return loopback_environment(tmp_path, salt=1)
 
 
 def test_a_robot_driven_over_ros2_reaches_its_goal_cell_by_cell(tmp_path: Path, dds_environment: dict[str, str]) -> None:

@@ -11,13 +11,12 @@ from __future__ import annotations
 
 import itertools
 import json
-import os
-import random
 import subprocess
 import sys
 from pathlib import Path
 
 import pytest
+from dds_loopback import loopback_environment
 
 from mrmp.core.heading import Heading
 from mrmp.io.ros_messages import cell_position, heading_quaternion
@@ -26,18 +25,11 @@ pytest.importorskip("cyclonedds", reason="needs the ros2 extra (cyclonedds): pip
 
 ROOT = Path(__file__).resolve().parents[2]
 LISTENER = Path(__file__).with_name("ros2_listener.py")
-LOOPBACK_DDS = """<CycloneDDS><Domain id="any"><General><Interfaces><NetworkInterface address="127.0.0.1"/></Interfaces>
-<AllowMulticast>false</AllowMulticast></General><Discovery><ParticipantIndex>auto</ParticipantIndex>
-<MaxAutoParticipantIndex>40</MaxAutoParticipantIndex><Peers><Peer address="127.0.0.1"/></Peers></Discovery></Domain></CycloneDDS>
-"""
 
 
 @pytest.fixture
 def dds_environment(tmp_path: Path) -> dict[str, str]:
-    config = tmp_path / "cyclonedds.xml"
-    config.write_text(LOOPBACK_DDS, encoding="utf-8")
-    domain = random.Random(os.getpid()).randrange(1, 200)  # runs side by side on one machine keep apart
-    return dict(os.environ, CYCLONEDDS_URI=config.as_uri(), ROS_DOMAIN_ID=str(domain))
+    return loopback_environment(tmp_path, salt=0)
 
 
 def cell_of(line: dict) -> tuple[int, int]:

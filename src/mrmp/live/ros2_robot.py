@@ -112,8 +112,7 @@ def _odometry(robot: DiffDrive, linear: float, angular: float) -> Odometry:
     """The ``nav_msgs/msg/Odometry`` of ``robot``'s pose now and its current twist."""
     from mrmp.live import ros2_types as types
 
-    nanoseconds = time.time_ns()
-    header = types.Header(types.Time(nanoseconds // 1_000_000_000, nanoseconds % 1_000_000_000), "odom")
+    header = types.stamped_header(time.time_ns(), "odom")
     orientation = types.Quaternion(0.0, 0.0, math.sin(robot.yaw / 2.0), math.cos(robot.yaw / 2.0))
     pose = types.PoseWithCovariance(types.Pose(types.Point(robot.x, robot.y, 0.0), orientation), [0.0] * 36)
     twist = types.Twist(types.Vector3(linear, 0.0, 0.0), types.Vector3(0.0, 0.0, angular))

@@ -48,7 +48,16 @@ from mrmp.core.cell import Cell
 from mrmp.core.heading import Heading
 from mrmp.io.ros_messages import FRAME, cell_position, heading_quaternion, robot_topic
 
-__all__ = ["DOMAIN_VARIABLE", "MAX_DOMAIN_ID", "Ros2Publisher", "pose_topic", "ros2_domain", "ros2_problem", "state_topic"]
+__all__ = [
+    "DOMAIN_VARIABLE",
+    "MAX_DOMAIN_ID",
+    "Ros2Publisher",
+    "pose_topic",
+    "published_qos",
+    "ros2_domain",
+    "ros2_problem",
+    "state_topic",
+]
 
 DOMAIN_VARIABLE = "ROS_DOMAIN_ID"
 """The environment variable that names the ROS 2 domain, as for every ROS 2 node."""
@@ -97,6 +106,16 @@ def state_topic(robot_id: str) -> str:
     return "rt" + robot_topic(robot_id, "state")
 
 
+def published_qos() -> Any:
+    """The QoS of the pose and state topics (module docstring): reliable, transient-local, the last :data:`HISTORY`."""
+    from cyclonedds.core import Policy, Qos
+    from cyclonedds.util import duration
+
+    return Qos(
+        Policy.Reliability.Reliable(duration(seconds=1)), Policy.Durability.TransientLocal, Policy.History.KeepLast(HISTORY)
+    )
+
+
 class Ros2Publisher:
     """One robot's pose and state on ROS 2 topics (module docstring).
 
@@ -124,11 +143,9 @@ class Ros2Publisher:
         cell_size: float = 1.0,
         clock: Callable[[], int] = time.time_ns,
     ) -> None:
-        from cyclonedds.core import Policy, Qos
         from cyclonedds.domain import DomainParticipant
         from cyclonedds.pub import DataWriter
         from cyclonedds.topic import Topic
-        from cyclonedds.util import duration
 
         from mrmp.live import ros2_types
 
@@ -139,11 +156,7 @@ class Ros2Publisher:
         self.cell_size = cell_size
         self.clock = clock
         self.published = 0
-        qos = Qos(
-            Policy.Reliability.Reliable(duration(seconds=1)),
-            Policy.Durability.TransientLocal,
-            Policy.History.KeepLast(HISTORY),
-        )
+        qos = published_qos()
         self._participant: Any = DomainParticipant(domain)
         participant = self._participant
         self._pose: Any = DataWriter(participant, Topic(participant, pose_topic(robot_id), ros2_types.PoseStamped), qos=qos)
@@ -175,17 +188,12 @@ class Ros2Publisher:
 
     # -- messages ------------------------------------------------------------------------
 
-    def _header(self) -> Any:
-        types = self._types
-        nanoseconds = self.clock()
-        return types.Header(types.Time(nanoseconds // 1_000_000_000, nanoseconds % 1_000_000_000), FRAME)
-
     def _write_pose(self) -> None:
         types = self._types
         x, y, z = cell_position(self.cell, self.cell_size)
         qx, qy, qz, qw = heading_quaternion(self.heading)
         pose = types.Pose(types.Point(x, y, z), types.Quaternion(qx, qy, qz, qw))
-        self._pose.write(types.PoseStamped(self._header(), pose))
+        self._pose.write(types.PoseStamped(types.stamped_header(self.clock(), FRAME), pose))
         self.published += 1
 
     def _write_state(self, event: str, cell: Cell, t: float) -> None:

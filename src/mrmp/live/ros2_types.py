@@ -44,6 +44,7 @@ __all__ = [
     "Twist",
     "TwistWithCovariance",
     "Vector3",
+    "stamped_header",
 ]
 
 
@@ -61,6 +62,15 @@ class Header(IdlStruct, typename="std_msgs::msg::dds_::Header_"):
 
     stamp: Time
     frame_id: str
+
+
+def stamped_header(nanoseconds: int, frame: str) -> Header:
+    """A header stamped ``nanoseconds`` of ROS time, in ``frame``.
+
+    >>> stamped_header(3_000_000_007, "map")
+    Header(stamp=Time(sec=3, nanosec=7), frame_id='map')
+    """
+    return Header(Time(nanoseconds // 1_000_000_000, nanoseconds % 1_000_000_000), frame)
 
 
 @dataclass
