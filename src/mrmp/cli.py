@@ -1025,7 +1025,7 @@ def agent(
         domain = _ros2_domain() if ros2 else None
         if drive not in ("simulated", "ros2"):
             raise InputError(Problem("--drive", f"must be simulated or ros2, got {drive!r}"))
-        drive_domain = _ros2_domain() if drive == "ros2" else 0
+        drive_domain = _ros2_domain("--drive") if drive == "ros2" else 0
         ids = [spec.id for spec in scenario.robots]
         if robot not in ids:
             raise InputError(Problem("--robot", f"no robot has the id {robot!r} in {scenario_path}"))
@@ -1072,15 +1072,15 @@ def agent(
     raise typer.Exit(0 if report.arrived else 1)
 
 
-def _ros2_domain() -> int:
-    """The ROS 2 domain of ``--ros2`` (``ROS_DOMAIN_ID``), once its package is known to be there."""
+def _ros2_domain(option: str = "--ros2") -> int:
+    """The ROS 2 domain that ``option`` (``--ros2``, ``--drive ros2``) uses (``ROS_DOMAIN_ID``), once its package is there."""
     import os
 
     from mrmp.live.ros2_topics import DOMAIN_VARIABLE, ros2_domain, ros2_problem
 
     missing = ros2_problem()
     if missing is not None:
-        raise InputError(Problem("--ros2", missing))
+        raise InputError(Problem(option, missing))
     try:
         return ros2_domain(os.environ)
     except ValueError as error:
