@@ -31,6 +31,7 @@ from mrmp.core.scenario import Scenario
 from mrmp.experiments.execution import execute_in_simulator
 from mrmp.experiments.run_options import FIELD_NAMES, NETWORK_OPTIONS, POLICY_SETTINGS, SCENARIO_OPTIONS, apply_run_options
 from mrmp.io import load_movingai_scenario, load_scenario, write_result_json
+from mrmp.io.lorr import is_lorr_problem, load_lorr_scenario
 from mrmp.io.results import result_to_dict
 from mrmp.sim.policy_table import policy_names
 from mrmp.sim.simulator import simulate
@@ -43,7 +44,8 @@ ScenarioSource = Scenario | str | os.PathLike[str]
 
 
 def load(path: str | os.PathLike[str], scen: str | os.PathLike[str] | None = None, agents: int | None = None) -> Scenario:
-    """The scenario in a YAML file, or on a MovingAI map with the first ``agents`` robots of ``scen``.
+    """The scenario in a YAML file, a League of Robot Runners problem (``.json``: a lifelong run of its task
+    stream, :func:`mrmp.io.lorr.lorr_scenario`), or a MovingAI map with the first ``agents`` robots of ``scen``.
 
     Raises :class:`~mrmp.core.errors.InputError` naming the file, line and
     field of every problem found.
@@ -54,10 +56,15 @@ def load(path: str | os.PathLike[str], scen: str | os.PathLike[str] | None = Non
     (5, ['A', 'B'])
     >>> len(mrmp.load("maps/random-32-32-20.map", scen="maps/random-32-32-20-random-1.scen", agents=20).robots)
     20
+    >>> lorr = mrmp.load("examples/lorr/maze-example_40.json")
+    >>> len(lorr.robots), lorr.policy.body, lorr.max_ticks
+    (40, 'turning', 5000)
     """
     if scen is None:
         if agents is not None:
             raise InputError(Problem("agents", "robots are chosen from a .scen file: give scen too"))
+        if is_lorr_problem(path):
+            return load_lorr_scenario(path)
         return load_scenario(Path(path), known_policies=policy_names())
     if agents is not None and agents <= 0:
         raise InputError(Problem("agents", f"must be positive, got {agents}"))

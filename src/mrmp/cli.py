@@ -10,6 +10,7 @@ from __future__ import annotations
 import functools
 import inspect
 import sys
+import time
 from collections.abc import Callable, Iterable
 from dataclasses import dataclass
 from pathlib import Path
@@ -20,12 +21,15 @@ import typer.core
 from rich.console import Console
 from rich.table import Table
 
+from mrmp.core.body import body_model
+from mrmp.core.cell import Cell
 from mrmp.core.errors import InputError, MrmpError, Problem
 from mrmp.core.limits import (
     MAX_LIVE_DELAY_SECONDS,
     MAX_LIVE_ROBOTS,
     MAX_RUN_SECONDS,
     MAX_STEP_SECONDS,
+    MAX_TICKS,
     MAX_TIME_SCALE,
     MIN_TIME_SCALE,
     shown,
@@ -35,6 +39,7 @@ from mrmp.core.result import RunResult
 from mrmp.core.scenario import PolicyOptions, Scenario
 from mrmp.experiments.run_options import FLAG_NAMES, apply_run_options, parse_range
 from mrmp.io import load_movingai_scenario, load_scenario, validate_file, write_result_json
+from mrmp.io.lorr import LORR_STEPS, is_lorr_problem, load_lorr_scenario
 from mrmp.live.transport_table import TRANSPORTS
 from mrmp.sim.policy_table import body_problem, policy_entry, policy_names
 from mrmp.sim.simulator import TickObserver, simulate
@@ -184,7 +189,7 @@ def _fail(problems: list[Problem] | tuple[Problem, ...]) -> typer.Exit:
 
 
 def _load(
-    scenario_path: Path | None, map_path: Path | None, scen_path: Path | None, agents: int | None
+    scenario_path: Path | None, map_path: Path | None, scen_path: Path | None, agents: int | None, steps: int | None = None
 ) -> Scenario:
     if scenario_path is not None:
         if map_path or scen_path:
@@ -193,12 +198,25 @@ def _load(
             raise InputError(
                 Problem("--agents", "goes with --map and --scen; a YAML scenario lists its robots (or sets agents: next to scen:)")
             )
+        if is_lorr_problem(scenario_path):
+            return load_lorr_scenario(scenario_path, _steps(steps))
+        if steps is not None:
+            raise InputError(Problem("--steps", "is the length of a LoRR problem's run (a .json file); use --max-ticks"))
         return load_scenario(scenario_path, known_policies=policy_names())
     if map_path is None or scen_path is None:
         raise InputError(Problem("SCENARIO", "give a scenario file, or --map and --scen (with --agents)"))
     if agents is not None and agents <= 0:
         raise InputError(Problem("--agents", f"must be positive, got {agents}"))
     return load_movingai_scenario(map_path, scen_path, agents)
+
+
+def _steps(steps: int | None) -> int:
+    """``--steps``, checked: a LoRR run's length in steps (the Start-Kit's default when not given)."""
+    if steps is None:
+        return LORR_STEPS
+    if not 1 <= steps <= MAX_TICKS:
+        raise InputError(Problem("--steps", f"must be between 1 and {MAX_TICKS}, got {steps}"))
+    return steps
 
 
 def with_policy_flags(command: Callable[..., None]) -> Callable[..., None]:
@@ -435,6 +453,12 @@ def print_result(result: RunResult, console: Console) -> None:
         console.print(f"  dropped by robots: {rejected}; injected faults: {injected}", markup=False)
         if network.get("missed_lines"):
             console.print(f"  grid lines missed by bodies: {network['missed_lines']} (positions believed wrong from then on)")
+    elif result.tasks is not None:
+        console.print(
+            f"{verdict} ({result.stop_reason} at step {result.ticks}): {result.tasks.finished} tasks finished "
+            f"({sum(robot.goals_reached for robot in result.robots)} errands), collisions: {len(result.collisions)}, "
+            f"messages {result.messages}, wall time {result.wall_time_s:.3f} s"
+        )
     elif result.lifelong:
         goals = sum(robot.goals_reached for robot in result.robots)
         console.print(
@@ -516,6 +540,7 @@ def run(
     scen_path: Annotated[Path | None, typer.Option("--scen", help="A MovingAI .scen file (with --map).", rich_help_panel=SCENARIOS)] = None,
     agents: Annotated[int | None, typer.Option(help="Robots taken from the .scen.", show_default="all", rich_help_panel=SCENARIOS)] = None,
     max_ticks: Annotated[int | None, typer.Option(help="Stop after this many ticks.", show_default=SCENARIO_DEFAULT, rich_help_panel=SCENARIOS)] = None,
+    steps: Annotated[int | None, typer.Option(help="A LoRR problem (.json): steps the run lasts.", show_default=str(LORR_STEPS), rich_help_panel=SCENARIOS)] = None,
     lifelong: Annotated[bool, typer.Option("--lifelong", help="A robot that reaches its goal gets a new one (seeded); report throughput.", rich_help_panel=SCENARIOS)] = False,
     seed: Annotated[int | None, typer.Option(help="Seed of the run's random draws (network faults, tie-breaks, new goals, paces).", show_default=SCENARIO_DEFAULT, rich_help_panel=SCENARIOS)] = None,
     policy: Annotated[str | None, typer.Option(help="The decision rule every robot runs.", metavar=choices(policy_names()), show_default=SCENARIO_DEFAULT, autocompletion=policy_names, rich_help_panel=POLICIES)] = None,
@@ -527,6 +552,7 @@ def run(
     reorder: Annotated[float | None, typer.Option(help="Probability that a message overtakes earlier ones.", show_default=SCENARIO_DEFAULT, rich_help_panel=FAULTS)] = None,
     json_path: Annotated[Path | None, typer.Option("--json", help="Write the whole result as JSON (- for stdout).", metavar="PATH|-", rich_help_panel=OUTPUT)] = None,
     record: Annotated[Path | None, typer.Option("--record", help="Write the run for ROS 2 tools: OUT.mcap, or OUT.bag (a rosbag2 folder); needs the ros2 extra (docs/ros2.md).", metavar="OUT", rich_help_panel=OUTPUT)] = None,
+    lorr_output: Annotated[Path | None, typer.Option("--lorr-output", help="A LoRR problem's run: write the League of Robot Runners' output JSON (for its tools, such as PlanViz).", metavar="FILE", rich_help_panel=OUTPUT)] = None,
     animate: Annotated[Path | None, typer.Option(help="Write an animation: .gif, .svg or .mp4 (needs ffmpeg).", rich_help_panel=OUTPUT)] = None,
     show_messages: Annotated[bool, typer.Option("--show-messages", help="Record each tick's messages and draw them in the --animate animation (and the --json result).", rich_help_panel=OUTPUT)] = False,
     goal_lines: Annotated[bool, typer.Option("--goal-lines", help="Draw a line from each robot to its goal in the --animate animation.", rich_help_panel=OUTPUT)] = False,
@@ -551,12 +577,12 @@ def run(
     request = RunRequest(
         None if json_path is None else str(json_path), animate, show_messages, watch, watch_fps, planner, time_limit, live, transport, time_scale,
         delay_ms, jitter, miss_line, results, kill or [], unsafe, goal_lines=goal_lines, colour_by=colour_by, speed=speed,
-        record=record, ros2=ros2,
+        record=record, ros2=ros2, lorr_output=lorr_output,
     )
     console = Console(stderr=request.json_path == "-", highlight=False)
     try:
         scenario = apply_run_options(
-            _load(scenario_path, map_path, scen_path, agents),
+            _load(scenario_path, map_path, scen_path, agents, steps),
             policy,
             policy_settings,
             names=FLAG_NAMES,
@@ -571,13 +597,14 @@ def run(
         )
         _validate_run(scenario, request)
         plan = _plan(planner, scenario, time_limit, console) if planner is not None else None
-        result = _live_run(scenario, request, plan, console) if live else _simulated_run(scenario, request, plan, console)
+        step_seconds: list[float] = []
+        result = _live_run(scenario, request, plan, console) if live else _simulated_run(scenario, request, plan, console, step_seconds)
     except InputError as error:
         raise _fail(error.problems) from None
     except MrmpError as error:  # e.g. a plan that cannot be executed (PlanDeadlockError)
         Console(stderr=True).print(f"error: {error}", markup=False)
         raise typer.Exit(2) from None
-    _output_run(result, scenario, request, console)
+    _output_run(result, scenario, request, console, step_seconds)
 
 
 @dataclass(frozen=True)
@@ -605,6 +632,7 @@ class RunRequest:
     speed: float = 1.0
     record: Path | None = None
     ros2: bool = False
+    lorr_output: Path | None = None
 
 
 def _validate_run(scenario: Scenario, request: RunRequest) -> None:
@@ -643,6 +671,10 @@ def _validate_run(scenario: Scenario, request: RunRequest) -> None:
             raise InputError(Problem(str(request.record), record_issue))
     if request.watch and request.live:
         raise InputError(Problem("--watch", "live runs are not drawn in the terminal (--watch is for simulated runs)"))
+    if request.lorr_output is not None and scenario.tasks is None:
+        raise InputError(Problem("--lorr-output", "writes the run of a LoRR problem (a .json problem file)"))
+    if request.lorr_output is not None and not body_model(scenario.policy.body).turns_in_place:
+        raise InputError(Problem("--lorr-output", f"LoRR's actions are those of turning bodies, not {scenario.policy.body}"))
     if request.ros2 and not request.live:
         raise InputError(Problem("--ros2", "publishes the robots of a live run: add --live"))
     if request.ros2:
@@ -669,8 +701,11 @@ def _validate_live(scenario: Scenario, request: RunRequest) -> None:
             raise InputError(Problem("--results", str(error))) from None
 
 
-def _simulated_run(scenario: Scenario, request: RunRequest, plan: PlanningResult | None, console: Console) -> RunResult:
-    """Simulate ``scenario`` (following ``plan`` when given), drawn in the terminal with ``--watch``."""
+def _simulated_run(
+    scenario: Scenario, request: RunRequest, plan: PlanningResult | None, console: Console, step_seconds: list[float]
+) -> RunResult:
+    """Simulate ``scenario`` (following ``plan`` when given), drawn in the terminal with ``--watch``; each tick's
+    wall-clock seconds are appended to ``step_seconds``."""
     from mrmp.sim.simulator import records_messages
 
     recorded = request.record is not None and (plan is not None or records_messages(scenario))  # --record: /mrmp/messages
@@ -687,7 +722,26 @@ def _simulated_run(scenario: Scenario, request: RunRequest, plan: PlanningResult
         def start(on_tick: TickObserver | None) -> RunResult:
             return simulate(scenario, record_messages=record, on_tick=on_tick)
 
-    return _watched(scenario, request.watch_fps if request.watch else None, console, start)
+    def timed_start(on_tick: TickObserver | None) -> RunResult:
+        return start(StepTimer(step_seconds, on_tick))
+
+    return _watched(scenario, request.watch_fps if request.watch else None, console, timed_start)
+
+
+class StepTimer:
+    """A tick observer that appends each tick's wall-clock seconds (since the tick before, or since it was made) to a list."""
+
+    def __init__(self, seconds: list[float], then: TickObserver | None) -> None:
+        self.seconds = seconds
+        self.then = then
+        self._last = time.perf_counter()
+
+    def __call__(self, tick: int, cells: list[Cell]) -> None:
+        now = time.perf_counter()
+        self.seconds.append(now - self._last)
+        self._last = now
+        if self.then is not None:
+            self.then(tick, cells)
 
 
 def _live_run(scenario: Scenario, request: RunRequest, plan: PlanningResult | None, console: Console) -> RunResult:
@@ -716,12 +770,19 @@ def _live_run(scenario: Scenario, request: RunRequest, plan: PlanningResult | No
         )  # fmt: skip
 
 
-def _output_run(result: RunResult, scenario: Scenario, request: RunRequest, console: Console) -> None:
-    """Print the result, write its JSON and animation as asked, and exit with the run's status."""
+def _output_run(
+    result: RunResult, scenario: Scenario, request: RunRequest, console: Console, step_seconds: list[float]
+) -> None:
+    """Print the result, write its JSON, animation and LoRR output as asked, and exit with the run's status."""
     print_result(result, console)
     try:
         if request.json_path is not None:
             write_result_json(result, request.json_path, grid=scenario.grid)
+        if request.lorr_output is not None:
+            from mrmp.io.lorr_output import write_lorr_output
+
+            write_lorr_output(result, scenario.grid, request.lorr_output, step_seconds)
+            console.print(f"LoRR output written to {request.lorr_output}", markup=False)
         if request.animate is not None:
             from mrmp.viz import write_animation
 

@@ -23,6 +23,7 @@ from dataclasses import dataclass, field
 
 from mrmp.core.cell import Cell
 from mrmp.core.heading import Heading
+from mrmp.core.tasks import TaskLog
 
 COLLISION_KINDS = ("vertex", "swap", "obstacle", "off_grid", "jump", "follow", "rotation", "action")
 """What the referee reports: two robots in one cell, two robots exchanging cells,
@@ -128,6 +129,9 @@ class RunResult:
     (:mod:`mrmp.core.body`); a robot's ``time_s`` counts its body's actions in
     seconds, so ``time_makespan_s`` and ``time_sum_of_costs_s`` are the
     makespan and the sum of costs in the body's seconds, beside the ticks.
+    A lifelong run with a task stream carries its ``tasks``
+    (:class:`~mrmp.core.tasks.TaskLog`: tasks finished, errands reached,
+    schedules), and a robot's ``goals_reached`` counts its errands.
     """
 
     scenario: str
@@ -150,6 +154,7 @@ class RunResult:
     lifelong: bool = False
     message_log: list[list[tuple[str, str, str]]] | None = None
     body: str = "omni"
+    tasks: TaskLog | None = None
 
     @property
     def all_arrived(self) -> bool:

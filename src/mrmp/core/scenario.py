@@ -39,6 +39,7 @@ from mrmp.core.options import (
     swap_setting,
     synchronizer_setting,
 )
+from mrmp.core.tasks import TaskStream, task_problems
 
 __all__ = [
     "RESOLUTIONS",
@@ -145,7 +146,8 @@ class Scenario:
     ``safety`` turns on the safety layer that guards every move
     (:mod:`mrmp.protocol.safety`); ``False`` runs the policy as written.
     ``lifelong``: a robot that reaches its goal receives a new one (drawn with
-    the seed), and the run lasts until its tick limit.
+    the seed, or, with ``tasks``, its next errand or a task from the stream's
+    scheduler: :mod:`mrmp.core.tasks`), and the run lasts until its tick limit.
     """
 
     grid: Grid
@@ -156,6 +158,7 @@ class Scenario:
     policy: PolicyOptions = field(default_factory=PolicyOptions)
     safety: bool = True
     lifelong: bool = False
+    tasks: TaskStream | None = None
     seed: int = 0
     max_ticks: int | None = None
     name: str = ""
@@ -284,6 +287,10 @@ def scenario_problems(scenario: Scenario) -> list[Problem]:
         if link.sender == link.recipient:
             problems.append(Problem(f"{where}.to", "a link joins two different robots"))
         problems.extend(_fault_problems(link.faults, where))
+    if scenario.tasks is not None:
+        problems.extend(task_problems(scenario.tasks, grid))
+        if not scenario.lifelong:
+            problems.append(Problem("tasks", "a task stream needs a lifelong run"))
     if scenario.max_ticks is not None and scenario.max_ticks <= 0:
         problems.append(Problem("max_ticks", f"must be positive, got {scenario.max_ticks}"))
     elif scenario.max_ticks is not None and scenario.max_ticks > MAX_TICKS:

@@ -41,11 +41,25 @@ from typing import Any
 from mrmp.core.cell import Cell
 from mrmp.core.errors import InputError, Problem
 from mrmp.core.grid import Grid
+from mrmp.core.heading import Heading
 from mrmp.core.limits import MAX_ROBOTS
+from mrmp.core.scenario import PolicyOptions, RobotSpec, Scenario
+from mrmp.core.tasks import TaskStream
 from mrmp.io._files import PathLike, read_text
 from mrmp.io.movingai import parse_map
 
-__all__ = ["MAX_TASKS", "LorrProblem", "lorr_cell", "lorr_location", "read_lorr_problem"]
+__all__ = [
+    "LORR_HEADING",
+    "LORR_STEPS",
+    "MAX_TASKS",
+    "LorrProblem",
+    "is_lorr_problem",
+    "load_lorr_scenario",
+    "lorr_cell",
+    "lorr_location",
+    "lorr_scenario",
+    "read_lorr_problem",
+]
 
 MAX_TASKS = 1_000_000
 """The most tasks a task file may hold (read before any work starts)."""
@@ -246,3 +260,46 @@ def _tasks(file: Path, grid: Grid) -> tuple[tuple[Cell, ...], ...]:
             raise InputError(Problem(where, f"expected errand locations separated by commas, got {text!r}"))
         tasks.append(tuple(_location(part, grid, where) for part in errands))
     return tuple(tasks)
+
+
+LORR_STEPS = 5000
+"""The steps a LoRR run lasts when not told (the Start-Kit's ``--simulationTime`` default)."""
+LORR_HEADING = Heading.EAST
+"""Where every LoRR robot faces at the start (the Start-Kit's orientation 0: toward the next column)."""
+
+
+def lorr_scenario(problem: LorrProblem, steps: int = LORR_STEPS) -> Scenario:
+    """A lifelong mrmp scenario of ``problem``: its robots on their starts facing east, its task stream, ``steps`` ticks.
+
+    The robots run decentralized ``pibt`` in the ``turning`` body (LoRR's
+    ``MAPF_T``), its calls in priority order (``sequencing: driver``); every
+    robot's goal is its start until the scheduler gives it a task. One tick is
+    one LoRR action (the 2024 rules; a 2026 problem's ``agentCounter``
+    execution ticks per action are not simulated).
+
+    >>> scenario = lorr_scenario(read_lorr_problem("examples/lorr/maze-example_40.json"), steps=100)
+    >>> scenario.max_ticks, scenario.tasks.reveal, scenario.policy.body, scenario.robots[0].heading.name
+    (100, 60, 'turning', 'EAST')
+    """
+    robots = tuple(RobotSpec(str(index), start, start, LORR_HEADING) for index, start in enumerate(problem.starts))
+    stream = TaskStream(problem.tasks, reveal=max(1, int(problem.tasks_reveal * problem.team_size)))
+    return Scenario(
+        problem.grid,
+        robots,
+        policy=PolicyOptions(name="pibt", body="turning", sequencing="driver"),
+        lifelong=True,
+        tasks=stream,
+        max_ticks=steps,
+        name=problem.name,
+        description=f"League of Robot Runners problem {problem.source}",
+    )
+
+
+def load_lorr_scenario(path: PathLike, steps: int = LORR_STEPS) -> Scenario:
+    """:func:`lorr_scenario` of the LoRR problem file ``path`` (its errors as :func:`read_lorr_problem`'s)."""
+    return lorr_scenario(read_lorr_problem(path), steps)
+
+
+def is_lorr_problem(path: PathLike) -> bool:
+    """Whether ``path`` names a LoRR problem (a ``.json`` file), not a YAML scenario."""
+    return Path(path).suffix.lower() == ".json"

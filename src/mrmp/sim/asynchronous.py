@@ -55,6 +55,7 @@ from mrmp.sim.goals import GoalBook
 from mrmp.sim.metrics import shortest_steps
 from mrmp.sim.referee import Referee
 from mrmp.sim.spatial import SpatialIndex
+from mrmp.sim.task_book import hand_out_tasks, task_book
 from mrmp.sim.ticking import TickObserver, run_result, run_ticks, scenario_network, send_counted
 
 __all__ = ["SLOWEST_PACE", "AsynchronousSimulator", "causal_timers"]
@@ -128,6 +129,9 @@ class AsynchronousSimulator:
         ]
         self._everyone = range(len(self.robots))
         self._goals = GoalBook(scenario.seed, grid.free_cells() if scenario.lifelong else [])
+        self.task_book = task_book(scenario, flat)
+        if self.task_book is not None:
+            self._count_goals()
 
     def default_max_ticks(self) -> int:
         """Room for the slowest robot's moves and the lock conversations of a crowd over the scenario's network
@@ -222,6 +226,9 @@ class AsynchronousSimulator:
 
     def _count_goals(self) -> None:
         robots = self.robots
+        if self.task_book is not None:
+            hand_out_tasks(self.task_book, self.tick, [robot.tail for robot in robots], self._results, self._set_goal)
+            return
         for index in self._goals.arrivals(robot.at_goal for robot in robots):
             self._results[index].goals_reached += 1
             if self.scenario.lifelong:
@@ -229,6 +236,9 @@ class AsynchronousSimulator:
                 goal = self._goals.next_goal(index, {other.goal for other in robots}, robot.tail)
                 if goal is not None:
                     robot.set_goal(goal)
+
+    def _set_goal(self, index: int, goal: Cell) -> None:
+        self.robots[index].set_goal(goal)
 
     def _result(self, stop_reason: str, wall_time: float) -> RunResult:
         cell_time = self.scenario.timing.cell_time

@@ -56,6 +56,7 @@ from collections.abc import Container, Sequence
 from operator import attrgetter
 
 from mrmp.core.body import body_model
+from mrmp.core.cell import Cell
 from mrmp.core.faults import message_fates
 from mrmp.core.heading import right_turns
 from mrmp.core.result import RobotResult, RunResult
@@ -69,6 +70,7 @@ from mrmp.search.flat_map import FlatMap
 from mrmp.sim.goals import GoalBook
 from mrmp.sim.metrics import default_max_ticks, network_slowdown, shortest_steps
 from mrmp.sim.referee import Referee
+from mrmp.sim.task_book import hand_out_tasks, task_book
 from mrmp.sim.ticking import TickObserver, link_faults, run_result, run_ticks
 
 __all__ = ["MAX_TRIES", "RoundsSimulator", "message_size"]
@@ -172,6 +174,9 @@ class RoundsSimulator:
         self.stats: Counter[str] = Counter()
         self._sizes = fixed_sizes()  # bytes of each message type on the wire, from the message table
         self._goals = GoalBook(scenario.seed, grid.free_cells() if scenario.lifelong else [])
+        self.task_book = task_book(scenario, flat)
+        if self.task_book is not None:
+            self._count_goals()
 
     def _default_max_ticks(self) -> int:
         """Room for PIBT's steps (as :func:`~mrmp.sim.metrics.default_max_ticks`); over a slow or lossy
@@ -287,9 +292,13 @@ class RoundsSimulator:
             self.on_tick(self.tick, after)
 
     def _count_goals(self) -> None:
-        """Count goals reached; in a lifelong run, hand each such robot a new goal (drawn with the seed)."""
+        """Count goals reached; in a lifelong run, hand each such robot a new goal (drawn with the seed, or the task book's)."""
         flat = self.flat
         robots = self.robots
+        if self.task_book is not None:
+            cells = [flat.cells[robot.present] for robot in robots]
+            hand_out_tasks(self.task_book, self.tick, cells, self._results, self._set_goal)
+            return
         for index in self._goals.arrivals(robot.at_goal for robot in robots):
             self._results[index].goals_reached += 1
             if self.scenario.lifelong:
@@ -299,6 +308,11 @@ class RoundsSimulator:
                 if goal is not None:
                     robot.goal = flat.index(goal)
                     robot.elapsed = 0
+
+    def _set_goal(self, index: int, goal: Cell) -> None:
+        robot = self.robots[index]
+        robot.goal = self.flat.index(goal)
+        robot.elapsed = 0
 
     # -- rounds ------------------------------------------------------------------------
 

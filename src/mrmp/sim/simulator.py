@@ -57,11 +57,13 @@ from mrmp.policies.base import Decision, Policy, interaction_radius
 from mrmp.protocol.codec import DecodeError, decode
 from mrmp.protocol.messages import Message
 from mrmp.robot.robot import Outgoing, Robot
+from mrmp.search.flat_map import FlatMap
 from mrmp.sim.goals import GoalBook
 from mrmp.sim.metrics import default_max_ticks, network_slowdown, shortest_steps
 from mrmp.sim.policy_table import POLICY_TABLE, body_problem, make_policy, policy_entry
 from mrmp.sim.referee import Referee
 from mrmp.sim.spatial import SpatialIndex
+from mrmp.sim.task_book import hand_out_tasks, task_book
 from mrmp.sim.ticking import TickObserver, run_result, run_ticks, scenario_network, send_counted
 
 RECURRENCE_LIMIT = 10
@@ -231,6 +233,9 @@ class LockstepSimulator:
         self._still_since = 0
         self._everyone = range(len(self.robots))
         self._goals = GoalBook(scenario.seed, grid.free_cells() if scenario.lifelong else [])
+        self.task_book = task_book(scenario, FlatMap(grid))
+        if self.task_book is not None:
+            self._count_goals()
         self.on_tick = on_tick
         self._ids = [spec.id for spec in scenario.robots]
         self._message_log: list[list[tuple[str, str, str]]] | None = [[]] if record_messages else None
@@ -351,6 +356,9 @@ class LockstepSimulator:
         nobody's goal and not the robot's own cell, robots taken in index order.
         """
         robots = self.robots
+        if self.task_book is not None:
+            hand_out_tasks(self.task_book, self.tick, [robot.present for robot in robots], self._results, self._set_goal)
+            return
         for index in self._goals.arrivals(robot.arrived for robot in robots):
             self._results[index].goals_reached += 1
             if self.scenario.lifelong:
@@ -358,6 +366,9 @@ class LockstepSimulator:
                 goal = self._goals.next_goal(index, {other.goal for other in robots}, robot.present)
                 if goal is not None:
                     robot.goal = goal
+
+    def _set_goal(self, index: int, goal: Cell) -> None:
+        self.robots[index].goal = goal
 
     def _stuck(self) -> str | None:
         configuration = (tuple(robot.present for robot in self.robots), tuple(robot.heading for robot in self.robots))

@@ -33,6 +33,7 @@ from mrmp.protocol.codec import encode
 from mrmp.robot.robot import Outgoing
 from mrmp.sim.network import SimulatedNetwork
 from mrmp.sim.referee import Referee
+from mrmp.sim.task_book import TaskBook
 
 TickObserver = Callable[[int, list[Cell]], None]
 """Called after every tick with the tick number and every robot's cell, in scenario order."""
@@ -46,6 +47,7 @@ class TickedSimulation(Protocol):
     tick: int
     max_ticks: int
     lengths: list[int]
+    task_book: TaskBook | None
 
     def step(self) -> None:
         """Advance one tick."""
@@ -161,5 +163,6 @@ def run_result(
         network=network,
         lifelong=scenario.lifelong,
         body=scenario.policy.body,
+        tasks=None if simulation.task_book is None else simulation.task_book.log,
         **extra,
     )
