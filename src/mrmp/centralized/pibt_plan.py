@@ -4,7 +4,8 @@ PIBT (Okumura, Machida, Défago and Tamura, "Priority Inheritance with
 Backtracking for Iterative Multi-agent Path Finding", IJCAI 2019; Artificial
 Intelligence 310, 2022) plans a tick at a time: robots are served in order of
 priority, a robot's priority grows by one every tick it is away from its goal
-and drops back to its fraction when it arrives, and
+(for ``turning`` bodies, by :data:`~mrmp.policies.pibt_rules.DEAD_END_BONUS` more
+in a dead end, as in the League of Robot Runners' Start-Kit) and drops back to its fraction when it arrives, and
 :class:`~mrmp.centralized.pibt_step.PIBT` makes the step. This is the
 reference the fleet's decentralized ``pibt`` is measured against, and the
 generator inside :func:`~mrmp.centralized.lacam.lacam`.
@@ -43,6 +44,7 @@ from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
 from mrmp.core.heading import Heading
 from mrmp.core.scenario import Scenario
+from mrmp.policies.pibt_rules import DEAD_END_BONUS
 from mrmp.search.distance import distance_table
 from mrmp.search.flat_grid import flat_grid
 from mrmp.search.heading_distance import heading_distances
@@ -128,6 +130,7 @@ def pibt_plan(
         rotations=False, turning_y_size=flat.y_size if turning else 0,
         swap=not turning if swap is None else swap, tie_penalties=seed is not None and not turning,
     )  # fmt: skip
+    bonus = DEAD_END_BONUS if turning else 0  # the Start-Kit's dead-end rule, as the fleet's turning robots
     scale = 1.0 / (len(flat.neighbours) + 1)
     priorities = [distance * scale for distance in far]
     cell_rows, heading_rows = [list(cells)], [list(headings)]
@@ -140,8 +143,11 @@ def pibt_plan(
         cells, headings = target, next_headings if turning else headings
         cell_rows.append(list(cells))
         heading_rows.append(list(headings))
+        neighbours = flat.neighbours
         priorities = [
-            priority + 1 if cells[robot] != goal_cells[robot] else priority - int(priority)
+            priority + 1 + (bonus if len(neighbours[cells[robot]]) == 1 else 0)
+            if cells[robot] != goal_cells[robot]
+            else priority - int(priority)
             for robot, priority in enumerate(priorities)
         ]
         tick += 1

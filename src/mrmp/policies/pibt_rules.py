@@ -43,6 +43,11 @@ NOISE_SCALE = 0.2
 """Scale of the random tie-break when tie penalties are on (penalties and noise stay below one move)."""
 
 
+DEAD_END_BONUS = 10
+"""Steps of priority a robot whose body turns in place gains, besides the step, for each step it ends in a dead end
+away from its goal: the League of Robot Runners' Start-Kit rule (``default_planner/planner.cpp``, ``p[i] + 10``)."""
+
+
 def sorted_candidates(
     neighbours: Sequence[tuple[int, ...]],
     here: int,

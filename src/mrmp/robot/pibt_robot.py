@@ -160,6 +160,13 @@ class PibtRobot:
         The body turns in place (``turning``; module docstring): candidates
         ranked by :meth:`~mrmp.search.flat_map.FlatMap.heading_distances` with a
         quarter turn either way costing one tick; needs ``swap`` off.
+    dead_end_bonus:
+        Steps of priority added, on top of the step itself, for every step the
+        robot ends in a dead end (a cell with one neighbour) away from its goal:
+        the Start-Kit's rule (``default_planner/planner.cpp``: ``p[i] + 10``), so
+        that a robot shut in a dead end outranks the robot that waits at its
+        mouth. Without the swap technique (bodies that turn in place) the two
+        would otherwise wait for each other for ever.
     """
 
     def __init__(
@@ -178,6 +185,7 @@ class PibtRobot:
         rng: random.Random | None = None,
         tie_penalties: bool | None = None,
         turning: bool = False,
+        dead_end_bonus: int = 0,
     ) -> None:
         if radius < MIN_RADIUS:
             raise ValueError(f"radius {radius} is below {MIN_RADIUS}: robots two cells apart could take the same cell")
@@ -196,6 +204,7 @@ class PibtRobot:
         self._noise = rng.random if rng is not None else None
         self.tie_penalties = rng is not None if tie_penalties is None else tie_penalties
         self.turning = turning
+        self.dead_end_bonus = dead_end_bonus
         self.elapsed = 0
         self.step = 0
         self.seq = 0
@@ -401,15 +410,22 @@ class PibtRobot:
                 self.present = self.target
             if self.target is not None:
                 self.heading = self.next_heading
-            self.elapsed = 0 if self.present == self.goal else self.elapsed + 1
+            self._count_elapsed()
             return self.present
         target = self.target if self.target is not None else self.present
         if target != self.present:
             cells = self.flat.cells
             self.heading = Heading.between(cells[self.present], cells[target])
         self.present = target
-        self.elapsed = 0 if target == self.goal else self.elapsed + 1
+        self._count_elapsed()
         return target
+
+    def _count_elapsed(self) -> None:
+        """One more step away from the goal (plus ``dead_end_bonus`` in a dead end), or 0 on it."""
+        if self.present == self.goal:
+            self.elapsed = 0
+        else:
+            self.elapsed += 1 + (self.dead_end_bonus if len(self.flat.neighbours[self.present]) == 1 else 0)
 
     # -- PIBT's call, by messages -------------------------------------------------------
 

@@ -54,6 +54,7 @@ import time
 from collections import Counter
 from collections.abc import Container, Sequence
 from operator import attrgetter
+from typing import Any
 
 from mrmp.core.body import body_model
 from mrmp.core.cell import Cell
@@ -62,6 +63,7 @@ from mrmp.core.heading import right_turns
 from mrmp.core.result import RobotResult, RunResult
 from mrmp.core.scenario import NetworkFaults, Scenario
 from mrmp.core.seeds import Stream, stream_random
+from mrmp.policies.pibt_rules import DEAD_END_BONUS
 from mrmp.protocol.codec import fixed_sizes
 from mrmp.protocol.messages import BeaconMessage, Message, ReserveMessage  # noqa: F401  (ReserveMessage: doctest)
 from mrmp.robot.messaging import Outgoing
@@ -133,6 +135,7 @@ class RoundsSimulator:
         self.body = body_model(options.body)
         turning = self.body.turns_in_place
         self.robots: list[PibtRobot] = []
+        turning_options: dict[str, Any] = {"turning": True, "dead_end_bonus": DEAD_END_BONUS} if turning else {}
         for index, spec in enumerate(scenario.robots):
             goal = flat.index(spec.goal)
             start = flat.index(spec.start)
@@ -151,7 +154,7 @@ class RoundsSimulator:
                     turn_cost=scenario.timing.turn_time / scenario.timing.cell_time,
                     rng=stream_random(scenario.seed, Stream.TIES, index) if random_ties else None,
                     tie_penalties=tie_penalties,
-                    **({"turning": True} if turning else {}),
+                    **turning_options,
                 )
             )
         self.referee = Referee(grid, [spec.id for spec in scenario.robots], self.body)

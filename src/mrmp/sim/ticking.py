@@ -29,6 +29,7 @@ from mrmp.core.cell import Cell
 from mrmp.core.result import RobotResult, RunResult
 from mrmp.core.scenario import NetworkFaults, Scenario
 from mrmp.core.seeds import Stream, derive_seed
+from mrmp.core.tasks import TaskLog
 from mrmp.protocol.codec import encode
 from mrmp.robot.robot import Outgoing
 from mrmp.sim.network import SimulatedNetwork
@@ -47,7 +48,6 @@ class TickedSimulation(Protocol):
     tick: int
     max_ticks: int
     lengths: list[int]
-    task_book: TaskBook | None
 
     def step(self) -> None:
         """Advance one tick."""
@@ -139,6 +139,12 @@ def send_counted(
     return recipients
 
 
+def _task_log(simulation: TickedSimulation) -> TaskLog | None:
+    """The log of ``simulation``'s task book, if it has one (a simulator serving a task stream keeps it as ``task_book``)."""
+    book: TaskBook | None = getattr(simulation, "task_book", None)
+    return None if book is None else book.log
+
+
 def run_result(
     simulation: TickedSimulation,
     results: list[RobotResult],
@@ -163,6 +169,6 @@ def run_result(
         network=network,
         lifelong=scenario.lifelong,
         body=scenario.policy.body,
-        tasks=None if simulation.task_book is None else simulation.task_book.log,
+        tasks=_task_log(simulation),
         **extra,
     )

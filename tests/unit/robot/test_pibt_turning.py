@@ -22,9 +22,11 @@ from mrmp.core import Grid, NetworkFaults, PolicyOptions, RobotSpec, Scenario
 from mrmp.core.grid import connected_regions
 from mrmp.core.heading import Heading
 from mrmp.io.scenario_file import load_scenario
+from mrmp.policies.pibt_rules import DEAD_END_BONUS
 from mrmp.protocol.codec import decode, encode
 from mrmp.protocol.messages import StayMessage
 from mrmp.robot.pibt_robot import PibtRobot
+from mrmp.sim import rounds
 from mrmp.sim.rounds import RoundsSimulator
 
 N, E, S, W = Heading.NORTH, Heading.EAST, Heading.SOUTH, Heading.WEST
@@ -154,3 +156,26 @@ def test_stay_messages_round_trip_the_codec_and_turning_refuses_swap() -> None:
     assert decode(encode(message)) == message
     with pytest.raises(ValueError, match="no swap technique"):
         PibtRobot(0, 0, 1, RoundsSimulator(random_scenario(0)).flat, swap=True, turning=True)
+
+
+@pytest.mark.parametrize("bonus", [DEAD_END_BONUS, 0])
+def test_a_robot_shut_in_a_dead_end_outranks_the_one_waiting_at_its_mouth(bonus: int, monkeypatch: pytest.MonkeyPatch) -> None:
+    """Without the swap technique, B (at the mouth, for the dead end) and A (in it, for outside) wait for each other
+    for ever while B outranks A; the Start-Kit's dead-end bonus lets A go first. The variant without it never ends."""
+    monkeypatch.setattr(rounds, "DEAD_END_BONUS", bonus)
+    grid = Grid.from_rows(["...", "#.#"])
+    dead_end, mouth, outside = (0, 1), (1, 1), (1, 0)
+    scenario = Scenario(
+        grid,
+        (RobotSpec("A", dead_end, outside), RobotSpec("B", mouth, dead_end)),
+        policy=PolicyOptions(name="pibt", body="turning", sequencing="driver"),
+        max_ticks=60,
+    )
+    simulator = RoundsSimulator(scenario)
+    simulator.robots[1].elapsed = 5  # B has waited longer: it outranks A
+    result = simulator.run()
+    assert not result.collisions
+    if bonus:
+        assert result.stop_reason == "all arrived" and result.makespan <= 10
+    else:
+        assert result.stop_reason == "tick limit"
