@@ -50,8 +50,8 @@ CASES = (
     "warehouse.domain/sortation_large_2000.json:200"
 )
 """The Start-Kit v2.1.0 example problems measured by default, ``:N`` keeping the first N robots (about 25 minutes
-here; the city and game problems, ``city.domain/paris_1_256_250.json`` and ``game.domain/brc202d_500.json``, take
-longer and more memory: mrmp keeps a distance list per goal in Python)."""
+here). The city problem ``city.domain/paris_1_256_250.json`` takes about 8 minutes more; the game problem
+``game.domain/brc202d_500.json`` needs more than 24 GB (mrmp keeps a distance list per goal in Python)."""
 MOST_STEPS = 100_000
 
 
