@@ -234,6 +234,17 @@ def _timing_problems(timing: Timing) -> list[Problem]:
     return problems
 
 
+def task_stream_problems(scenario: Scenario) -> list[Problem]:
+    """Every problem with ``scenario``'s task stream (:func:`~mrmp.core.tasks.task_problems`), and one if the run
+    that has it is not lifelong; none without a stream."""
+    if scenario.tasks is None:
+        return []
+    problems = task_problems(scenario.tasks, scenario.grid)
+    if not scenario.lifelong:
+        problems.append(Problem("tasks", "a task stream needs a lifelong run"))
+    return problems
+
+
 def scenario_problems(scenario: Scenario) -> list[Problem]:
     """Every problem with the meaning of ``scenario``, each named by its field path.
 
@@ -287,10 +298,7 @@ def scenario_problems(scenario: Scenario) -> list[Problem]:
         if link.sender == link.recipient:
             problems.append(Problem(f"{where}.to", "a link joins two different robots"))
         problems.extend(_fault_problems(link.faults, where))
-    if scenario.tasks is not None:
-        problems.extend(task_problems(scenario.tasks, grid))
-        if not scenario.lifelong:
-            problems.append(Problem("tasks", "a task stream needs a lifelong run"))
+    problems.extend(task_stream_problems(scenario))
     if scenario.max_ticks is not None and scenario.max_ticks <= 0:
         problems.append(Problem("max_ticks", f"must be positive, got {scenario.max_ticks}"))
     elif scenario.max_ticks is not None and scenario.max_ticks > MAX_TICKS:

@@ -43,6 +43,7 @@ from mrmp.core.grid import Grid
 from mrmp.core.heading import Heading, right_turns
 from mrmp.core.result import RunResult
 from mrmp.io._files import PathLike, atomic_write_text
+from mrmp.io.lorr import lorr_location
 
 __all__ = ["lorr_actions", "lorr_output", "write_lorr_output"]
 
@@ -89,11 +90,9 @@ def lorr_output(result: RunResult, grid: Grid, step_seconds: Sequence[float] = (
     if not body_model(result.body).turns_in_place:
         raise MrmpError(f"--lorr-output: LoRR's actions are those of turning bodies, this run's were {result.body}")
     log = result.tasks
-    width = grid.y_size
 
     def row_column(cell: Cell) -> list[int]:
-        location = (grid.x_size - 1 - cell[0]) * width + cell[1]
-        return [location // width, location % width]
+        return list(divmod(lorr_location(cell, grid), grid.y_size))
 
     paths = [lorr_actions(robot.path, robot.headings) for robot in result.robots]
     # a task given at the end of tick t is checked from step t + 1 on, which the Start-Kit writes as t + 1

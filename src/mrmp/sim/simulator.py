@@ -57,7 +57,6 @@ from mrmp.policies.base import Decision, Policy, interaction_radius
 from mrmp.protocol.codec import DecodeError, decode
 from mrmp.protocol.messages import Message
 from mrmp.robot.robot import Outgoing, Robot
-from mrmp.search.flat_map import FlatMap
 from mrmp.sim.goals import GoalBook
 from mrmp.sim.metrics import default_max_ticks, network_slowdown, shortest_steps
 from mrmp.sim.policy_table import POLICY_TABLE, body_problem, make_policy, policy_entry
@@ -233,7 +232,7 @@ class LockstepSimulator:
         self._still_since = 0
         self._everyone = range(len(self.robots))
         self._goals = GoalBook(scenario.seed, grid.free_cells() if scenario.lifelong else [])
-        self.task_book = task_book(scenario, FlatMap(grid))
+        self.task_book = task_book(scenario)
         if self.task_book is not None:
             self._count_goals()
         self.on_tick = on_tick

@@ -46,10 +46,10 @@ from dataclasses import dataclass
 from itertools import pairwise
 
 from mrmp.core.cell import Cell
-from mrmp.core.errors import InputError, Problem
+from mrmp.core.errors import InputError
 from mrmp.core.result import RobotResult
-from mrmp.core.scenario import Scenario
-from mrmp.core.tasks import TaskLog, TaskStream, task_problems
+from mrmp.core.scenario import Scenario, task_stream_problems
+from mrmp.core.tasks import TaskLog, TaskStream
 from mrmp.search.flat_map import FlatMap
 
 __all__ = ["SCHEDULER_TABLE", "Scheduler", "Task", "TaskBook", "TaskUpdate", "greedy_schedule", "hand_out_tasks", "task_book"]
@@ -213,19 +213,17 @@ def hand_out_tasks(
         set_goal(index, goal)
 
 
-def task_book(scenario: Scenario, flat: FlatMap) -> TaskBook | None:
-    """The task book of ``scenario`` (None when it has no task stream).
+def task_book(scenario: Scenario, flat: FlatMap | None = None) -> TaskBook | None:
+    """The task book of ``scenario`` (None when it has no task stream), on ``flat`` (made here when not given).
 
     Raises
     ------
     InputError
-        If the stream has problems (:func:`~mrmp.core.tasks.task_problems`) or the run is not lifelong.
+        If the stream has problems (:func:`~mrmp.core.scenario.task_stream_problems`).
     """
     if scenario.tasks is None:
         return None
-    problems = task_problems(scenario.tasks, scenario.grid)
-    if not scenario.lifelong:
-        problems.append(Problem("tasks", "a task stream needs a lifelong run"))
+    problems = task_stream_problems(scenario)
     if problems:
         raise InputError(problems)
-    return TaskBook(scenario.tasks, flat, len(scenario.robots))
+    return TaskBook(scenario.tasks, flat if flat is not None else FlatMap(scenario.grid), len(scenario.robots))
