@@ -7,8 +7,8 @@ the same number of steps:
 * the Start-Kit's default entry (its greedy scheduler and its planner: PIBT
   with traffic-flow guide paths, C++, Release build), through the Start-Kit's
   own simulator (``build/lifelong -s STEPS -t PLAN_MS``);
-* mrmp: decentralized ``pibt`` in the ``turning`` body, its calls in priority
-  order (``sequencing: driver``), the same greedy scheduler
+* mrmp: ``pibt`` computed by the robots' messages in the ``turning`` body, the
+  simulator starting their calls in priority order (``sequencing: driver``), the same greedy scheduler
   (:mod:`mrmp.sim.task_book`), in the simulator (:func:`mrmp.io.lorr.lorr_scenario`);
 
 and prints the tasks each finished (LoRR's score, ``numTaskFinished``), their

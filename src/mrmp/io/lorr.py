@@ -271,8 +271,9 @@ LORR_HEADING = Heading.EAST
 def lorr_scenario(problem: LorrProblem, steps: int = LORR_STEPS) -> Scenario:
     """A lifelong mrmp scenario of ``problem``: its robots on their starts facing east, its task stream, ``steps`` ticks.
 
-    The robots run decentralized ``pibt`` in the ``turning`` body (LoRR's
-    ``MAPF_T``), its calls in priority order (``sequencing: driver``); every
+    The robots compute ``pibt`` by messages in the ``turning`` body (LoRR's
+    ``MAPF_T``), the simulator starting their calls in priority order
+    (``sequencing: driver``); every
     robot's goal is its start until the scheduler gives it a task. One tick is
     one LoRR action (the 2024 rules; a 2026 problem's ``agentCounter``
     execution ticks per action are not simulated).
