@@ -16,7 +16,8 @@ ratio, the seconds per step (the Start-Kit's mean ``plannerTimes``; mrmp's
 wall time of the whole run over its steps, robots, messages and task book
 included) and their ratio, mrmp's collisions and its messages per robot-step.
 One step is one LoRR action (the 2024 rules: Start-Kit v2.1.0). Each row is
-appended to ``--out`` (JSON lines) as soon as it is measured.
+appended to ``--out`` (JSON lines) as soon as it is measured; the Start-Kit's
+processes end with the script, however it is killed.
 
 The Start-Kit is not shipped with mrmp: give its source tree (v2.1.0,
 MAPF-Competition/Start-Kit commit 5ea4fa1, MIT license) with ``--start-kit``;
@@ -33,6 +34,8 @@ from __future__ import annotations
 
 import argparse
 import json
+import os
+import signal
 import subprocess
 import sys
 import tempfile
@@ -41,6 +44,7 @@ from dataclasses import asdict, dataclass
 from pathlib import Path
 
 from mrmp.core.errors import InputError
+from mrmp.io.lifetime import preexec_dying_with
 from mrmp.io.lorr import load_lorr_scenario
 from mrmp.sim.simulator import simulate
 
@@ -96,15 +100,19 @@ def build(start_kit: Path) -> Path:
             ["cmake", "-B", "build", ".", "-DPYTHON=false", "-DCMAKE_BUILD_TYPE=Release"],
             ["make", "-C", "build", "-j2"],
         ):
-            subprocess.run(command, cwd=start_kit, stdout=output, stderr=subprocess.STDOUT, check=True)
+            subprocess.run(
+                command, cwd=start_kit, stdout=output, stderr=subprocess.STDOUT, check=True,
+                preexec_fn=preexec_dying_with(signal.SIGKILL),
+            )  # fmt: skip
     return program
 
 
 def case_problem(start_kit: Path, case: str, scratch: Path) -> tuple[Path, str]:
     """The problem file of ``case`` (``DOMAIN/FILE.json[:N]``) and its name; with ``:N`` a copy keeping N robots.
 
-    The copy is written beside the original (LoRR resolves its files from the
-    problem's folder) under a name of its own, and removed by the caller.
+    The copy is written in ``scratch``, its files named relative to it (LoRR
+    resolves them from the problem's folder), so that nothing is written into
+    the Start-Kit's tree.
     """
     name, _, robots = case.partition(":")
     problem = start_kit / "example_problems" / name
@@ -118,7 +126,10 @@ def case_problem(start_kit: Path, case: str, scratch: Path) -> tuple[Path, str]:
     if int(robots) > data["teamSize"]:
         raise InputError(f"--cases: {case}: the problem has {data['teamSize']} robots")
     data["teamSize"] = int(robots)
-    copy = problem.with_name(f"{scratch.name}-{problem.stem}-{robots}.json")
+    back = os.path.relpath(problem.parent, scratch)
+    for field in ("mapFile", "agentFile", "taskFile"):
+        data[field] = f"{back}/{data[field]}"
+    copy = scratch / f"{problem.stem}-{robots}.json"
     copy.write_text(json.dumps(data, indent=4))
     return copy, f"{problem.stem}:{robots}"
 
@@ -128,7 +139,10 @@ def start_kit_run(program: Path, problem: Path, steps: int, plan_ms: int, scratc
     output = scratch / f"{problem.stem}-start-kit.json"
     command = [str(program), "-i", str(problem), "-o", str(output), "-s", str(steps), "-t", str(plan_ms)]
     command += ["-l", str(scratch / f"{problem.stem}-start-kit.log")]
-    subprocess.run(command, cwd=scratch, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, check=True)
+    subprocess.run(
+        command, cwd=scratch, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, check=True,
+        preexec_fn=preexec_dying_with(signal.SIGKILL),
+    )  # fmt: skip
     result = json.loads(output.read_text())
     times = result.get("plannerTimes") or [0.0]
     return int(result["numTaskFinished"]), sum(times) / len(times)
@@ -137,12 +151,8 @@ def start_kit_run(program: Path, problem: Path, steps: int, plan_ms: int, scratc
 def measure(program: Path, start_kit: Path, case: str, steps: int, plan_ms: int, scratch: Path) -> Row:
     """One case, the Start-Kit first, then mrmp."""
     problem, name = case_problem(start_kit, case, scratch)
-    try:
-        start_kit_tasks, start_kit_step = start_kit_run(program, problem, steps, plan_ms, scratch)
-        scenario = load_lorr_scenario(problem, steps)
-    finally:
-        if problem.name.startswith(scratch.name):
-            problem.unlink()
+    start_kit_tasks, start_kit_step = start_kit_run(program, problem, steps, plan_ms, scratch)
+    scenario = load_lorr_scenario(problem, steps)
     started = time.perf_counter()
     result = simulate(scenario)
     wall = time.perf_counter() - started
