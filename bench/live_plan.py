@@ -3,20 +3,31 @@
 Plans ``--agents`` robots of a MovingAI scenario (random-32-32-20 by default) with
 LaCAM, executes the plan live over UDP with ``--loss`` message loss at
 ``--time-scale`` times the robots' speed (optionally killing robots: ``--kill
-ID@SECONDS``), and prints, per time scale: robots arrived, collisions, the wall
-makespan against the plan's makespan in seconds at that speed (plan ticks x cell
-time / time scale), the plan's execution bound at that speed and the wall makespan
-against it, moves, and messages per move (datagram-recipients, heartbeats included).
+ID@SECONDS``), and prints, per body and time scale: robots arrived, collisions, the
+wall makespan against the plan's makespan in seconds at that speed (plan ticks x
+cell time / time scale), the plan's live execution bound at that speed and the wall
+makespan against it, moves and quarter turns, and messages per move
+(datagram-recipients, heartbeats included).
 
-The execution bound (:func:`mrmp.centralized.body_time.execution_seconds`) is the
-soonest live bodies can carry the plan out, whatever messages cost: they turn right
-only, which the plan's ticks do not count, and cover both cells while they move, so a
-robot that follows another into a cell it leaves in the same tick starts once the
-other has arrived. It is what the messages are measured against. Before the runs, the
-bound is printed as a multiple of the plan's ticks times the cell time, and so is the
-bound of bodies that turn in no time (what following alone costs).
+Bodies (``--bodies``, comma-separated; ``docs/protocol.md``, "Body models"):
 
-Usage: python bench/live_plan.py [--agents 100] [--time-scales 2,5] [--loss 0.1] [--kill 3@2]
+* ``thesis``: an ``omni`` plan (moves to any neighbour, turns free) driven by the
+  thesis's bodies, as every live fleet was before bodies were named: they turn
+  right only, which the plan's ticks do not count;
+* ``turning``: a plan made for ``turning`` bodies (LoRR's ``MAPF_T``: a quarter turn
+  either way in place is a tick of its own) driven by such bodies, which turn toward
+  their next cell while they wait.
+
+The live execution bound (:func:`mrmp.centralized.body_time.execution_seconds`) is the
+soonest live bodies can carry the plan out, whatever messages cost. Live bodies cover
+both cells while they move, so the safety layer hands a cell over once its occupant
+has arrived elsewhere: a robot that follows another into a cell it leaves in the same
+tick starts once the other has arrived (``follows=False``). It is what the messages are
+measured against. Before the runs, the bound is printed as a multiple of the plan's
+ticks times the cell time (for ``thesis``, also the bound of bodies that turn in no
+time: what following alone costs).
+
+Usage: python bench/live_plan.py [--agents 48] [--bodies thesis,turning] [--time-scales 2,5] [--loss 0.1] [--kill 3@2]
 """
 
 from __future__ import annotations
@@ -28,12 +39,17 @@ from dataclasses import replace
 from pathlib import Path
 
 from mrmp.centralized.body_time import execution_seconds
+from mrmp.centralized.plan import PlanningResult
 from mrmp.centralized.registry import plan_with
+from mrmp.core import Scenario
+from mrmp.core.body import body_model
 from mrmp.io import load_movingai_scenario
 from mrmp.live.launcher import LiveOptions, run_live
 from mrmp.live.transport import LiveFaults
 
 MAPS = Path(__file__).resolve().parents[1] / "maps"
+PLANNED_BODY = {"thesis": "omni", "turning": "turning"}
+"""The body each live body's plan is made for: thesis bodies drive omni plans (no planner plans for them)."""
 
 
 def main() -> int:
@@ -41,47 +57,71 @@ def main() -> int:
     parser.add_argument("--map", type=Path, default=MAPS / "random-32-32-20.map")
     parser.add_argument("--scen", type=Path, default=MAPS / "random-32-32-20-random-1.scen")
     parser.add_argument("--agents", type=int, default=100)
+    parser.add_argument("--bodies", default="thesis,turning", help="comma-separated: thesis, turning")
     parser.add_argument("--time-scales", default="2")
     parser.add_argument("--loss", type=float, default=0.1)
     parser.add_argument("--kill", action="append", default=[], help="ID@SECONDS (repeatable)")
     arguments = parser.parse_args()
-    scenario = load_movingai_scenario(arguments.map, arguments.scen, arguments.agents)
-    plan = plan_with("lacam", scenario, time_limit_s=60)
-    if plan.paths is None:
-        print(f"lacam: no plan ({plan.status}: {plan.message})")
-        return 1
+    bodies = arguments.bodies.split(",")
+    unknown = [name for name in bodies if name not in PLANNED_BODY]
+    if unknown:
+        parser.error(f"--bodies: unknown {', '.join(unknown)}; use thesis, turning")
+    loaded = load_movingai_scenario(arguments.map, arguments.scen, arguments.agents)
     kill = {robot: float(seconds) for robot, seconds in (text.split("@") for text in arguments.kill)}
-    print(f"{scenario.name}: {arguments.agents} robots, plan makespan {plan.makespan()} ticks,", end=" ")
-    print(f"loss {arguments.loss}, kill {kill}")
-    headings = [robot.heading for robot in scenario.robots]
-    instant_turns = replace(scenario.timing, turn_time=0.0)
-    bound_ticks = execution_seconds(plan.paths, headings, scenario.timing) / scenario.timing.cell_time
-    following_ticks = execution_seconds(plan.paths, headings, instant_turns) / scenario.timing.cell_time
+    print(f"{loaded.name}: {arguments.agents} robots, loss {arguments.loss}, kill {kill}")
     print(
-        f"execution bound: {bound_ticks / plan.makespan():.2f} times the plan's ticks x cell time"
-        f" ({following_ticks / plan.makespan():.2f} with bodies turning in no time: following alone)"
+        f"{'body':>7} {'scale':>5} {'arrived':>8} {'coll':>4} {'wall s':>7} {'plan s':>7} {'ratio':>6} {'bound s':>7}"
+        f" {'/bound':>6} {'moves':>6} {'turns':>6} {'messages':>9} {'msg/move':>8}  stop"
     )
-    print(
-        f"{'scale':>5} {'arrived':>8} {'coll':>4} {'wall s':>7} {'plan s':>7} {'ratio':>6} {'bound s':>7} {'/bound':>6}"
-        f" {'moves':>6}"
-        f" {'messages':>9} {'msg/move':>8}  stop"
-    )
-    for scale in [float(text) for text in arguments.time_scales.split(",")]:
-        folder = Path(tempfile.mkdtemp(prefix=f"mrmp-bench-plan-{arguments.agents}-"))
-        options = LiveOptions(results=folder, time_scale=scale, plan=plan, faults=LiveFaults(loss=arguments.loss), kill=kill)
-        result = run_live(scenario, options)
-        arrived = sum(robot.arrived for robot in result.robots)
-        moves = max(1, result.network.get("moves", 0))
-        planned = plan.makespan() * scenario.timing.cell_time / scale
-        bound = execution_seconds(plan.paths, headings, scenario.timing, scale)
-        print(
-            f"{scale:>5g} {arrived:>4}/{len(result.robots):<3} {len(result.collisions):>4} {result.time_makespan_s:>7.2f}"
-            f" {planned:>7.2f} {result.time_makespan_s / planned:>6.2f} {bound:>7.2f} {result.time_makespan_s / bound:>6.2f}"
-            f" {moves:>6} {result.messages:>9}"
-            f" {result.messages / moves:>8.1f}  {result.stop_reason}",
-            flush=True,
-        )
+    for name in bodies:
+        scenario = loaded.with_changes(policy=replace(loaded.policy, body=PLANNED_BODY[name]))
+        plan = plan_with("lacam", scenario, time_limit_s=60)
+        if plan.paths is None:
+            print(f"{name:>7} lacam: no plan ({plan.status}: {plan.message})")
+            continue
+        _say_bounds(name, scenario, plan)
+        for scale in [float(text) for text in arguments.time_scales.split(",")]:
+            _run(name, scenario, plan, scale, arguments.loss, kill)
     return 0
+
+
+def _bound(name: str, scenario: Scenario, plan: PlanningResult, scale: float, turn_time: float | None = None) -> float:
+    """The live execution bound of ``plan`` driven by ``name`` bodies (module docstring), in seconds at ``scale``."""
+    assert plan.paths is not None
+    headings = [robot.heading for robot in scenario.robots]
+    timing = scenario.timing if turn_time is None else replace(scenario.timing, turn_time=turn_time)
+    if name == "thesis":
+        return execution_seconds(plan.paths, headings, timing, scale)
+    return execution_seconds(plan.paths, headings, timing, scale, body=body_model(name), follows=False)
+
+
+def _say_bounds(name: str, scenario: Scenario, plan: PlanningResult) -> None:
+    """Print the plan's makespan and its live execution bound as a multiple of its ticks times the cell time."""
+    ticks = plan.makespan() * scenario.timing.cell_time
+    line = f"{name:>7}: {PLANNED_BODY[name]} plan, makespan {plan.makespan()} ticks; live execution bound"
+    line += f" {_bound(name, scenario, plan, 1.0) / ticks:.2f} times its ticks x cell time"
+    if name == "thesis":
+        line += f" ({_bound(name, scenario, plan, 1.0, turn_time=0.0) / ticks:.2f} with bodies turning in no time)"
+    print(line)
+
+
+def _run(name: str, scenario: Scenario, plan: PlanningResult, scale: float, loss: float, kill: dict[str, float]) -> None:
+    """Execute ``plan`` live at ``scale`` and print its row."""
+    folder = Path(tempfile.mkdtemp(prefix=f"mrmp-bench-plan-{len(scenario.robots)}-"))
+    options = LiveOptions(results=folder, time_scale=scale, plan=plan, faults=LiveFaults(loss=loss), kill=kill)
+    result = run_live(scenario, options)
+    arrived = sum(robot.arrived for robot in result.robots)
+    moves = max(1, result.network.get("moves", 0))
+    turns = sum(robot.turns for robot in result.robots) if name == "turning" else 0
+    planned = plan.makespan() * scenario.timing.cell_time / scale
+    bound = _bound(name, scenario, plan, scale)
+    print(
+        f"{name:>7} {scale:>5g} {arrived:>4}/{len(result.robots):<3} {len(result.collisions):>4}"
+        f" {result.time_makespan_s:>7.2f} {planned:>7.2f} {result.time_makespan_s / planned:>6.2f} {bound:>7.2f}"
+        f" {result.time_makespan_s / bound:>6.2f} {moves:>6} {turns:>6} {result.messages:>9}"
+        f" {result.messages / moves:>8.1f}  {result.stop_reason}",
+        flush=True,
+    )
 
 
 if __name__ == "__main__":

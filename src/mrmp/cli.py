@@ -442,12 +442,16 @@ def print_result(result: RunResult, console: Console) -> None:
         rejected = _counts(network, "rejected_")
         injected = _counts(network, "injected_")
         moves = sum(robot.steps for robot in result.robots)
+        if body_model(result.body).turns_in_place:  # its lower bound counts the quarter turns too
+            moves_said = f"moves {moves} and quarter turns {sum(robot.turns for robot in result.robots)}"
+        else:
+            moves_said = f"moves {moves}"
         arrivals = sum(robot.time_s for robot in result.robots if robot.arrived)
         console.print(
             f"{verdict} ({result.stop_reason}): wall-clock makespan {result.time_makespan_s:.2f} s "
             f"(ideal {result.ideal_makespan_s or 0:.2f} s: the longest single-robot path at this speed), "
             f"sum of arrival times {arrivals:.2f} s, "
-            f"moves {moves} (lower bound {result.lower_bound}), collisions: {len(result.collisions)}, "
+            f"{moves_said} (lower bound {result.lower_bound}), collisions: {len(result.collisions)}, "
             f"messages {result.messages}, wall time {result.wall_time_s:.1f} s"
         )
         console.print(f"  dropped by robots: {rejected}; injected faults: {injected}", markup=False)
@@ -1080,12 +1084,15 @@ def agent(
         entry = policy_entry(scenario.policy.name)
         if entry.live_driver is None:
             raise InputError(Problem("--policy", f"{entry.name} {entry.not_live}"))
-        body_issue = body_problem(scenario, live=True)
+        body_issue = body_problem(scenario, live=True, planned=plan is not None)
         if body_issue is not None:
             raise InputError(body_issue)
         domain = _ros2_domain() if ros2 else None
         if drive not in ("simulated", "ros2"):
             raise InputError(Problem("--drive", f"must be simulated or ros2, got {drive!r}"))
+        if drive == "ros2" and body_model(scenario.policy.body).turns_in_place:
+            reason = f"drives the thesis's line-counting body, which does not turn in place ({scenario.policy.body} bodies)"
+            raise InputError(Problem("--drive", reason))
         drive_domain = _ros2_domain("--drive") if drive == "ros2" else 0
         ids = [spec.id for spec in scenario.robots]
         if robot not in ids:

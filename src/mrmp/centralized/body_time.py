@@ -33,6 +33,13 @@ against.
   Following counts from the leader's start, as for ``omni``; a rotation cannot
   be carried out (no robot of it may start first).
 
+With ``follows=False`` a body that may follow is timed as live bodies drive
+it: the live safety layer hands a cell over once its occupant has *arrived*
+elsewhere (a live body covers both cells while it moves), so a robot enters
+a cell only then, as for ``thesis``; a ``turning`` body turns toward its next
+cell while it waits (:meth:`~mrmp.robot.robot.Robot.turn`), so its quarter
+turns overlap the wait.
+
 For a plan the body can carry out tick by tick (every move legal for it under
 :class:`~mrmp.sim.referee.Referee`), an action of tick ``t`` can start by
 ``t - 1`` cell times, so for ``omni`` and ``turning`` the bound is at most the
@@ -69,6 +76,15 @@ second a cell), a following body when the first starts:
 1.0
 >>> execution_seconds(train, [Heading.NORTH, Heading.NORTH], timing, time_scale=2.0, body=body_model("turning"))
 0.5
+>>> execution_seconds(train, [Heading.NORTH, Heading.NORTH], timing, time_scale=2.0, body=body_model("turning"), follows=False)
+1.0
+
+Live, a ``turning`` robot turns while it waits: the second robot turns toward
+the cell the first leaves, then enters it once the first has arrived:
+
+>>> corner = [[(1, 0), (2, 0)], [(1, 1), (1, 0)]]
+>>> execution_seconds(corner, [Heading.NORTH, Heading.NORTH], timing, body=body_model("turning"), follows=False)
+2.0
 """
 
 from __future__ import annotations
@@ -93,6 +109,8 @@ def execution_seconds(
     time_scale: float = 1.0,
     body: BodyModel | None = None,
     heading_paths: Sequence[Sequence[Heading]] | None = None,
+    *,
+    follows: bool | None = None,
 ) -> float:
     """The soonest (seconds) bodies starting with ``headings`` end ``paths`` (module docstring).
 
@@ -102,6 +120,9 @@ def execution_seconds(
     robot's heading at every tick (tick 0 first, its start heading; a robot
     keeps its last heading once its list ends); only a ``turning`` body reads
     it, counting every quarter turn it shows, in place or before a move.
+    ``follows`` overrides the body's following rule: False times the body
+    as live fleets drive it (module docstring; its turns are then derived
+    from the cell paths).
 
     Raises
     ------
@@ -113,25 +134,37 @@ def execution_seconds(
         heading in ``headings``.
     """
     cell_seconds = timing.cell_time / time_scale
-    if body is None or not body.follows:
+    if body is None:
         return _arrival_seconds(paths, headings, cell_seconds, timing.turn_time / time_scale)
     quarter_seconds = body.turn_ticks(timing.turn_time, timing.cell_time) * cell_seconds
+    if not (body.follows if follows is None else follows):
+        return _arrival_seconds(paths, headings, cell_seconds, quarter_seconds, body)
     return _following_seconds(paths, headings, heading_paths, body, cell_seconds, quarter_seconds)
 
 
 def _arrival_seconds(
-    paths: Sequence[Sequence[Cell]], headings: Sequence[Heading], cell_seconds: float, turn_seconds: float
+    paths: Sequence[Sequence[Cell]],
+    headings: Sequence[Heading],
+    cell_seconds: float,
+    turn_seconds: float,
+    body: BodyModel | None = None,
 ) -> float:
-    """The ``thesis`` bound: right turns and a cell per move, a cell entered once its occupant has arrived elsewhere."""
+    """The bound without following: a cell entered once its occupant has arrived elsewhere.
+
+    Without ``body`` (``thesis``) a move is its right turns and a cell, the
+    turns made once the move may start; a body that turns in place turns
+    toward its next cell while it waits (its fewest quarter turns either way).
+    """
     moves, dependencies = action_dependencies(paths)
     durations = [
-        _move_seconds(path[0], robot_moves, heading, cell_seconds, turn_seconds)
+        _move_seconds(path[0], robot_moves, heading, cell_seconds, turn_seconds, body)
         for path, robot_moves, heading in zip(paths, moves, headings)
     ]
+    turns_while_waiting = body is not None and body.turns_in_place
     ends: dict[tuple[int, int], float] = {}
     for robot, robot_moves in enumerate(moves):
         for move in range(len(robot_moves)):
-            _end(robot, move, dependencies, durations, ends)
+            _end(robot, move, dependencies, durations, ends, turns_while_waiting)
     return max(ends.values(), default=0.0)
 
 
@@ -231,12 +264,15 @@ def _quarter_turns(
     return before, pending
 
 
-def _move_seconds(start: Cell, moves: Sequence[Cell], heading: Heading, cell_seconds: float, turn_seconds: float) -> list[float]:
-    """How long each of a robot's moves lasts: its right turns, then one cell."""
+def _move_seconds(
+    start: Cell, moves: Sequence[Cell], heading: Heading, cell_seconds: float, turn_seconds: float, body: BodyModel | None
+) -> list[tuple[float, float]]:
+    """How long each of a robot's moves turns (right turns, or the body's quarter turns) and then drives one cell."""
     durations, here = [], start
     for cell in moves:
         direction = Heading.between(here, cell)
-        durations.append(right_turns(heading, direction) * turn_seconds + cell_seconds)
+        turns = right_turns(heading, direction) if body is None else body.quarter_turns(heading, direction)
+        durations.append((turns * turn_seconds, cell_seconds))
         heading, here = direction, cell
     return durations
 
@@ -245,10 +281,15 @@ def _end(
     robot: int,
     move: int,
     dependencies: Sequence[dict[int, list[tuple[int, int]]]],
-    durations: Sequence[Sequence[float]],
+    durations: Sequence[Sequence[tuple[float, float]]],
     ends: dict[tuple[int, int], float],
+    turns_while_waiting: bool = False,
 ) -> float:
     """When move ``move`` of ``robot`` ends: after its own previous move and every move it waits for.
+
+    A move turns, then drives (``durations``: seconds of each); its turns start
+    after the robot's previous move, and after the moves it waits for unless
+    ``turns_while_waiting``.
 
     Iterative (a chain of robots following one another is as long as the fleet), over a graph
     that :func:`~mrmp.centralized.dependencies.action_dependencies` has checked acyclic.
@@ -260,14 +301,18 @@ def _end(
             stack.pop()
             continue
         who, index = current
-        needed = [(other, progress - 1) for other, progress in dependencies[who].get(index, ()) if progress > 0]
-        if index > 0:
-            needed.append((who, index - 1))
-        missing = [item for item in needed if item not in ends]
+        waited = [(other, progress - 1) for other, progress in dependencies[who].get(index, ()) if progress > 0]
+        own = [(who, index - 1)] if index > 0 else []
+        missing = [item for item in (*waited, *own) if item not in ends]
         if missing:
             stack.extend(missing)
             continue
         stack.pop()
-        ready = max((ends[item] for item in needed), default=0.0)
-        ends[current] = ready + durations[who][index]
+        turn, drive = durations[who][index]
+        others = max((ends[item] for item in waited), default=0.0)
+        mine = max((ends[item] for item in own), default=0.0)
+        if turns_while_waiting:
+            ends[current] = max(others, mine + turn) + drive
+        else:
+            ends[current] = max(others, mine) + turn + drive
     return ends[robot, move]

@@ -125,6 +125,19 @@ class BodyModel:
             raise ValueError(f"body {self.name} cannot turn {quarter:+d} quarter in place")
         return Heading((int(facing) - 1 + quarter) % 4 + 1)
 
+    def first_turn(self, facing: Heading, wanted: Heading) -> Heading | None:
+        """The heading after the first in-place quarter turn from ``facing`` toward ``wanted``: the shorter
+        way, clockwise for a half turn; None when it already faces it or does not turn in place.
+
+        >>> [body_model("turning").first_turn(Heading.NORTH, wanted) for wanted in Heading]
+        [None, <Heading.EAST: 2>, <Heading.EAST: 2>, <Heading.WEST: 4>]
+        >>> body_model("thesis").first_turn(Heading.NORTH, Heading.EAST) is None
+        True
+        """
+        if not self.turns_in_place or facing == wanted:
+            return None
+        return self.turned(facing, 1 if right_turns(facing, wanted) <= 2 else -1)
+
     def turns(self, facing: Heading) -> tuple[Heading, ...]:
         """The headings one in-place quarter turn reaches from ``facing`` (clockwise first; none without such turns).
 

@@ -20,6 +20,12 @@ clock:
   (:mod:`mrmp.live.driver`; a policy without an interaction radius, every time);
 * run the safety layer's timers (resend or abandon a claim).
 
+A robot whose body turns in place (``policy.body: turning``) turns a quarter
+toward a neighbour it does not face as an action of its own
+(:meth:`~mrmp.robot.robot.Robot.turn`, on a body with
+:class:`~mrmp.live.body.TurnsInPlace`), and announces its new heading when the
+turn ends; it claims and enters only the cell ahead.
+
 A robot whose policy reads no peer's cells (interaction radius 0: a robot
 following a plan, which waits only for its peers' progress) has nothing to
 listen for: it decides at once after announcing, and the pause after a decision
@@ -45,9 +51,11 @@ import time
 from collections.abc import Callable
 from enum import Enum
 
+from mrmp.core.body import body_model
 from mrmp.core.cell import Cell
+from mrmp.core.errors import MrmpError
 from mrmp.core.scenario import Scenario
-from mrmp.live.body import Body
+from mrmp.live.body import Body, TurnsInPlace
 from mrmp.live.driver import AgentReport, AgentTiming, LiveDriver, believed_near, live_state_radius
 from mrmp.live.transport import Transport
 from mrmp.policies.base import Policy, interaction_radius
@@ -112,7 +120,9 @@ class Agent(LiveDriver):
             retry_interval=timing.claim_retry,
             silence_timeout=timing.silence_timeout,
             state_radius=None if radius is None else live_state_radius(radius),
+            body=body_model(scenario.policy.body),
         )
+        self._turning = False  # the body's action in progress is a turn in place, not a move
         self._phase = Phase.LISTEN
         self._next_decision = 0.0
         self._decided_at = 0.0
@@ -199,14 +209,35 @@ class Agent(LiveDriver):
             due = -math.inf  # the claim is over: the next turn pauses
         return due
 
+    def _start_turn(self, now: float) -> bool:
+        """Start the quarter turn in place the robot decided, if any (module docstring); whether one started.
+
+        Raises
+        ------
+        MrmpError
+            If the robot turns in place and its body cannot.
+        """
+        heading = self.robot.turn(now)
+        if heading is None:
+            return False
+        if not isinstance(self.body, TurnsInPlace):
+            raise MrmpError(f"robot {self.robot.id}: its body cannot turn in place (policy.body {self.robot.body.name})")
+        self.body.start_turn(heading, now)
+        self._turning = True
+        return True
+
     def _step(self, now: float, started: float) -> bool:
         """Announce, listen, decide (and claim), move, or pause (module docstring)."""
         robot, body, timing, report = self.robot, self.body, self.timing, self.report
         sent_state = False
         if body.moving:
             if body.poll(now):
-                robot.arrived_at(body.cell, body.heading)
-                self._record_move(now, started, robot.arrived)
+                if self._turning:
+                    self._turning = False
+                    robot.turned(body.heading)
+                else:
+                    robot.arrived_at(body.cell, body.heading)
+                    self._record_move(now, started, robot.arrived)
                 self._send(robot.announce(now))
                 self._said, self._said_at = (robot.present, robot.intended, robot.heading, robot.arrived, robot.progress), now
                 sent_state = True
@@ -219,6 +250,8 @@ class Agent(LiveDriver):
             if target is not None:
                 body.start_move(target, now)
                 report.decision_latency.append(now - self._decided_at)
+                self._phase = Phase.MOVING
+            elif self._start_turn(now):
                 self._phase = Phase.MOVING
             elif robot.wanted is None and robot.safety.pending is None:
                 pause = timing.heartbeat if robot.arrived else timing.listen_time * (1 + self.random.random())

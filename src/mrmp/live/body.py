@@ -12,7 +12,11 @@ the driver can sleep until then instead of polling.
   right turn, divided by a time scale, with optional jitter (robots running at
   different, varying speeds) and an optional probability of missing a grid
   line, after which the body overshoots one cell and the robot's belief of its
-  position lags the truth: position errors to be studied.
+  position lags the truth: position errors to be studied. Given a body model
+  that turns in place (``turning``, LoRR's ``MAPF_T``: :mod:`mrmp.core.body`)
+  it is that body instead: it drives only to the cell ahead, and turns a
+  quarter either way in place (:meth:`SimulatedBody.start_turn`), each action
+  one cell time.
 * :class:`LineCountingBody` is the body of a real robot: it drives a
   :class:`KheperaDriver` (two motor speeds and a floor line sensor) and counts
   line crossings. A real Khepera III driver implements :class:`KheperaDriver`.
@@ -28,8 +32,9 @@ import math
 import random
 from collections.abc import Callable
 from dataclasses import dataclass
-from typing import Protocol
+from typing import Protocol, runtime_checkable
 
+from mrmp.core.body import BodyModel
 from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
 from mrmp.core.heading import Heading, right_turns
@@ -53,6 +58,15 @@ class OccupancyRecorder:
         self.events.append((event, cell, t))
         if self.sink is not None:
             self.sink(event, cell, t)
+
+
+@runtime_checkable
+class TurnsInPlace(Protocol):
+    """A body that also turns a quarter in place, as an action of its own (a ``turning`` body)."""
+
+    def start_turn(self, heading: Heading, now: float) -> None:
+        """Turn in place to ``heading``, a quarter turn away; ``poll`` then reports its end as a move's."""
+        ...
 
 
 class Body(Protocol):
@@ -110,6 +124,23 @@ class SimulatedBody:
         Random generator of this body.
     recorder:
         Where ground truth goes.
+    model:
+        The body model (:mod:`mrmp.core.body`): None or ``thesis``, the
+        Khepera III (right turns, then the cell); a model that turns in place
+        drives only to the cell ahead and turns with :meth:`start_turn`, a
+        quarter turn lasting one cell time.
+
+    Examples
+    --------
+    >>> from mrmp.core.body import body_model
+    >>> body = SimulatedBody((0, 0), Heading.NORTH, Grid(3, 3), Timing(cell_time=1.0), model=body_model("turning"))
+    >>> body.start_turn(Heading.WEST, now=0.0)   # a quarter counter-clockwise, one cell time
+    >>> body.poll(0.5), body.poll(1.0), body.heading.name, body.cell
+    (False, True, 'WEST', (0, 0))
+    >>> body.start_move((1, 0), now=1.0)
+    Traceback (most recent call last):
+    ...
+    ValueError: a turning body drives only to the cell ahead: it faces WEST, not NORTH toward (1, 0)
     """
 
     def __init__(
@@ -123,6 +154,7 @@ class SimulatedBody:
         miss_line: float = 0.0,
         rng: random.Random | None = None,
         recorder: OccupancyRecorder | None = None,
+        model: BodyModel | None = None,
     ) -> None:
         self.cell = start
         self.true_cell = start
@@ -138,16 +170,52 @@ class SimulatedBody:
         self.turns = 0
         self.missed_lines = 0
         self.bumps = 0
+        self.model = model
         self._segments: list[_Segment] = []
         self._target: Cell = start
 
+    def _scale(self) -> float:
+        """Seconds of this action per second of the timing: the time scale, and this action's jitter."""
+        factor = 1.0 + (self.random.uniform(-self.jitter, self.jitter) if self.jitter else 0.0)
+        return factor / self.time_scale
+
+    def start_turn(self, heading: Heading, now: float) -> None:
+        """Turn a quarter in place to ``heading`` (a body model that turns in place), in one cell time.
+
+        Raises
+        ------
+        ValueError
+            If the body does not turn in place, or ``heading`` is not a quarter turn away.
+        """
+        model = self.model
+        if model is None or heading not in model.turns(self.heading):
+            name = "thesis" if model is None else model.name
+            raise ValueError(f"a {name} body cannot turn in place from {self.heading.name} to {heading.name}")
+        self.turns += 1
+        end = now + model.turn_ticks(self.timing.turn_time, self.timing.cell_time) * self.timing.cell_time * self._scale()
+        self._segments = [_Segment(self.true_cell, self.true_cell, now, end)]
+        self.heading = heading
+        self._target = self.cell
+        self.moving = True
+        self._entered = 0
+
     def start_move(self, target: Cell, now: float) -> None:
-        """Plan the turns and the drive into ``target``; record when each cell is entered."""
+        """Plan the turns and the drive into ``target``; record when each cell is entered.
+
+        Raises
+        ------
+        ValueError
+            For a body model that turns in place, if the body does not face ``target``.
+        """
         direction = Heading.between(self.cell, target)
+        if self.model is not None and self.model.turns_in_place and direction != self.heading:
+            raise ValueError(
+                f"a {self.model.name} body drives only to the cell ahead: it faces {self.heading.name},"
+                f" not {direction.name} toward {target}"
+            )
         turns = right_turns(self.heading, direction)
         self.turns += turns
-        factor = 1.0 + (self.random.uniform(-self.jitter, self.jitter) if self.jitter else 0.0)
-        scale = factor / self.time_scale
+        scale = self._scale()
         t = now + turns * self.timing.turn_time * scale
         source = self.true_cell
         first = direction.ahead(source)

@@ -29,13 +29,17 @@ near is addressed before it is within the interaction radius
 waits (at most ``start_wait`` seconds) until it has heard from every peer, so
 that a fleet whose processes start one by one begins together; its clock starts
 then. While it waits it sends its state every heartbeat to the peers it has not
-heard from, at once to a peer it hears from for the first time, and every fleet
-heartbeat to every peer. The run ends when this robot and every peer have arrived (and a short
-linger has passed so that late requests are still answered, at least a fleet
-heartbeat, so that a far peer that has left its goal again is heard of; the
-robot then sends its state to every peer), when every peer
-that has not arrived has been silent for ``give_up_after`` seconds, on timeout,
-or on a stop request.
+heard from, each with a :class:`~mrmp.protocol.messages.HelloMessage`, at once
+to a peer it hears from for the first time, and every fleet heartbeat to every
+peer. A robot answers every hello with its state, waiting or running: a
+waiting robot whose first answer from a peer was lost hears it at the next
+hello, not a fleet heartbeat later (with 48 robots that is 2.35 s, and one
+robot starting that late holds up every robot that waits for it). The run
+ends when this robot and every peer have arrived (and a short linger has
+passed so that late requests are still answered, at least a fleet heartbeat,
+so that a far peer that has left its goal again is heard of; the robot then
+sends its state to every peer), when every peer that has not arrived has been
+silent for ``give_up_after`` seconds, on timeout, or on a stop request.
 """
 
 from __future__ import annotations
@@ -56,7 +60,7 @@ from mrmp.live.body import Body
 from mrmp.live.client_thread import ClientThread
 from mrmp.live.transport import FaultyTransport, Transport
 from mrmp.protocol.auth import Opener, Sealer
-from mrmp.protocol.messages import Message
+from mrmp.protocol.messages import HelloMessage, Message
 from mrmp.robot.robot import Outgoing
 
 
@@ -203,6 +207,10 @@ class Brain(Protocol):
     """What the driver needs of a sans-IO robot brain (:class:`~mrmp.robot.robot.Robot`, ``CausalRobot``)."""
 
     dropped: Counter[str]
+
+    def next_seq(self) -> int:
+        """Its next sequence number (the driver stamps its hellos with it)."""
+        ...
 
     def receive(self, message: Message, now: float) -> list[Outgoing]:
         """Take in one decoded message; return the answers to send."""
@@ -369,10 +377,19 @@ class LiveDriver:
                 self._inbox.put(message)
 
     def _drain_inbox(self, now: float) -> None:
-        """Hand the brain every message the receiving thread queued, and send its answers."""
+        """Hand the brain every message the receiving thread queued, and send its answers; answer a hello with the
+        state (module docstring)."""
         for message in self._inbox.take():
             self.report.messages_received += 1
-            self._send(self.robot.receive(message, now))
+            if isinstance(message, HelloMessage):
+                self._send(self._fleet_wait_to((message.sender,)))
+            else:
+                self._send(self.robot.receive(message, now))
+
+    def _hellos_to(self, peers: tuple[int, ...]) -> list[Outgoing]:
+        """The fleet-wait state addressed to ``peers``, and a hello asking each for its state."""
+        states = self._fleet_wait_to(peers)
+        return [*states, Outgoing(HelloMessage(self.index, self.robot.next_seq()), peers)]
 
     def _sleep(self, until: float, timers: bool = True) -> None:
         """Sleep until the clock reads ``until`` (or a stop is requested), waking for the brain's timers.
@@ -490,11 +507,12 @@ class LiveDriver:
     def _wait_for_fleet(self) -> None:
         """Send the state, and answer, until every peer has been heard (or ``start_wait`` passes).
 
-        The state goes every heartbeat to the peers not heard from yet, at once
-        to a peer heard from for the first time (it is up: now it hears this
-        robot too), and every fleet heartbeat to every peer (in case that answer
-        was lost): a fleet whose processes start one by one does not flood the
-        robots already up with a state from each of them every heartbeat.
+        The state goes every heartbeat to the peers not heard from yet, with a
+        hello that each answers with its state (its answer to this robot's first
+        state may have been lost), at once to a peer heard from for the first
+        time (it is up: now it hears this robot too), and every fleet heartbeat
+        to every peer: a fleet whose processes start one by one does not flood
+        the robots already up with a state from each of them every heartbeat.
         """
         clock = self.clock
         deadline = clock() + self.timing.start_wait
@@ -512,7 +530,7 @@ class LiveDriver:
                 self._send(fleet_wide(self._fleet_wait_messages()))
                 last_state = last_fleet_state = now
             elif now - last_state >= self.timing.heartbeat and unheard:
-                self._send(self._fleet_wait_to(unheard))
+                self._send(self._hellos_to(unheard))
                 last_state = now
             next_state = min(last_state + self.timing.heartbeat, last_fleet_state + self.timing.fleet_heartbeat)
             self._sleep(min(next_state, deadline), timers=False)  # no brain timers run before the start

@@ -128,7 +128,7 @@ def run_live(
     """
     ids = [robot.id for robot in scenario.robots]
     _check(options, ids)
-    body_issue = body_problem(scenario, live=True)
+    body_issue = body_problem(scenario, live=True, planned=options.plan is not None)
     if body_issue is not None:
         raise InputError(body_issue)
     files = _write_run_files(scenario, options, ids)

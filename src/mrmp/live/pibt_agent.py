@@ -427,9 +427,13 @@ class PibtBrain:
         self.dropped["other_type"] += 1
         return []
 
+    def next_seq(self) -> int:
+        """The next number of the robot's sequence (every message it sends has a fresh one)."""
+        return self.robot._seq()
+
     def _stamp(self, message: M) -> M:
         """``message`` numbered in the robot's sequence (the safety layer leaves it 0)."""
-        return dataclasses.replace(message, seq=self.robot._seq())  # type: ignore[type-var]
+        return dataclasses.replace(message, seq=self.next_seq())  # type: ignore[type-var]
 
     def _stamped(self, sends: list[tuple[Message, tuple[int, ...]]]) -> list[Outgoing]:
         return [Outgoing(self._stamp(message), recipients) for message, recipients in sends]

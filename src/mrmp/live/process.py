@@ -19,6 +19,7 @@ from collections.abc import Callable, Iterator, Mapping
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
+from mrmp.core.body import body_model
 from mrmp.core.cell import Cell
 from mrmp.core.errors import InputError, Problem
 from mrmp.core.scenario import Scenario
@@ -276,6 +277,7 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
                 miss_line=options.miss_line,
                 rng=stream_random(options.seed, Stream.BODY, index),
                 recorder=OccupancyRecorder(sink),
+                model=body_model(scenario.policy.body),
             )
         sealer = Sealer(options.key, options.session)
         opener = Opener(options.key, options.session, fleet_size=len(scenario.robots))

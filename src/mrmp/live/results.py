@@ -15,6 +15,7 @@ from collections import Counter
 from collections.abc import Mapping, Sequence
 from typing import Any
 
+from mrmp.core.body import body_model
 from mrmp.core.cell import Cell
 from mrmp.core.errors import NoPathError
 from mrmp.core.heading import Heading
@@ -25,7 +26,19 @@ from mrmp.sim.metrics import shortest_steps
 
 
 def ideal_makespan(scenario: Scenario, time_scale: float) -> float:
-    """The longest single-robot path time (turns included) at the run's speed, in seconds."""
+    """The longest single-robot path time (turns included) at the run's speed, in seconds.
+
+    For bodies that turn in place (``turning``), the most ticks any robot needs
+    alone (:func:`~mrmp.sim.metrics.shortest_steps`: moves and quarter turns),
+    a cell time each; otherwise the thesis's body (right turns, then a cell).
+
+    >>> from mrmp.core import Grid, PolicyOptions, RobotSpec, Timing
+    >>> alone = Scenario(Grid(3, 3), (RobotSpec("A", (0, 0), (0, 2), heading=Heading.NORTH),), timing=Timing(1.0, 0.5))
+    >>> ideal_makespan(alone, 1.0), ideal_makespan(alone.with_changes(policy=PolicyOptions(body="turning")), 2.0)
+    (2.5, 1.5)
+    """
+    if body_model(scenario.policy.body).turns_in_place:
+        return max(shortest_steps(scenario), default=0) * scenario.timing.cell_time / time_scale
     longest = 0.0
     for robot in scenario.robots:
         try:
@@ -136,4 +149,5 @@ def live_result(
         mode="live",
         tick_seconds=tick_seconds,
         ideal_makespan_s=ideal_makespan(scenario, time_scale),
+        body=scenario.policy.body,
     )

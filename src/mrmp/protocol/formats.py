@@ -22,6 +22,7 @@ Bodies follow the 10-byte header; cells are two signed 32-bit integers::
    13 release        claim (u32), cell                                                  22 bytes in all
    14 release ack    owner (u32), claim (u32), cell                                     26 bytes in all
    15 handoff        claim (u32), cell                                                  22 bytes in all
+   17 hello          (no body)                                                          10 bytes in all
 
 A cell a message does not have (a state's target or claim cell, a grant's
 head) is :data:`~mrmp.protocol.messages.NO_CELL` on the wire, and a flag says
@@ -29,8 +30,8 @@ whether it is there, so that every accepted datagram is exactly one encoding.
 
 Examples
 --------
->>> STATE.size, CLAIM.size, LOCK_GRANT.size, RELEASE.size, RELEASE_ACK.size, HANDOFF.size
-(52, 22, 45, 22, 26, 22)
+>>> STATE.size, CLAIM.size, LOCK_GRANT.size, RELEASE.size, RELEASE_ACK.size, HANDOFF.size, HELLO.size
+(52, 22, 45, 22, 26, 22, 10)
 """
 
 from __future__ import annotations
@@ -46,6 +47,7 @@ from mrmp.protocol.messages import (
     BeaconMessage,
     ClaimMessage,
     HandoffMessage,
+    HelloMessage,
     InheritMessage,
     LockAckMessage,
     LockGrantMessage,
@@ -254,3 +256,4 @@ def _unpack_handoff(sender: int, seq: int, fields: Fields, _: tuple[Cell, ...]) 
 
 
 HANDOFF = register(WireFormat(15, HandoffMessage, "!Iii", lambda m: (m.claim, *m.cell), _unpack_handoff))
+HELLO = register(WireFormat(17, HelloMessage, "!", lambda m: (), lambda sender, seq, fields, _: HelloMessage(sender, seq)))

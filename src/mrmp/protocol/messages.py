@@ -12,7 +12,8 @@ current claim; see ``docs/protocol.md``).
 :class:`ClaimMessage` and :class:`ReplyMessage` are the safety protocol's
 request for a cell and its answer, :class:`ReleaseMessage` and
 :class:`ReleaseAckMessage` its release of a cell and the acknowledgement, :class:`HandoffMessage`
-a robot's commitment to leave its cell in the current tick (the lockstep model's following). :class:`BeaconMessage`,
+a robot's commitment to leave its cell in the current tick (the lockstep model's following).
+:class:`HelloMessage` asks a peer for its state while a live robot waits for its fleet to start. :class:`BeaconMessage`,
 :class:`InheritMessage`, :class:`AnswerMessage`, :class:`ReserveMessage` and
 :class:`PullMessage` carry decentralized PIBT (:mod:`mrmp.robot.pibt_robot`), and
 :class:`StayMessage` too for bodies that turn in place.
@@ -170,6 +171,15 @@ class HandoffMessage(Message):
     seq: int
     claim: int
     cell: Cell
+
+
+@dataclass(frozen=True, slots=True)
+class HelloMessage(Message):
+    """A live robot waiting for its fleet before its first step: it has not heard the recipient yet, which answers
+    with its state (:mod:`mrmp.live.driver`). Sent beside the waiting robot's own state; no brain sees it."""
+
+    sender: int
+    seq: int
 
 
 @dataclass(frozen=True, slots=True)

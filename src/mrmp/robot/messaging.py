@@ -114,10 +114,14 @@ class MessageEndpoint:
     dropped: Counter[str]
     safety: SafetyLayer
 
+    def next_seq(self) -> int:
+        """This robot's next sequence number (every message it sends has a fresh one: the receivers' replay window)."""
+        self.seq += 1
+        return self.seq
+
     def _stamp(self, message: M) -> M:
         """``message`` with this robot's next sequence number."""
-        self.seq += 1
-        return message.with_seq(self.seq)
+        return message.with_seq(self.next_seq())
 
     def _stamped(self, sends: Iterable[tuple[Message, tuple[int, ...]]]) -> list[Outgoing]:
         """The safety layer's ``(message, recipients)`` pairs, each message with this robot's next sequence number."""

@@ -28,6 +28,19 @@ One step, as in the thesis (sections 3.5-3.6), with the safety layer:
 With ``guarded=False`` step 4 allows whatever step 3 decided, reproducing the
 thesis as written.
 
+**Bodies that turn in place** (``body`` ``turning``, LoRR's ``MAPF_T``:
+:mod:`mrmp.core.body`) drive only to the cell ahead. Such a robot whose chosen
+cell, or, when it stays, whose Next, is a neighbour it does not face turns a
+quarter toward it first (:meth:`Robot.turn`, one action of its own; the body
+reports its end with :meth:`Robot.turned`). A turn keeps the robot on its cell,
+so it needs nobody's leave: a robot waiting for its peers turns toward its next
+cell meanwhile. A robot that chose to move claims the cell as it starts turning
+(the claim's round trip overlaps the turn) and enters it only once it faces it,
+except under the safety layer's lockstep rule (``following``): there a granted
+claim commits the robot to leave its cell within the tick, handing it to a
+follower, so the robot claims only once it faces the cell (claiming while it
+turns, a follower would drive into it: ``docs/protocol.md``, "Body models").
+
 Examples
 --------
 >>> from mrmp.core import Grid, RobotSpec
@@ -47,6 +60,7 @@ from collections import Counter
 from collections.abc import Sequence
 from dataclasses import replace
 
+from mrmp.core.body import DEFAULT_BODY, BodyModel, body_model
 from mrmp.core.cell import Cell, manhattan
 from mrmp.core.grid import Grid
 from mrmp.core.heading import Heading
@@ -131,6 +145,10 @@ class Robot(MessageEndpoint):
         lockstep rule a refused claim then *stands* while the policy keeps
         choosing its cell (:class:`~mrmp.protocol.safety.SafetyLayer`,
         ``keep_refused``), instead of being sent again every step.
+    body:
+        Its body model (:mod:`mrmp.core.body`; default ``omni``). A body that
+        turns in place turns toward a neighbour it does not face before
+        claiming it (module docstring); other bodies move to any neighbour.
     """
 
     def __init__(
@@ -149,6 +167,7 @@ class Robot(MessageEndpoint):
         following: bool = False,
         state_refresh: int | None = None,
         lossy: bool = True,
+        body: BodyModel | None = None,
     ) -> None:
         if state_refresh is not None and (state_refresh < 1 or state_radius is None or knowledge_lease is None):
             raise ValueError("a state refresh needs a positive period, a state radius and a knowledge lease")
@@ -166,8 +185,11 @@ class Robot(MessageEndpoint):
         self.guarded = guarded
         self.present: Cell = spec.start
         self.heading: Heading = spec.heading
+        self.body = body if body is not None else body_model(DEFAULT_BODY)
         self.intended: Cell = spec.start
         self.wanted: Cell | None = None
+        self.turn_wanted: Heading | None = None
+        """The heading of the quarter turn decided this step (a body that turns in place), until the body starts it."""
         self.moving = False
         self.belief = Belief()
         self._heard_since: set[int] = set()
@@ -311,6 +333,9 @@ class Robot(MessageEndpoint):
         self.last_decision = decision
         self._heard_since_decision.clear()
         self.wanted = decision.next if decision.next != self.present else None
+        self.turn_wanted = self._turn_toward(self.wanted if self.wanted is not None else self.intended)
+        if self.turn_wanted is not None and not self._claims_while_turning():
+            self.wanted = None  # it claims once it faces the cell
         if standing is not None and self.wanted == standing.cell:
             return []  # the claim refused earlier stands: its replicas grant it when its cell is handed off or released
         sends: list[Outgoing] = []
@@ -390,11 +415,57 @@ class Robot(MessageEndpoint):
         """Whether the robot stays this tick: not moving, no cell wanted, no claim pending."""
         return not self.moving and self.wanted is None and self.safety.pending is None
 
+    def _turn_toward(self, cell: Cell) -> Heading | None:
+        """The quarter turn a body that turns in place makes toward the neighbour ``cell`` it does not face, if any."""
+        if not self.body.turns_in_place or manhattan(cell, self.present) != 1:
+            return None
+        return self.body.first_turn(self.heading, Heading.between(self.present, cell))
+
+    def _faces(self, cell: Cell) -> bool:
+        """Whether the body may drive into the neighbour ``cell`` as it stands: any body but one that turns in place,
+        which must face it."""
+        return not self.body.turns_in_place or Heading.between(self.present, cell) == self.heading
+
+    def _claims_while_turning(self) -> bool:
+        """Whether a robot that turns toward the cell it chose claims it at once (module docstring): not under the
+        safety layer's lockstep rule, where a granted claim hands the robot's own cell to a follower within the tick."""
+        return not self.safety.following
+
+    def turn(self, now: float) -> Heading | None:
+        """The heading the body may start turning to now (a quarter turn in place), if any; the robot then counts as moving.
+
+        >>> from mrmp.core import Grid, RobotSpec
+        >>> from mrmp.policies.astar import AstarPolicy
+        >>> spec = RobotSpec("A", (0, 0), (0, 2), heading=Heading.NORTH)
+        >>> robot = Robot(spec, 0, Grid(1, 3), AstarPolicy(), [(0, 0)], body=body_model("turning"))
+        >>> _ = robot.announce(now=1); robot.decide(now=1)[0].message.cell   # east: claimed, a quarter turn away
+        (0, 1)
+        >>> robot.motion(now=1), robot.turn(now=1)
+        (None, <Heading.EAST: 2>)
+        >>> robot.turned(Heading.EAST); robot.motion(now=2)
+        (0, 1)
+        """
+        heading = self.turn_wanted
+        if heading is None and self.wanted is not None:
+            heading = self._turn_toward(self.wanted)  # the second quarter of a half turn toward the cell it claimed
+        if self.moving or heading is None:
+            return None
+        self.turn_wanted = None
+        self.moving = True
+        return heading
+
+    def turned(self, heading: Heading) -> None:
+        """The body reports the end of its turn in place: it faces ``heading``, on the same cell."""
+        self.heading = heading
+        self.moving = False
+
     def motion(self, now: float) -> Cell | None:
         """The cell the body may start entering now, if any; the robot then counts as moving."""
         wanted = self.wanted
         if self.moving or wanted is None:
             return None
+        if not self._faces(wanted):
+            return None  # it turns toward the cell first (module docstring)
         if self.guarded and not self.safety.may_enter(wanted):
             return None
         self.safety.begin_move(wanted)

@@ -263,12 +263,18 @@ def policy_entry(name: str) -> PolicyEntry:
         ) from None
 
 
+EXECUTING_BODIES: tuple[str, ...] = (DEFAULT_BODY, "turning")
+"""The bodies that execute a central plan (the per-robot :class:`~mrmp.robot.robot.Robot` drives them: a body that
+turns in place turns toward its next cell while it waits), in the simulator and live."""
+
+
 def body_problem(scenario: Scenario, *, live: bool = False, planned: bool = False) -> Problem | None:
     """Why ``scenario``'s robots cannot run in its body model this way, or None when they can.
 
     A policy runs the bodies of its entry's :attr:`~PolicyEntry.bodies`, in
-    the simulator; live fleets and the execution of central plans drive
-    ``omni`` bodies only so far.
+    the simulator; a central plan is executed by every body of
+    :data:`EXECUTING_BODIES`, in the simulator and live; the live drivers of
+    the message-based policies drive ``omni`` bodies only so far.
 
     >>> from mrmp.core import Grid, RobotSpec
     >>> robots = (RobotSpec("A", (0, 0), (0, 1)),)
@@ -276,18 +282,22 @@ def body_problem(scenario: Scenario, *, live: bool = False, planned: bool = Fals
     >>> body_problem(turning) is None
     True
     >>> print(body_problem(turning, live=True))
-    policy.body: turning bodies are not driven live yet (only omni)
+    policy.body: pibt drives omni bodies live so far, not turning
+    >>> body_problem(turning, live=True, planned=True) is None
+    True
     >>> print(body_problem(turning.with_changes(policy=PolicyOptions(name="astar", body="turning"))))
     policy.body: astar plans for omni bodies, not turning
     """
     body = scenario.policy.body
     if body == DEFAULT_BODY:
         return None
-    if live:
-        return Problem("policy.body", f"{body} bodies are not driven live yet (only {DEFAULT_BODY})")
     if planned:
-        return Problem("policy.body", f"central plans are executed by {DEFAULT_BODY} bodies only so far, not {body}")
+        if body in EXECUTING_BODIES:
+            return None
+        return Problem("policy.body", f"central plans are executed by {', '.join(EXECUTING_BODIES)} bodies, not {body}")
     entry = policy_entry(scenario.policy.name)
+    if live:
+        return Problem("policy.body", f"{entry.name} drives {DEFAULT_BODY} bodies live so far, not {body}")
     if body not in entry.bodies:
         return Problem("policy.body", f"{entry.name} plans for {', '.join(entry.bodies)} bodies, not {body}")
     return None

@@ -11,7 +11,10 @@ Per tick, as in the thesis (sections 3.5-3.6), with the safety layer:
    without delay: an answer was lost) is sent again, and delivered;
 4. every robot whose move is allowed (guarded: a majority registered the cell
    to it; unguarded: always) moves, turning right first when the heading
-   changes, and observes its new cell;
+   changes, and observes its new cell; with bodies that turn in place
+   (``policy.body: turning``) a robot moves only to the cell ahead, and a robot
+   that decided to turn toward a neighbour turns a quarter instead, on its cell
+   (:meth:`~mrmp.robot.robot.Robot.turn`);
 5. the referee checks the new configuration, and the robots' timers run;
 6. robots on their goals count a goal reached; in a lifelong run each then
    receives a new goal (drawn with the run's seed).
@@ -48,6 +51,7 @@ import time
 from collections import Counter
 from collections.abc import Sequence
 
+from mrmp.core.body import body_model
 from mrmp.core.cell import Cell
 from mrmp.core.errors import InputError
 from mrmp.core.heading import Heading, right_turns
@@ -189,6 +193,7 @@ class LockstepSimulator:
         starts = [spec.start for spec in scenario.robots]
         faults = scenario.worst_faults()
         retry, timeout = safety_timers(faults.delay_max)
+        self.body = body_model(scenario.policy.body)
         self.robots = []
         for index, spec in enumerate(scenario.robots):
             policy = policies[index] if policies is not None else make_policy(scenario.policy, scenario.timing)
@@ -208,6 +213,7 @@ class LockstepSimulator:
                     following=following,
                     state_refresh=state_refresh(policy, faults) if quiet else None,
                     lossy=not (quiet and faults.is_perfect),
+                    body=self.body,
                 )
             )
         self.extra_rounds = 0 if faults.is_perfect else EXTRA_ROUNDS
@@ -217,7 +223,7 @@ class LockstepSimulator:
         per_round_trip = slowdown / (2 * faults.delay_max + 1)
         self.recurrence_limit = int((RECURRENCE_LIMIT + 2 * timeout) * max(1.0, per_round_trip))
         self.network = scenario_network(scenario)
-        self.referee = Referee(grid, [spec.id for spec in scenario.robots])
+        self.referee = Referee(grid, [spec.id for spec in scenario.robots], self.body)
         self.lengths = shortest_steps(scenario)
         self.max_ticks = scenario.max_ticks or default_max_ticks(scenario, self.lengths)
         self.record_decisions = record_decisions
@@ -269,21 +275,29 @@ class LockstepSimulator:
         if self.record_decisions:
             self.decisions.append([robot.last_decision for robot in robots])  # type: ignore[misc]
         before = [robot.present for robot in robots]
+        headings_before = [robot.heading for robot in robots]
         targets = [robot.motion(tick) for robot in robots]
         timing = self.scenario.timing
         grid = self.scenario.grid
+        quarter = self.body.turn_ticks(timing.turn_time, timing.cell_time) * timing.cell_time
         moved = False
         for robot, target in zip(robots, targets):
             result = self._results[robot.index]
             heading = robot.heading
             duration = timing.cell_time
-            if target is not None and target != robot.present:
+            turn = robot.turn(tick) if target is None else None
+            if turn is not None:
+                moved = True
+                result.turns += 1
+                duration = quarter
+                robot.turned(turn)
+            elif target is not None and target != robot.present:
                 moved = True
                 try:
                     new_heading = Heading.between(robot.present, target)
                 except ValueError:
                     new_heading = heading
-                turns = right_turns(heading, new_heading)
+                turns = self.body.quarter_turns(heading, new_heading) if self.body.headed else right_turns(heading, new_heading)
                 result.turns += turns
                 cost = grid.cost(target) if grid.in_bounds(target) else 1.0
                 duration = turns * timing.turn_time + timing.cell_time * cost
@@ -295,7 +309,11 @@ class LockstepSimulator:
             result.path.append(robot.present)
             result.headings.append(robot.heading)
             self._durations[robot.index].append(duration)
-        self.referee.check_tick(tick, before, [robot.present for robot in robots])
+        if self.body.headed:
+            after_headings = [robot.heading for robot in robots]
+            self.referee.check_tick(tick, before, [robot.present for robot in robots], headings_before, after_headings)
+        else:
+            self.referee.check_tick(tick, before, [robot.present for robot in robots])
         self._still_since = self._still_since + 1 if not moved else 0
         self._count_goals()
         for robot in robots:

@@ -37,9 +37,9 @@ def test_pibt_runs_turning_bodies_and_the_result_is_judged_in_their_model() -> N
         (["--policy", "pibt", "--body", "turning"], "policy.body: turning bodies run with sequencing: driver so far"),
         (
             ["--policy", "pibt", "--body", "turning", "--sequencing", "driver", "--live"],
-            "policy.body: turning bodies are not driven live yet (only omni)",
+            "policy.body: pibt drives omni bodies live so far, not turning",
         ),
-        (["--body", "turning", "--planner", "lacam"], "policy.body: central plans are executed by omni bodies only"),
+        (["--body", "thesis", "--planner", "lacam"], "policy.body: central plans are executed by omni, turning bodies, not thesis"),
         (["--body", "wheels"], "must be one of omni, thesis, turning, got 'wheels'"),
     ],
 )
@@ -48,3 +48,27 @@ def test_a_body_that_cannot_run_that_way_is_refused_in_one_line(flags: list[str]
     assert result.exit_code == 2, result.output
     lines = [line for line in result.output.splitlines() if line.strip()]
     assert len(lines) == 1 and reason in lines[0] and "Traceback" not in result.output
+
+
+def test_a_plan_for_turning_bodies_is_executed_by_them_in_its_makespan() -> None:
+    """Planned for turning bodies and executed by them on a perfect network: the plan's ticks, one legal action each."""
+    result = invoke("run", CROWD, "--planner", "lacam", "--body", "turning", "--json", "-")
+    assert result.exit_code == 0, result.output
+    run = json.loads(result.stdout)
+    assert run["success"] and run["collisions"] == [] and run["body"] == "turning"
+    assert run["makespan"] == run["plan_makespan"] and run["sum_of_costs"] == run["plan_sum_of_costs"]
+    assert sum(robot["turns"] for robot in run["robots"]) > 0
+    for robot in run["robots"]:
+        cells, headings = robot["path"], robot["headings"]
+        for tick in range(1, len(cells)):
+            assert cells[tick] == cells[tick - 1] or headings[tick] == headings[tick - 1]
+
+
+def test_a_ros2_drive_refuses_turning_bodies_in_one_line(tmp_path: Path) -> None:
+    """The ROS 2 drive is the thesis's line-counting body, which turns right only and never in place."""
+    scenario = tmp_path / "turning.yaml"
+    scenario.write_text(CROWD.read_text().replace("policy:\n", "policy:\n  body: turning\n", 1))
+    result = invoke("agent", scenario, "--robot", "r0", "--plan", tmp_path / "plan-0.json", "--drive", "ros2")
+    assert result.exit_code == 2, result.output
+    lines = [line for line in result.output.splitlines() if line.strip()]
+    assert len(lines) == 1 and "--drive: drives the thesis's line-counting body" in lines[0], result.output

@@ -139,3 +139,54 @@ def test_a_drifted_body_bumps_at_the_edge_instead_of_leaving_the_grid():
     drive(body, (4, 0))
     assert body.cell == (4, 0) and body.true_cell == (4, 0) and body.bumps == 1
     assert recorder.events == []  # it never covered another cell
+
+
+def turning_body(heading=Heading.NORTH, **options):
+    from mrmp.core.body import body_model
+
+    return SimulatedBody((2, 2), heading, Grid(5, 5), Timing(2.0, 1.0), time_scale=10, model=body_model("turning"), **options)
+
+
+def test_a_turning_body_turns_a_quarter_in_place_in_one_cell_time_either_way():
+    recorder = OccupancyRecorder()
+    body = turning_body(recorder=recorder)
+    body.start_turn(Heading.WEST, 0.0)  # counter-clockwise
+    assert body.moving and not body.poll(0.19) and body.poll(0.2)
+    assert body.heading is Heading.WEST and body.cell == body.true_cell == (2, 2) and body.turns == 1
+    body.start_turn(Heading.NORTH, 1.0)  # clockwise
+    assert body.poll(1.2) and body.heading is Heading.NORTH
+    assert recorder.events == []  # a turn in place enters and leaves no cell
+
+
+def test_a_turning_body_drives_only_ahead_and_turns_only_a_quarter():
+    body = turning_body()
+    end = drive(body, (3, 2))  # north, ahead: one cell time, no turn
+    assert 0.2 <= end < 0.22 and body.turns == 0 and body.cell == (3, 2)
+    for refused in (lambda: body.start_move((3, 3), 1.0), lambda: body.start_turn(Heading.SOUTH, 1.0)):
+        try:
+            refused()
+        except ValueError as error:
+            assert "turning body" in str(error)
+        else:
+            raise AssertionError("a turning body did what it cannot")
+    assert not body.moving
+
+
+def test_the_thesis_body_does_not_turn_in_place():
+    body = SimulatedBody((2, 2), Heading.NORTH, Grid(5, 5), Timing(2.0, 1.0))
+    try:
+        body.start_turn(Heading.EAST, 0.0)
+    except ValueError as error:
+        assert "thesis body cannot turn in place" in str(error)
+    else:
+        raise AssertionError("the thesis's body turned in place")
+
+
+def test_a_turning_body_draws_its_jitter_per_action():
+    ends = set()
+    for seed in range(20):
+        body = turning_body(jitter=0.3, rng=random.Random(seed))
+        body.start_turn(Heading.EAST, 0.0)
+        assert not body.poll(0.0)
+        ends.add(round(body.next_event(), 6))
+    assert len(ends) > 10 and all(0.2 * 0.7 - 1e-9 <= end <= 0.2 * 1.3 + 1e-9 for end in ends)

@@ -18,7 +18,7 @@ from mrmp.live.agent import Agent
 from mrmp.live.body import SimulatedBody
 from mrmp.live.driver import AgentTiming, Mailbox
 from mrmp.protocol.auth import Opener, Sealer
-from mrmp.protocol.messages import StateMessage
+from mrmp.protocol.messages import HelloMessage, StateMessage
 
 KEY = b"k" * 32
 TIMING = AgentTiming(start_wait=1.0, timeout=30.0, poll=0.004)
@@ -111,7 +111,8 @@ def test_an_arrived_robot_waiting_for_a_silent_peer_sends_the_same_messages_in_f
     turns, sent, stop, _ = run(Agent, scenario())
     assert stop == polled_stop == "arrived; peers silent"
     assert sent == polled_sent
-    assert sent and all(kind == StateMessage.__name__ for kind, _ in sent)
+    assert sent and {kind for kind, _ in sent} == {StateMessage.__name__, HelloMessage.__name__}
+    assert all(recipient == 1 for kind, recipient in sent if kind == HelloMessage.__name__)  # to B, never heard
     assert polled_turns > 400  # 1 s of fleet wait and 1.2 s of linger, every 4 ms
     assert turns * 10 < polled_turns
 
@@ -149,7 +150,7 @@ class InjectingMailbox(CountingMailbox):
         return super().wait(timeout)
 
 
-def fleet_wait(heard_at_wait: int) -> list[tuple[float, int | None]]:
+def fleet_wait(heard_at_wait: int) -> list[tuple[float, int | None, str]]:
     """Robot A waits for B and C (C never speaks; B's state comes at A's ``heard_at_wait``-th wait):
     when A sent its state, and to whom (None: every peer)."""
     robots = (RobotSpec("A", (0, 0), (0, 0)), RobotSpec("B", (3, 3), (3, 3)), RobotSpec("C", (0, 3), (0, 3)))
@@ -159,8 +160,15 @@ def fleet_wait(heard_at_wait: int) -> list[tuple[float, int | None]]:
     body = SimulatedBody(spec.start, spec.heading, scene.grid, scene.timing)
     timing = AgentTiming(start_wait=2.5, heartbeat=0.2, fleet_heartbeat=1.0)
     agent = Agent(scene, 0, transport, body, Sealer(KEY, 1), Opener(KEY, 1), timing=timing, clock=clock)
-    sent: list[tuple[float, int | None]] = []
-    agent._client.send = lambda data, recipient: sent.append((round(clock.now - 100.0, 3), recipient))  # type: ignore[method-assign]
+    sent: list[tuple[float, int | None, str]] = []
+    openers: dict[int | None, Opener] = {}  # each recipient opens what it gets
+
+    def record(data: bytes, recipient: int | None) -> None:
+        message = openers.setdefault(recipient, Opener(KEY, 1)).open(data)
+        assert message is not None  # every datagram, hellos too, stamped with a fresh sequence number
+        sent.append((round(clock.now - 100.0, 3), recipient, type(message).__name__))
+
+    agent._client.send = record  # type: ignore[method-assign]
     on_fake_clock(agent, InjectingMailbox(clock, StateMessage(1, 1, (3, 3), (3, 3)), at=heard_at_wait))
     agent._wait_for_fleet()
     assert agent._peers_heard() == 1  # C never spoke: the wait ended at start_wait
@@ -169,16 +177,32 @@ def fleet_wait(heard_at_wait: int) -> list[tuple[float, int | None]]:
 
 def test_waiting_for_the_fleet_a_robot_tells_unheard_peers_every_heartbeat_and_everyone_every_fleet_heartbeat():
     sent = fleet_wait(heard_at_wait=3)  # B's state comes during the third wait: it is heard at 0.6 s
+    state, hello = StateMessage.__name__, HelloMessage.__name__
     assert sent == [
-        (0.0, None),  # every peer
-        (0.2, 1), (0.2, 2), (0.4, 1), (0.4, 2),  # the peers not heard from, every heartbeat
-        (0.6, 1),  # B, heard for the first time, is answered at once
-        (0.6, 2), (0.8, 2),  # then only C, every heartbeat
-        (1.0, None),  # and every peer every fleet heartbeat
-        (1.2, 2), (1.4, 2), (1.6, 2), (1.8, 2),
-        (2.0, None),
-        (2.2, 2), (2.4, 2),
+        (0.0, None, state),  # every peer
+        (0.2, 1, state), (0.2, 2, state), (0.2, 1, hello), (0.2, 2, hello),  # the peers not heard from, every heartbeat,
+        (0.4, 1, state), (0.4, 2, state), (0.4, 1, hello), (0.4, 2, hello),  # each asked for its state
+        (0.6, 1, state),  # B, heard for the first time, is answered at once
+        (0.6, 2, state), (0.6, 2, hello), (0.8, 2, state), (0.8, 2, hello),  # then only C, every heartbeat
+        (1.0, None, state),  # and every peer every fleet heartbeat
+        (1.2, 2, state), (1.2, 2, hello), (1.4, 2, state), (1.4, 2, hello),
+        (1.6, 2, state), (1.6, 2, hello), (1.8, 2, state), (1.8, 2, hello),
+        (2.0, None, state),
+        (2.2, 2, state), (2.2, 2, hello), (2.4, 2, state), (2.4, 2, hello),
     ]  # fmt: skip
+
+
+def test_a_hello_is_answered_with_the_state_at_once_whether_waiting_or_running():
+    """A peer's hello says it has not heard this robot: the state goes to it alone, and the brain never sees the hello."""
+    scene = scenario()
+    spec = scene.robots[0]
+    body = SimulatedBody(spec.start, spec.heading, scene.grid, scene.timing)
+    agent = Agent(scene, 0, Recording(), body, Sealer(KEY, 1), Opener(KEY, 1), timing=TIMING, clock=FakeClock())
+    sent: list[tuple[str, int | None]] = []
+    agent._send = lambda outgoing: sent.extend((type(o.message).__name__, o.recipients) for o in outgoing)  # type: ignore[method-assign]
+    agent._inbox.put(HelloMessage(1, 7))
+    agent._drain_inbox(100.0)
+    assert sent == [(StateMessage.__name__, (1,))] and agent.robot.belief.peers == {}
 
 
 def test_the_end_of_the_run_is_seen_as_by_a_scan_of_every_peer():
