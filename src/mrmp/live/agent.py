@@ -32,6 +32,12 @@ listen for: it decides at once after announcing, and the pause after a decision
 to stay (it waits for a peer's move) ends as soon as a message comes, rather than
 after ``listen_time``, so that it starts the move as soon as it hears that it may.
 The pause after a refused claim keeps its random length (it breaks symmetry).
+Such a robot also repeats its state once, ``listen_time`` after each arrival, to
+the robots it names (those waiting for the move it made, and those it waits
+for): its dependents hear of the move from the first state (a push), and a lost
+push would otherwise cost them a pull, a heartbeat later. Measured on a LaCAM plan
+for 48 turning bodies at 10% loss (``bench/live_plan.py``), a robot whose move
+waited on another's decided a mean 60 ms after that one arrived without the repeat.
 
 Before its first step a robot waits (at most ``start_wait`` seconds) until it
 has heard from every peer, so that a fleet whose processes start one by one
@@ -123,6 +129,7 @@ class Agent(LiveDriver):
             body=body_model(scenario.policy.body),
         )
         self._turning = False  # the body's action in progress is a turn in place, not a move
+        self._repeat_at = math.inf  # when the state goes again after an arrival (a robot that listens for nothing)
         self._phase = Phase.LISTEN
         self._next_decision = 0.0
         self._decided_at = 0.0
@@ -203,6 +210,7 @@ class Agent(LiveDriver):
     def _due(self) -> float:
         """The body's next event, the end of the listening or the pause, or at once when a claim is over."""
         due = super()._due()
+        due = min(due, self._repeat_at)
         if self._phase is Phase.LISTEN or self._phase is Phase.PAUSE:
             due = min(due, self._next_decision)
         elif self._phase is Phase.CLAIM and self.robot.wanted is None and self.robot.safety.pending is None:
@@ -238,6 +246,8 @@ class Agent(LiveDriver):
                 else:
                     robot.arrived_at(body.cell, body.heading)
                     self._record_move(now, started, robot.arrived)
+                    if self._listen_time() == 0:
+                        self._repeat_at = now + timing.listen_time
                 self._send(robot.announce(now))
                 self._said, self._said_at = (robot.present, robot.intended, robot.heading, robot.arrived, robot.progress), now
                 sent_state = True
@@ -256,6 +266,10 @@ class Agent(LiveDriver):
             elif robot.wanted is None and robot.safety.pending is None:
                 pause = timing.heartbeat if robot.arrived else timing.listen_time * (1 + self.random.random())
                 self._phase, self._next_decision = Phase.PAUSE, now + pause
+        if now >= self._repeat_at:
+            self._repeat_at = math.inf
+            self._send(robot.announce(now))
+            sent_state = True
         if self._phase is Phase.PAUSE and now >= self._next_decision:
             sent_state = self._announce_if_new(now)
             self._phase, self._next_decision = Phase.LISTEN, now + self._listen_time()

@@ -316,7 +316,27 @@ class SafetyLayer:
         pending = self.pending
         if pending is None or pending.cell != cell:
             return False
-        return pending.committed or (not pending.refused and len(pending.votes) >= self.quorum)
+        return pending.committed or (not self._lost(pending) and len(pending.votes) >= self.quorum)
+
+    def _lost(self, pending: PendingClaim) -> bool:
+        """Whether ``pending`` is lost: under the lockstep rule, refused by any replica (its robot then decides
+        again within the tick, or the claim stands); otherwise refused by more replicas than a majority can spare,
+        so that one replica still holding a record of the cell's last owner (its release is on its way) costs the
+        claimant nothing while the other two grant.
+
+        >>> layer = SafetyLayer(0, [(0, 0), (0, 1), (0, 2), (0, 3)])
+        >>> _ = layer.start_claim((5, 5), now=0.0)
+        >>> replicas = layer.claim_recipients((5, 5))
+        >>> refusal = lambda replica: ReplyMessage(replica, 1, 0, layer.pending.number, (5, 5), False)
+        >>> grant = lambda replica: ReplyMessage(replica, 1, 0, layer.pending.number, (5, 5), True)
+        >>> _ = layer.handle_reply(refusal(replicas[0]), now=0.0); layer._lost(layer.pending)
+        False
+        >>> _ = [layer.handle_reply(grant(replica), now=0.0) for replica in replicas[1:]]; layer.may_enter((5, 5))
+        True
+        """
+        if self.following:
+            return pending.refused
+        return len(pending.refusers) > len(self.replicas_of(pending.cell)) - self.quorum
 
     def begin_move(self, cell: Cell) -> None:
         """The body starts entering ``cell`` (which :meth:`may_enter` allowed, or any cell when unguarded)."""
@@ -368,7 +388,7 @@ class SafetyLayer:
                 if not pending.standing:
                     self.stats.refused += 1
                     pending.standing = True
-            elif pending.refused:
+            elif self._lost(pending):
                 self.stats.refused += 1
                 self.cancel_claim()
             elif now - pending.started_at >= self.claim_timeout:
@@ -487,10 +507,11 @@ class SafetyLayer:
     def handle_reply(self, message: ReplyMessage, now: float) -> list[Send]:
         """Count a replica's answer to this robot's pending claim (others are ignored).
 
-        Under the lockstep model's rule a grant may come after a refusal from
-        the same replica (its owner handed the cell off meanwhile) and replaces
-        it; the grant that completes a majority commits the claim, and the
-        handoff of the Present is returned to be sent.
+        A grant may come after a refusal from the same replica (under the
+        lockstep model's rule its owner handed the cell off meanwhile; otherwise
+        the owner's release reached it before the claim was sent again) and
+        replaces it; under that rule the grant that completes a majority commits
+        the claim, and the handoff of the Present is returned to be sent.
         """
         pending = self.pending
         if pending is None or message.claimant != self.index or message.claim != pending.number:
@@ -499,8 +520,7 @@ class SafetyLayer:
             return []
         if message.granted:
             pending.votes.add(message.sender)
-            if self.following:
-                pending.refusers.discard(message.sender)
+            pending.refusers.discard(message.sender)  # its latest answer counts: the record of a release came since
         else:
             pending.refusers.add(message.sender)
         return self._commit_if_granted()
