@@ -44,9 +44,6 @@ from mrmp.protocol.auth import Opener, Sealer
 from mrmp.robot.causal_pibt import LOCK_RADIUS, CausalRobot
 from mrmp.robot.robot import Outgoing
 
-LOCK_RETRY_FRACTION = 3
-"""Lock requests and releases are resent this many times more often than claims (a lock holds others up)."""
-
 
 class CausalAgent(LiveDriver):
     """Runs one Causal-PIBT robot in real time (see the module docstring).
@@ -75,7 +72,7 @@ class CausalAgent(LiveDriver):
     ) -> None:
         super().__init__(scenario, index, transport, body, sealer, opener, timing, seed, clock)
         spec = scenario.robots[index]
-        retry = timing.claim_retry / LOCK_RETRY_FRACTION
+        retry = timing.claim_retry  # lock requests and releases are resent as often as claims
         self.robot: CausalRobot = CausalRobot(
             index,
             scenario.grid,

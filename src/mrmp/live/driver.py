@@ -28,13 +28,15 @@ near is addressed before it is within the interaction radius
 (``docs/protocol.md``, "Neighbourhoods"). Before its first step a robot
 waits (at most ``start_wait`` seconds) until it has heard from every peer, so
 that a fleet whose processes start one by one begins together; its clock starts
-then. While it waits it sends its state every heartbeat to the peers it has not
-heard from, each with a :class:`~mrmp.protocol.messages.HelloMessage`, at once
-to a peer it hears from for the first time, and every fleet heartbeat to every
-peer. A robot answers every hello with its state, waiting or running: a
-waiting robot whose first answer from a peer was lost hears it at the next
-hello, not a fleet heartbeat later (with 48 robots that is 2.35 s, and one
-robot starting that late holds up every robot that waits for it). The run
+then. While it waits it sends its state every fleet heartbeat to every peer and
+at once to a peer it hears from for the first time, and asks the peers it has
+not heard from for their state with a :class:`~mrmp.protocol.messages.HelloMessage`,
+a heartbeat after it began waiting, then at gaps doubling up to a fleet
+heartbeat. A robot answers every hello with its state, waiting or running (and
+with a hello of its own to a sender it has not heard from): a waiting robot
+whose first answer from a peer was lost hears it at its next hello, not a fleet
+heartbeat later (with 48 robots that is 2.35 s, and one robot starting that late
+holds up every robot that waits for it). The run
 ends when this robot and every peer have arrived (and a short linger has
 passed so that late requests are still answered, at least a fleet heartbeat,
 so that a far peer that has left its goal again is heard of; the robot then
@@ -71,7 +73,7 @@ class AgentTiming:
     listen_time: float = 0.05
     heartbeat: float = 0.2
     fleet_heartbeat: float = 1.0
-    claim_retry: float = 0.15
+    claim_retry: float = 0.05
     claim_timeout: float = 1.0
     silence_timeout: float = 1.5
     give_up_after: float = 3.0
@@ -185,6 +187,8 @@ class AgentReport:
     turns: int = 0
     steps: int = 0
     messages_sent: int = 0
+    sent_by_kind: dict[str, int] = field(default_factory=dict)
+    """Messages sent (per recipient) by message type (``StateMessage``, ``ClaimMessage``...)."""
     bytes_sent: int = 0
     datagrams_sent: int = 0
     messages_received: int = 0
@@ -282,6 +286,10 @@ class LiveDriver:
         self._client = ClientThread(transport, name=f"robot-{index}-client")
         self.cell_seconds = scenario.timing.cell_time / getattr(body, "time_scale", 1.0)
         """Seconds the body takes for a cell (a body without a time scale runs in real time)."""
+        self._hello_due: dict[int, float] = {}
+        """While waiting for the fleet: when each peer not heard from is asked for its state next."""
+        self._hello_gap: dict[int, float] = {}
+        """While waiting for the fleet: the gap before each such peer's following hello."""
 
     # -- what a policy's driver supplies ----------------------------------------------------
 
@@ -378,18 +386,23 @@ class LiveDriver:
 
     def _drain_inbox(self, now: float) -> None:
         """Hand the brain every message the receiving thread queued, and send its answers; answer a hello with the
-        state (module docstring)."""
+        state, and with a hello too when its sender has not been heard from (module docstring)."""
         for message in self._inbox.take():
             self.report.messages_received += 1
-            if isinstance(message, HelloMessage):
-                self._send(self._fleet_wait_to((message.sender,)))
-            else:
+            if not isinstance(message, HelloMessage):
                 self._send(self.robot.receive(message, now))
+                continue
+            sender = (message.sender,)
+            self._send(self._fleet_wait_to(sender))
+            if self._peer_news(message.sender) is None:
+                self._send(self._hellos_to(sender))
+                if message.sender in self._hello_gap:  # it is up: ask it again soon, not at a long gap
+                    self._hello_gap[message.sender] = self.timing.heartbeat
+                    self._hello_due[message.sender] = now + self.timing.heartbeat
 
     def _hellos_to(self, peers: tuple[int, ...]) -> list[Outgoing]:
-        """The fleet-wait state addressed to ``peers``, and a hello asking each for its state."""
-        states = self._fleet_wait_to(peers)
-        return [*states, Outgoing(HelloMessage(self.index, self.robot.next_seq()), peers)]
+        """A hello to ``peers``, asking each for its state."""
+        return [Outgoing(HelloMessage(self.index, self.robot.next_seq()), peers)]
 
     def _sleep(self, until: float, timers: bool = True) -> None:
         """Sleep until the clock reads ``until`` (or a stop is requested), waking for the brain's timers.
@@ -415,14 +428,17 @@ class LiveDriver:
     def _send(self, outgoing: list[Outgoing]) -> None:
         """Seal each message and queue it for the client thread, counting it as sent."""
         report, client = self.report, self._client
+        by_kind = report.sent_by_kind
         for item in outgoing:
             data = self.sealer.seal(item.message)
+            kind = type(item.message).__name__
             if item.radius:  # a radius of 0 reaches no peer but those named
                 near = self._believed_within(item.radius)
                 item = item._replace(recipients=(*near, *(peer for peer in item.recipients or () if peer not in near)))
             if item.recipients is None:
                 client.send(data, None)
                 report.messages_sent += self._peers
+                by_kind[kind] = by_kind.get(kind, 0) + self._peers
                 report.bytes_sent += len(data) * self._peers
                 report.datagrams_sent += 1
             else:
@@ -431,6 +447,7 @@ class LiveDriver:
                     report.messages_sent += 1
                     report.bytes_sent += len(data)
                     report.datagrams_sent += 1
+                by_kind[kind] = by_kind.get(kind, 0) + len(item.recipients)
 
     # -- the main loop ---------------------------------------------------------------------
 
@@ -507,33 +524,42 @@ class LiveDriver:
     def _wait_for_fleet(self) -> None:
         """Send the state, and answer, until every peer has been heard (or ``start_wait`` passes).
 
-        The state goes every heartbeat to the peers not heard from yet, with a
-        hello that each answers with its state (its answer to this robot's first
-        state may have been lost), at once to a peer heard from for the first
-        time (it is up: now it hears this robot too), and every fleet heartbeat
-        to every peer: a fleet whose processes start one by one does not flood
-        the robots already up with a state from each of them every heartbeat.
+        The state goes every fleet heartbeat to every peer, and at once to a
+        peer heard from for the first time (it is up: now it hears this robot
+        too). A peer not heard from yet gets a hello, which it answers with its
+        state (its answer to this robot's state may have been lost): a heartbeat
+        after the start, then at gaps doubling from a heartbeat up to a fleet
+        heartbeat, so that a fleet whose processes start one by one does not
+        flood with hellos the robots already up, nor the addresses of those not up yet;
+        a hello from a peer not heard from (it is up) starts its gaps again from a heartbeat.
         """
-        clock = self.clock
-        deadline = clock() + self.timing.start_wait
-        last_state = last_fleet_state = -math.inf
+        clock, timing = self.clock, self.timing
+        started = clock()
+        deadline = started + timing.start_wait
+        last_fleet_state = -math.inf
         unheard = self._unheard_peers()
+        hello_due = self._hello_due = dict.fromkeys(unheard, started + timing.heartbeat)
+        hello_gap = self._hello_gap = dict.fromkeys(unheard, timing.heartbeat)
         while not self.stop_requested.is_set() and self._peers_heard() < self._peers and clock() < deadline:
             now = clock()
             self._drain_inbox(now)
             still_unheard = self._unheard_peers()
             newly_heard = tuple(sorted(set(unheard) - set(still_unheard)))
             unheard = still_unheard
-            if newly_heard and now - last_fleet_state < self.timing.fleet_heartbeat:  # answered at once
+            if newly_heard and now - last_fleet_state < timing.fleet_heartbeat:  # answered at once
                 self._send(self._fleet_wait_to(newly_heard))
-            if now - last_fleet_state >= self.timing.fleet_heartbeat:
+            if now - last_fleet_state >= timing.fleet_heartbeat:
                 self._send(fleet_wide(self._fleet_wait_messages()))
-                last_state = last_fleet_state = now
-            elif now - last_state >= self.timing.heartbeat and unheard:
-                self._send(self._hellos_to(unheard))
-                last_state = now
-            next_state = min(last_state + self.timing.heartbeat, last_fleet_state + self.timing.fleet_heartbeat)
-            self._sleep(min(next_state, deadline), timers=False)  # no brain timers run before the start
+                last_fleet_state = now
+            due = tuple(peer for peer in unheard if hello_due[peer] <= now)
+            if due:
+                self._send(self._hellos_to(due))
+                for peer in due:
+                    hello_due[peer] = now + hello_gap[peer]
+                    hello_gap[peer] = min(2 * hello_gap[peer], timing.fleet_heartbeat)
+            next_hello = min((hello_due[peer] for peer in unheard), default=math.inf)
+            next_event = min(next_hello, last_fleet_state + timing.fleet_heartbeat, deadline)
+            self._sleep(next_event, timers=False)  # no brain timers run before the start
 
     def _fleet_wait_to(self, peers: tuple[int, ...]) -> list[Outgoing]:
         """The fleet-wait state addressed to ``peers`` only."""

@@ -119,6 +119,8 @@ def live_result(
             network["missed_lines"] += int(report.get("missed_lines", 0))
             for reason, count in dict(report.get("rejected", {})).items():
                 network[f"rejected_{reason}"] += int(count)
+            for kind, count in dict(report.get("sent_by_kind", {})).items():
+                network[f"sent_{kind}"] += int(count)
             for name, count in dict(report.get("faults", {})).items():
                 network[f"injected_{name}"] += int(count)
             for name, count in dict(report.get("safety", {})).items():

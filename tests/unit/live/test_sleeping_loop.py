@@ -175,34 +175,43 @@ def fleet_wait(heard_at_wait: int) -> list[tuple[float, int | None, str]]:
     return sent
 
 
-def test_waiting_for_the_fleet_a_robot_tells_unheard_peers_every_heartbeat_and_everyone_every_fleet_heartbeat():
-    sent = fleet_wait(heard_at_wait=3)  # B's state comes during the third wait: it is heard at 0.6 s
+def test_waiting_for_the_fleet_a_robot_asks_unheard_peers_at_doubling_gaps_and_tells_everyone_every_fleet_heartbeat():
+    sent = fleet_wait(heard_at_wait=3)  # B's state comes during the third wait: it is heard at 0.8 s
     state, hello = StateMessage.__name__, HelloMessage.__name__
     assert sent == [
         (0.0, None, state),  # every peer
-        (0.2, 1, state), (0.2, 2, state), (0.2, 1, hello), (0.2, 2, hello),  # the peers not heard from, every heartbeat,
-        (0.4, 1, state), (0.4, 2, state), (0.4, 1, hello), (0.4, 2, hello),  # each asked for its state
-        (0.6, 1, state),  # B, heard for the first time, is answered at once
-        (0.6, 2, state), (0.6, 2, hello), (0.8, 2, state), (0.8, 2, hello),  # then only C, every heartbeat
-        (1.0, None, state),  # and every peer every fleet heartbeat
-        (1.2, 2, state), (1.2, 2, hello), (1.4, 2, state), (1.4, 2, hello),
-        (1.6, 2, state), (1.6, 2, hello), (1.8, 2, state), (1.8, 2, hello),
+        (0.2, 1, hello), (0.2, 2, hello),  # the peers not heard from are asked for their state a heartbeat later,
+        (0.4, 1, hello), (0.4, 2, hello),  # then at gaps doubling from a heartbeat (0.2 s)
+        (0.8, 1, state),  # B, heard for the first time, is answered at once
+        (0.8, 2, hello),
+        (1.0, None, state),  # every peer every fleet heartbeat
+        (1.6, 2, hello),  # C: the gap has reached the fleet heartbeat (1 s)
         (2.0, None, state),
-        (2.2, 2, state), (2.2, 2, hello), (2.4, 2, state), (2.4, 2, hello),
     ]  # fmt: skip
 
 
-def test_a_hello_is_answered_with_the_state_at_once_whether_waiting_or_running():
-    """A peer's hello says it has not heard this robot: the state goes to it alone, and the brain never sees the hello."""
+def answers_to_a_hello(heard: bool) -> list[tuple[str, tuple[int, ...] | None]]:
+    """What robot A sends when B's hello comes (B heard from before, or not)."""
     scene = scenario()
     spec = scene.robots[0]
     body = SimulatedBody(spec.start, spec.heading, scene.grid, scene.timing)
     agent = Agent(scene, 0, Recording(), body, Sealer(KEY, 1), Opener(KEY, 1), timing=TIMING, clock=FakeClock())
-    sent: list[tuple[str, int | None]] = []
+    sent: list[tuple[str, tuple[int, ...] | None]] = []
     agent._send = lambda outgoing: sent.extend((type(o.message).__name__, o.recipients) for o in outgoing)  # type: ignore[method-assign]
+    if heard:
+        agent.robot.receive(StateMessage(1, 1, (3, 3), (3, 3)), 100.0)
     agent._inbox.put(HelloMessage(1, 7))
     agent._drain_inbox(100.0)
-    assert sent == [(StateMessage.__name__, (1,))] and agent.robot.belief.peers == {}
+    assert set(agent.robot.belief.peers) == ({1} if heard else set())  # the brain never sees the hello
+    return sent
+
+
+def test_a_hello_is_answered_with_the_state_at_once_and_with_a_hello_when_its_sender_is_unheard():
+    """A peer's hello says it has not heard this robot: the state goes to it alone; a sender not heard from is asked
+    for its state in turn (it is up, and its own state to this robot may have been lost)."""
+    state, hello = StateMessage.__name__, HelloMessage.__name__
+    assert answers_to_a_hello(heard=True) == [(state, (1,))]
+    assert answers_to_a_hello(heard=False) == [(state, (1,)), (hello, (1,))]
 
 
 def test_the_end_of_the_run_is_seen_as_by_a_scan_of_every_peer():
