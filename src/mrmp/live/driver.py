@@ -170,6 +170,45 @@ class Mailbox:
                 return taken
 
 
+class HelloSchedule:
+    """When a robot waiting for its fleet asks each peer not heard from for its state (:class:`LiveDriver`).
+
+    A peer is asked ``first`` seconds after the wait begins, then at gaps
+    doubling from ``first`` up to ``longest``; :meth:`restart` (a hello came
+    from it: it is up) starts its gaps again.
+
+    >>> schedule = HelloSchedule([1, 2], now=0.0, first=0.2, longest=1.0)
+    >>> schedule.take_due([1, 2], 0.1), schedule.take_due([1, 2], 0.2), schedule.next_due([1, 2])
+    ((), (1, 2), 0.4)
+    >>> schedule.take_due([1], 0.4), schedule.next_due([1])   # the gap doubles: next at 0.8
+    ((1,), 0.8)
+    >>> schedule.restart(1, now=0.5); schedule.next_due([1])
+    0.7
+    """
+
+    def __init__(self, peers: Iterable[int], now: float, first: float, longest: float) -> None:
+        self.first, self.longest = first, longest
+        self._due = dict.fromkeys(peers, now + first)
+        self._gap = dict.fromkeys(self._due, first)
+
+    def take_due(self, peers: Iterable[int], now: float) -> tuple[int, ...]:
+        """Those of ``peers`` to ask now; each is then due again one gap later, its next gap doubled."""
+        due = tuple(peer for peer in peers if self._due.get(peer, math.inf) <= now)
+        for peer in due:
+            self._due[peer] = now + self._gap[peer]
+            self._gap[peer] = min(2 * self._gap[peer], self.longest)
+        return due
+
+    def next_due(self, peers: Iterable[int]) -> float:
+        """When the first of ``peers`` is to be asked next (``inf``: none)."""
+        return min((self._due.get(peer, math.inf) for peer in peers), default=math.inf)
+
+    def restart(self, peer: int, now: float) -> None:
+        """``peer`` is up: ask it again ``first`` seconds from ``now``, its gaps doubling again from there."""
+        if peer in self._due:
+            self._due[peer], self._gap[peer] = now + self.first, self.first
+
+
 @dataclass
 class AgentReport:
     """What one robot did in a live run (written to ``agent-<index>.json``)."""
@@ -286,10 +325,8 @@ class LiveDriver:
         self._client = ClientThread(transport, name=f"robot-{index}-client")
         self.cell_seconds = scenario.timing.cell_time / getattr(body, "time_scale", 1.0)
         """Seconds the body takes for a cell (a body without a time scale runs in real time)."""
-        self._hello_due: dict[int, float] = {}
-        """While waiting for the fleet: when each peer not heard from is asked for its state next."""
-        self._hello_gap: dict[int, float] = {}
-        """While waiting for the fleet: the gap before each such peer's following hello."""
+        self._hellos = HelloSchedule((), 0.0, timing.heartbeat, timing.fleet_heartbeat)
+        """While waiting for the fleet: when each peer not heard from is asked for its state."""
 
     # -- what a policy's driver supplies ----------------------------------------------------
 
@@ -396,9 +433,7 @@ class LiveDriver:
             self._send(self._fleet_wait_to(sender))
             if self._peer_news(message.sender) is None:
                 self._send(self._hellos_to(sender))
-                if message.sender in self._hello_gap:  # it is up: ask it again soon, not at a long gap
-                    self._hello_gap[message.sender] = self.timing.heartbeat
-                    self._hello_due[message.sender] = now + self.timing.heartbeat
+                self._hellos.restart(message.sender, now)  # it is up: ask it again soon, not at a long gap
 
     def _hellos_to(self, peers: tuple[int, ...]) -> list[Outgoing]:
         """A hello to ``peers``, asking each for its state."""
@@ -538,8 +573,7 @@ class LiveDriver:
         deadline = started + timing.start_wait
         last_fleet_state = -math.inf
         unheard = self._unheard_peers()
-        hello_due = self._hello_due = dict.fromkeys(unheard, started + timing.heartbeat)
-        hello_gap = self._hello_gap = dict.fromkeys(unheard, timing.heartbeat)
+        hellos = self._hellos = HelloSchedule(unheard, started, timing.heartbeat, timing.fleet_heartbeat)
         while not self.stop_requested.is_set() and self._peers_heard() < self._peers and clock() < deadline:
             now = clock()
             self._drain_inbox(now)
@@ -551,14 +585,10 @@ class LiveDriver:
             if now - last_fleet_state >= timing.fleet_heartbeat:
                 self._send(fleet_wide(self._fleet_wait_messages()))
                 last_fleet_state = now
-            due = tuple(peer for peer in unheard if hello_due[peer] <= now)
+            due = hellos.take_due(unheard, now)
             if due:
                 self._send(self._hellos_to(due))
-                for peer in due:
-                    hello_due[peer] = now + hello_gap[peer]
-                    hello_gap[peer] = min(2 * hello_gap[peer], timing.fleet_heartbeat)
-            next_hello = min((hello_due[peer] for peer in unheard), default=math.inf)
-            next_event = min(next_hello, last_fleet_state + timing.fleet_heartbeat, deadline)
+            next_event = min(hellos.next_due(unheard), last_fleet_state + timing.fleet_heartbeat, deadline)
             self._sleep(next_event, timers=False)  # no brain timers run before the start
 
     def _fleet_wait_to(self, peers: tuple[int, ...]) -> list[Outgoing]:
