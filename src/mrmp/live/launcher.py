@@ -313,7 +313,16 @@ def _shut_down(fleet: _Fleet) -> None:
         _stop([fleet.referee])
 
 
-def _stop(processes: list[subprocess.Popen[bytes]], grace: float = 3.0) -> None:
+STOP_GRACE_S = 10.0
+"""Seconds a process has, after SIGTERM, to write what it has and exit before it is killed.
+
+A robot stops within milliseconds of the signal on an idle machine; the grace is a
+bound on a hang, long enough for a loaded one to flush and write its report.
+"""
+
+
+def _stop(processes: list[subprocess.Popen[bytes]], grace: float = STOP_GRACE_S) -> None:
+    """SIGTERM every process still running, and kill those not gone ``grace`` seconds later."""
     for process in processes:
         if process.poll() is None:
             process.send_signal(signal.SIGTERM)

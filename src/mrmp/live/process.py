@@ -289,7 +289,12 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
         if isinstance(opened, ConnectedTransport):
             _wait_for_peers(opened, len(scenario.robots) - 1, agent.stop_requested)
         with profiled(options.results / f"profile-{index}.prof"):
-            report = agent.run(on_progress=lambda report: write_json(report_path, report.as_dict()))
+            try:
+                report = agent.run(on_progress=lambda report: write_json(report_path, report.as_dict()))
+            except Exception as error:  # what the robot gathered is kept, saying why it stopped
+                agent.report.stop_reason = f"crashed: {type(error).__name__}: {error}"
+                write_json(report_path, agent.report.as_dict())
+                raise
     finally:
         if transport is not None:
             transport.close()

@@ -166,10 +166,10 @@ def _unpack_beacon(sender: int, seq: int, fields: Fields, _: tuple[Cell, ...]) -
 
 
 def _unpack_answer(sender: int, seq: int, fields: Fields, _: tuple[Cell, ...]) -> AnswerMessage:
-    step, moved = fields
-    if moved > 1:
-        raise DecodeError("malformed", f"answer with moved={moved}")
-    return AnswerMessage(sender, seq, step, bool(moved))
+    step, outcome = fields
+    if outcome >= 3:  # 1: moved, 2: stays and turns to leave, 0: could not move
+        raise DecodeError("malformed", f"answer with outcome={outcome}")
+    return AnswerMessage(sender, seq, step, bool(outcome & 1), bool(outcome & 2))
 
 
 def _step_cell_format(code: int, kind: type[InheritMessage] | type[ReserveMessage] | type[PullMessage]) -> WireFormat[Any]:
@@ -193,7 +193,7 @@ BEACON = register(
     )
 )
 INHERIT = register(_step_cell_format(5, InheritMessage))
-ANSWER = register(WireFormat(6, AnswerMessage, "!IB", lambda m: (m.step, int(m.moved)), _unpack_answer))
+ANSWER = register(WireFormat(6, AnswerMessage, "!IB", lambda m: (m.step, int(m.moved) | 2 * int(m.turns)), _unpack_answer))
 RESERVE = register(_step_cell_format(7, ReserveMessage))
 PULL = register(_step_cell_format(8, PullMessage))
 STAY = register(

@@ -224,12 +224,19 @@ class InheritMessage(PibtMessage):
 
 @dataclass(frozen=True, slots=True)
 class AnswerMessage(PibtMessage):
-    """The answer to an :class:`InheritMessage`: whether the sender could leave its cell (``moved``)."""
+    """The answer to an :class:`InheritMessage`: whether the sender could leave its cell (``moved``).
+
+    ``turns``: bodies that turn in place, ahead-or-stay rule
+    (:attr:`~mrmp.robot.pibt_robot.PibtRobot.turns_by_staying`): the sender
+    stays, but turns to leave next step, so the asker waits behind it rather
+    than trying another cell.
+    """
 
     sender: int
     seq: int
     step: int
     moved: bool
+    turns: bool = False
 
 
 @dataclass(frozen=True, slots=True)

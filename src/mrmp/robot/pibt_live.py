@@ -110,13 +110,16 @@ class LivePibtRobot(ReliablePibtRobot):
         turn_cost: float = 0.5,
         rng: random.Random | None = None,
         tie_penalties: bool | None = None,
+        turning: bool = False,
+        dead_end_bonus: int = 0,
         retry: int = 1,
         starts: Sequence[int] = (),
         lookout: int = 2,
     ) -> None:
         super().__init__(
             index, start, goal, flat, tie=tie, heading=heading, radius=radius, swap=swap,
-            heading_aware=heading_aware, turn_cost=turn_cost, rng=rng, tie_penalties=tie_penalties, retry=retry,
+            heading_aware=heading_aware, turn_cost=turn_cost, rng=rng, tie_penalties=tie_penalties,
+            turning=turning, dead_end_bonus=dead_end_bonus, retry=retry,
         )  # fmt: skip
         self.known: dict[int, tuple[int, int]] = {}
         """Per peer: the cell it was last heard of, and the step at whose start it stood there."""

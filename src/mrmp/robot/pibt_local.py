@@ -133,10 +133,13 @@ class LocalPibtRobot(PibtRobot):
         turn_cost: float = 0.5,
         rng: random.Random | None = None,
         tie_penalties: bool | None = None,
+        turning: bool = False,
+        dead_end_bonus: int = 0,
     ) -> None:
         super().__init__(
             index, start, goal, flat, tie=tie, heading=heading, radius=radius, swap=swap,
             heading_aware=heading_aware, turn_cost=turn_cost, rng=rng, tie_penalties=tie_penalties,
+            turning=turning, dead_end_bonus=dead_end_bonus,
         )  # fmt: skip
         self.stats: Counter[str] = Counter()
         self.wake = False
@@ -154,6 +157,7 @@ class LocalPibtRobot(PibtRobot):
         self._confirmed = True
         self._finishing: bool | None = None
         self._lost = False
+        self._withdrawn = False  # lost its reservation while waiting for an answer: the answer comes first
         self._done = False
         self.stalled = 0
         self.reach = radius
@@ -182,6 +186,7 @@ class LocalPibtRobot(PibtRobot):
         self._root, self._rank = self.index, self.priority
         self._own_rank = self._rank
         self._confirmed, self._finishing, self._lost, self._done = True, None, False, False
+        self._withdrawn = False
         self.wake = True  # evaluate the start rule once the beacons are in
         return out
 
@@ -235,7 +240,14 @@ class LocalPibtRobot(PibtRobot):
     """
 
     rotations = True
-    """Take the cell of a robot busy in the robot's own call (PIBT's rotations): safe when every call ends in its step."""
+    """Take the cell of a robot busy in the robot's own call (PIBT's rotations): safe when every call ends in its step.
+
+    Never for bodies that turn in place (``turning``): they follow one another but may not rotate.
+    """
+
+    turns_by_staying = True
+    """Bodies that turn in place decide for the cell ahead or their own (:attr:`PibtRobot.turns_by_staying`):
+    a decision for good is never cancelled by a robot that turns."""
 
     informing = Handlers()
 
@@ -258,6 +270,7 @@ class LocalPibtRobot(PibtRobot):
                 reserved[old] = self._parent  # its own cell stays promised to the robot that pushed it
             else:
                 del reserved[old]  # a reservation replaced (after a lost conflict or backtracking)
+                self._restore_final_holder(old)
         targets[sender] = cell
         rank = self._claims[sender] = (message.root_elapsed, message.root_tie, -message.root)
         final = message.final
@@ -293,8 +306,29 @@ class LocalPibtRobot(PibtRobot):
     least the radius). A brain that learns of decisions otherwise sets it.
     """
 
+    def _restore_final_holder(self, cell: int) -> None:
+        """Give ``cell`` back to the robot heard to have decided for good on it, if one did.
+
+        Its claim may have lost here to a provisional one heard first, whose
+        sender has since moved on: a decision for good holds whatever came before.
+        """
+        targets, reserved = self._targets, self._reserved
+        for robot in self._final:
+            if targets.get(robot) == cell:
+                reserved[cell] = robot
+                return
+
     def _outranks(self, claimant: int, holder: int, cell: int) -> bool:
-        """Whether ``claimant``'s claim of ``cell`` beats ``holder``'s: staying on one's cell first, then the call's rank."""
+        """Whether ``claimant``'s claim of ``cell`` beats ``holder``'s.
+
+        A claim decided for good first (decided reservations are unique), then
+        staying on one's cell, then the call's rank. The first rule does not
+        rest on the beacons heard: the occupant of a cell may not be known yet
+        when its claims arrive over a faulty network.
+        """
+        final = self._final
+        if (claimant in final) != (holder in final):
+            return claimant in final
         occupant = self._occupants.get(cell)
         if (occupant == claimant) != (occupant == holder):
             return occupant == claimant
@@ -309,11 +343,11 @@ class LocalPibtRobot(PibtRobot):
         if self._lost:
             self._lost = False
             self.stats["withdrawn"] += 1
-            self._waiting = None  # the pushed robot answers the winner; a late answer to us is dropped
             self._finishing = None
-            self.target = None
-            self._next += 1
-            self._continue(out)
+            if self._waiting is not None:
+                self._withdrawn = True  # the robot it asked may be deciding in its call: its answer comes first
+            else:
+                self._next_cell(out)
         elif not self._confirmed and self._may_confirm():
             self._confirmed = True
             if self._finishing is not None:
@@ -340,6 +374,28 @@ class LocalPibtRobot(PibtRobot):
             else:
                 self.stats["waits"] += 1
         return out
+
+    def _next_cell(self, out: list[Outgoing]) -> None:
+        """The reservation lost to a call of higher priority: try the next cell."""
+        self.target = None
+        self._next += 1
+        self._continue(out)
+
+    def _take_answer(self, message: AnswerMessage, out: list[Outgoing]) -> None:
+        """An answer to an inheritance; after a withdrawal, whatever it says, the next cell.
+
+        A robot whose reservation of an occupied cell lost, while it waited for
+        the occupant's answer, waits on: the occupant may have taken the request
+        (the winner's came later, or never) and be deciding within this robot's
+        call. Going on at once would run two branches of one call side by side,
+        whose claims of one cell carry the same rank and so could both stand.
+        """
+        if self._withdrawn and message.sender == self._waiting:
+            self._withdrawn = False
+            self._waiting = None
+            self._next_cell(out)
+            return
+        super()._take_answer(message, out)
 
     def _may_confirm(self) -> bool:
         """Whether the provisional reservation has survived: in synchronous rounds, one round has passed."""
@@ -446,9 +502,16 @@ class LocalPibtRobot(PibtRobot):
                 self._next += 1
                 continue
             occupant = occupants.get(cell)
+            if self.turning and cell != here and cell != self._ahead_cell:
+                if self._turns_toward(cell, occupant, out):
+                    return
+                continue
             if occupant is None or occupant == self.index or occupant in final:
                 if occupant is not None and targets.get(occupant) == here:
                     self._next += 1  # would swap
+                    continue
+                if self.turning and self._closes_cycle(occupant, cell):
+                    self._next += 1  # pushed, behind a robot that drives on: it could close a cycle
                     continue
                 self._claim(cell, True, out)
                 return
@@ -457,7 +520,7 @@ class LocalPibtRobot(PibtRobot):
                 self._next += 1  # the occupant moves into our cell: taking its cell would swap
                 continue
             if target is not None:
-                if self.rotations and self._calls.get(occupant) == self._root:
+                if self.rotations and not self.turning and self._calls.get(occupant) == self._root:
                     self._reserve(cell, out)  # a robot of our own call leaves it (a rotation, as in PIBT)
                     self._finish(True, out)
                     return
@@ -471,6 +534,28 @@ class LocalPibtRobot(PibtRobot):
             out.append(Outgoing(inherit, (occupant,)))
             return
         self._claim(here, False, out)  # no candidate left: stay
+
+    def _turns_toward(self, cell: int, occupant: int | None, out: list[Outgoing]) -> bool:
+        """Ahead-or-stay: the robot chose ``cell``, which its body does not face. Whether the call goes on elsewhere than the next candidate.
+
+        It stays, turning toward ``cell``; an occupant that has not decided is
+        first asked to leave (it may drive away now, or turn to leave next
+        step), and the robot stays once it answers (:meth:`_take_answer`). A
+        cell whose occupant comes to this robot's cell is passed by.
+        """
+        if occupant is not None and occupant != self.index and occupant not in self._final:
+            target = self._targets.get(occupant)
+            if target == self.present or target is not None:
+                self._next += 1  # it comes here, or is busy in a call: turning toward it is no use
+                return False
+            self._reserve(cell, out)
+            self._waiting = occupant
+            root, (elapsed, tie, _) = self._root, self._rank
+            inherit = CallInheritMessage(self.index, self._seq(), self.step, self.flat.cells[cell], root, elapsed, tie)
+            out.append(Outgoing(inherit, (occupant,)))
+            return True
+        self._stay_turning(cell, out)
+        return True
 
     def _claim(self, cell: int, moved: bool, out: list[Outgoing]) -> None:
         """Reserve ``cell`` (free, left for good by its occupant, or the robot's own) and end the call.

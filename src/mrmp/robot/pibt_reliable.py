@@ -124,11 +124,14 @@ class ReliablePibtRobot(LocalPibtRobot):
         turn_cost: float = 0.5,
         rng: random.Random | None = None,
         tie_penalties: bool | None = None,
+        turning: bool = False,
+        dead_end_bonus: int = 0,
         retry: int = 1,
     ) -> None:
         super().__init__(
             index, start, goal, flat, tie=tie, heading=heading, radius=radius, swap=swap,
             heading_aware=heading_aware, turn_cost=turn_cost, rng=rng, tie_penalties=tie_penalties,
+            turning=turning, dead_end_bonus=dead_end_bonus,
         )  # fmt: skip
         if retry < 1:
             raise ValueError(f"retry {retry} is below 1 tick")

@@ -92,6 +92,7 @@ from collections import Counter
 
 from mrmp.core.heading import Heading
 from mrmp.policies.pibt_rules import (
+    ahead_cell,
     heading_candidates,
     sorted_candidates,
     swap_possible,
@@ -204,6 +205,7 @@ class PibtRobot:
         self._noise = rng.random if rng is not None else None
         self.tie_penalties = rng is not None if tie_penalties is None else tie_penalties
         self.turning = turning
+        self._ahead_or_stay = turning and self.turns_by_staying
         self.dead_end_bonus = dead_end_bonus
         self.elapsed = 0
         self.step = 0
@@ -213,6 +215,8 @@ class PibtRobot:
         self.drives = False  # turning: whether the robot drives to ``target`` this step (else it stays)
         self._stays_owed: list[int] = []
         self._staying: set[int] = set()  # turning: robots that told this one they stay, this step
+        self._stay_toward = start  # turning, ahead-or-stay: the neighbour it turns toward if it stays
+        self._ahead_cell = -1  # turning: the cell ahead at the start of its call (-1: none)
         self.dropped: Counter[str] = Counter()
         # what this step's messages told the robot
         self._occupants: dict[int, int] = {}
@@ -258,6 +262,7 @@ class PibtRobot:
         self.target = None
         self.next_heading = self.heading
         self.drives = False
+        self._stay_toward = self.present
         self._stays_owed = []
         self._staying = set()
         self._waiting = self._parent = self._pulled = None
@@ -377,8 +382,11 @@ class PibtRobot:
             self.dropped["unexpected_answer"] += 1
             return
         self._waiting = None
-        if message.moved:
+        cell = self._candidates[self._next]
+        if message.moved and not (self._ahead_or_stay and cell != self._ahead_cell):
             self._finish(True, out)
+        elif self._ahead_or_stay and (message.moved or message.turns):
+            self._stay_turning(cell, out)  # it leaves, now or next step: stay, facing its cell
         else:
             self._next += 1  # backtracking: the pushed robot stays; try the next cell
             self._continue(out)
@@ -464,6 +472,8 @@ class PibtRobot:
             candidates = sorted_candidates(
                 flat.neighbours, self.present, distances, self._noise, self._settled if self.tie_penalties else None
             )
+        if self.turning:
+            self._ahead_cell = ahead_cell(flat.neighbours, self.present, int(self.heading), flat.y_size)
         self._pulled = None
         if self.swap:
             self._pulled = self._swap_partner(candidates, distances)
@@ -510,8 +520,34 @@ class PibtRobot:
                 self._targets[pulled] = here
                 out.append(Outgoing(PullMessage(self.index, self._seq(), self.step, self.flat.cell(here)), (pulled,)))
         if self._parent is not None:
-            out.append(Outgoing(AnswerMessage(self.index, self._seq(), self.step, moved), (self._parent,)))
+            turns = self._ahead_or_stay and not moved and self._stay_toward != self.present
+            out.append(Outgoing(AnswerMessage(self.index, self._seq(), self.step, moved, turns), (self._parent,)))
             self._parent = None
+
+    turns_by_staying = False
+    """With ``turning``: whether a robot's decision says at once whether it drives (the *ahead-or-stay* rule).
+
+    False (the central generator's rule): a robot reserves the neighbour it
+    chose even when it only turns toward it, and whoever reserved the cell of a
+    robot that stays hears a :class:`StayMessage` and stays too, down the
+    chain: a decision can be cancelled after it was made. True: a robot
+    decides for the cell ahead (it drives) or for its own cell (it stays,
+    turning toward the neighbour it chose, :meth:`_stay_turning`); it still
+    asks that neighbour's occupant to leave, as PIBT would, and waits for the
+    answer. Asked to leave, a robot answers "moved" when it drives away, and
+    "stays, turns to leave" (:class:`AnswerMessage`'s ``turns``) when it turns
+    toward another cell; the asker then stays behind it, facing it, and says
+    the same to its own asker: the central rule's chain of robots that stay,
+    decided before anyone decides for good. A plain "could not move" sends the
+    asker to its next cell. Local sequencing needs it, since a decision for
+    good must stay good (``docs/protocol.md``, "Planning for ``turning`` bodies").
+    """
+
+    def _stay_turning(self, toward: int, out: list[Outgoing]) -> None:
+        """Decide to stay this step, turning toward ``toward`` (ahead-or-stay rule): the call's last candidate, its own cell."""
+        self._stay_toward = toward
+        self._next = len(self._candidates)
+        self._continue(out)
 
     def _closes_cycle(self, occupant: int | None, cell: int) -> bool:
         """Whether taking ``cell`` (of ``occupant``) could close a cycle: this robot is pushed, ``occupant`` moves.
@@ -533,10 +569,11 @@ class PibtRobot:
         here, heading = self.present, int(self.heading)
         flat = self.flat
         table = flat.heading_distances(self.goal, 1.0, both_ways=True)
-        facing = turning_action(flat.neighbours, here, heading, self.target, table, flat.y_size)
+        chosen = self._stay_toward if self.turns_by_staying and self.target == here else self.target
+        facing = turning_action(flat.neighbours, here, heading, chosen, table, flat.y_size)
         self.next_heading = Heading(facing)
         self.drives = self.target != here and facing == heading and self._occupants.get(self.target) not in self._staying
-        if not self.drives and moved:  # on a failure the robot that pushed this one hears it in the answer
+        if not self.drives and moved and not self.turns_by_staying:  # on a failure the robot that pushed this one hears it in the answer
             self._tell_taker(out)
 
     def _tell_taker(self, out: list[Outgoing]) -> None:

@@ -174,10 +174,6 @@ def pibt_simulator(scenario: Scenario, on_tick: TickObserver | None = None) -> R
     'SynchronizedRoundsSimulator'
     """
     options = options_from(PibtOptions, scenario.policy)
-    if scenario.policy.body != DEFAULT_BODY and (options.sequencing, options.synchronizer) != ("driver", "clock"):
-        raise InputError(
-            Problem("policy.body", f"{scenario.policy.body} bodies run with sequencing: driver so far (not local sequencing)")
-        )
     if options.sequencing == "local":
         return STEP_ENDS[options.synchronizer](scenario, on_tick=on_tick)
     if options.synchronizer != "clock":
