@@ -34,8 +34,15 @@ one machine.
 synchronizer (each ends its step when its neighbours are done) instead of the
 common clock; the simulator's makespan stays that of the clock's lockstep.
 
+``--body turning`` runs bodies that turn in place (``mrmp.core.body``): the
+live robots and the simulator plan in that body's model, a step is one action
+(a cell or a quarter turn, one cell time), and the execution bound is
+:func:`mrmp.centralized.body_time.execution_seconds` of the simulator's cells
+and headings as live bodies drive them (a robot enters a cell once its occupant
+has arrived elsewhere).
+
 Usage: python bench/live_pibt.py [--cases udp24,zenoh24,udp64,side] [--time-scale 2] [--before REV]
-       [--synchronizer clock|local]
+       [--synchronizer clock|local] [--body omni|turning]
 """
 
 from __future__ import annotations
@@ -52,7 +59,9 @@ import time
 from io import BytesIO
 from pathlib import Path
 
+from mrmp.centralized.body_time import execution_seconds
 from mrmp.core import Cell, NetworkFaults, PolicyOptions, RobotSpec, Scenario
+from mrmp.core.body import DEFAULT_BODY, body_model
 from mrmp.core.heading import Heading, right_turns
 from mrmp.core.result import RunResult
 from mrmp.io.scenario_file import load_scenario
@@ -66,13 +75,16 @@ EXAMPLE = ROOT / "examples" / "causal-32.yaml"
 
 SYNCHRONIZER = "clock"
 """``--synchronizer``: how the live ``pibt`` robots end their steps (``clock`` or ``local``)."""
+BODY = DEFAULT_BODY
+"""``--body``: the body model the robots plan for and drive."""
 
 
 def pibt_policy(policy: str = "pibt") -> PolicyOptions:
-    """The policy of a live case: ``pibt`` with the chosen synchronizer, or ``policy`` with its defaults."""
-    if policy == "pibt" and SYNCHRONIZER != "clock":  # named only when not the default: --before runs older code
-        return PolicyOptions(name=policy, synchronizer=SYNCHRONIZER)
-    return PolicyOptions(name=policy)
+    """The policy of a live case: ``pibt`` with the chosen synchronizer and body, or ``policy`` with its defaults."""
+    named = {"synchronizer": SYNCHRONIZER} if policy == "pibt" and SYNCHRONIZER != "clock" else {}
+    if BODY != DEFAULT_BODY:  # named only when not the default: --before runs older code
+        named.update(body=BODY, swap=False)
+    return PolicyOptions(name=policy, **named)
 
 
 def example(count: int | None = None, policy: str = "pibt") -> Scenario:
@@ -93,10 +105,15 @@ def drawn(count: int, seed: int = 0) -> Scenario:
     return scenario.with_changes(robots=robots, policy=pibt_policy(), name=f"drawn-{count}")
 
 
+def simulated(scenario: Scenario) -> RunResult:
+    """``scenario`` run by ``pibt`` with local sequencing over a perfect network, for the run's body."""
+    policy = PolicyOptions(name="pibt", sequencing="local", body=BODY, swap=BODY == DEFAULT_BODY)
+    return LocalRoundsSimulator(scenario.with_changes(policy=policy, network=NetworkFaults())).run()
+
+
 def simulated_makespan(scenario: Scenario) -> int:
     """The makespan in ticks of ``pibt`` with local sequencing over a perfect network."""
-    local = scenario.with_changes(policy=PolicyOptions(name="pibt", sequencing="local"), network=NetworkFaults())
-    result = LocalRoundsSimulator(local).run()
+    result = simulated(scenario)
     return result.makespan if result.success else -1
 
 
@@ -122,6 +139,12 @@ def execution_bound(scenario: Scenario, time_scale: float) -> float:
     takes (right turns, then one cell; a body covers both cells until it
     arrives). No live execution of those decisions can end sooner.
     """
+    if BODY != DEFAULT_BODY:
+        run = simulated(scenario)
+        starts = [robot.heading for robot in scenario.robots]
+        headings = [robot.headings for robot in run.robots]
+        cells = [robot.path for robot in run.robots]
+        return execution_seconds(cells, starts, scenario.timing, time_scale, body_model(BODY), headings, follows=False)
     local = scenario.with_changes(policy=PolicyOptions(name="pibt", sequencing="local"), network=NetworkFaults())
     paths: list[list[Cell]] = [list(robot.path) for robot in LocalRoundsSimulator(local).run().robots]
     length = max(len(path) for path in paths)
@@ -180,6 +203,8 @@ def run_before(source: Path, case: str, revision: str, time_scale: float) -> Non
     command = [sys.executable, __file__, "--cases", case, "--time-scale", str(time_scale), "--label", f"before ({revision})"]
     if SYNCHRONIZER != "clock":  # named only when not the default, as for the policy
         command += ["--synchronizer", SYNCHRONIZER]
+    if BODY != DEFAULT_BODY:
+        command += ["--body", BODY]
     subprocess.run(command, env=environment, check=True)
 
 
@@ -199,7 +224,7 @@ def row(label: str, scenario: Scenario, transport: str, loss: float, time_scale:
     else:
         sim_text, ratio = "-", "-"
     print(
-        f"{label}: {scenario.policy.name}{steps} {len(scenario.robots)} robots over {transport}, loss {loss:.0%}, "
+        f"{label}: {scenario.policy.name}{steps} {len(scenario.robots)} {scenario.policy.body} robots over {transport}, loss {loss:.0%}, "
         f"time scale {time_scale:g} (cell {cell:.2f} s): arrived {arrived}/{len(scenario.robots)}, "
         f"collisions {len(result.collisions)}, wall makespan {result.time_makespan_s:.2f} s, "
         f"simulator {sim_text}, ratio {ratio}, ideal {result.ideal_makespan_s or 0:.2f} s "
@@ -218,10 +243,12 @@ def main() -> int:
     parser.add_argument("--time-scale", type=float, default=2.0)
     parser.add_argument("--before", metavar="REV", help="run every case first with the code of git revision REV")
     parser.add_argument("--synchronizer", choices=("clock", "local"), default="clock", help="how live pibt robots end steps")
+    parser.add_argument("--body", choices=("omni", "turning"), default=DEFAULT_BODY, help="the body model")
     parser.add_argument("--label", default="", help=argparse.SUPPRESS)
     arguments = parser.parse_args()
-    global SYNCHRONIZER
+    global SYNCHRONIZER, BODY
     SYNCHRONIZER = arguments.synchronizer
+    BODY = arguments.body
     scale = arguments.time_scale
     source = export_source(arguments.before) if arguments.before else None
     for name in arguments.cases.split(","):

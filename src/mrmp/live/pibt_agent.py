@@ -69,10 +69,12 @@ from collections.abc import Callable
 from dataclasses import dataclass
 from typing import TypeVar
 
+from mrmp.core.body import body_model
 from mrmp.core.cell import Cell
+from mrmp.core.heading import Heading
 from mrmp.core.scenario import Scenario
 from mrmp.core.seeds import Stream, stream_random
-from mrmp.live.body import Body
+from mrmp.live.body import Body, TurnsInPlace
 from mrmp.live.driver import AgentTiming, LiveDriver, fleet_wide
 from mrmp.live.transport import Transport
 from mrmp.protocol.auth import OVERHEAD, TAG_BYTES, Opener, Sealer
@@ -87,6 +89,7 @@ from mrmp.protocol.messages import (
     ReplyMessage,
     StateMessage,
 )
+from mrmp.policies.pibt_rules import DEAD_END_BONUS
 from mrmp.protocol.pibt_local import CallAckMessage
 from mrmp.protocol.safety import SafetyLayer
 from mrmp.robot.messaging import Outgoing
@@ -202,13 +205,17 @@ class PibtBrain:
         self.timing = timing
         self.synchronized = options.synchronizer == "local"
         """Whether the robot ends its steps itself (``synchronizer: local``) instead of on the common clock."""
+        self.turning = body_model(options.body).turns_in_place
+        """Whether the body turns in place (``turning``): the brain plans its turns, and the queue holds them."""
         brain_type = SynchronizedPibtRobot if self.synchronized else LivePibtRobot
         self.robot: LivePibtRobot = brain_type(
             index, start, goal, flat,
             tie=int(distance) if distance != math.inf else 0,
             heading=spec.heading,
             radius=options.radius,
-            swap=options.swap,
+            swap=options.swap and not self.turning,
+            turning=self.turning,
+            dead_end_bonus=DEAD_END_BONUS if self.turning else 0,
             heading_aware=options.heading_aware,
             turn_cost=scenario.timing.turn_time / scenario.timing.cell_time,
             rng=stream_random(scenario.seed, Stream.TIES, index),
@@ -219,8 +226,9 @@ class PibtBrain:
             index, [robot.start for robot in scenario.robots], claim_timeout=math.inf, retry_interval=claim_retry
         )
         self.dropped = self.robot.dropped
-        self.queue: list[Cell] = []
-        """Cells decided and not yet entered, in order (the first is claimed once the body stands still)."""
+        self.queue: list[Cell | Heading] = []
+        """Actions decided and not yet begun, in order: a cell to enter (claimed first, once the body stands
+        still) or, for a body that turns in place, a heading to turn to."""
         self.moving = False
         self.moves: list[tuple[int, Cell]] = []
         """Every step's decided cell, as ``(step, cell)`` (the brain's path)."""
@@ -309,7 +317,7 @@ class PibtBrain:
         """Begin the next step, held while a queued move is not granted; the brain acts on it at its next run."""
         self.step += 1
         self._began = now
-        out.extend(self.robot.begin_step(self.step, now=self._ms(now), held=bool(self.queue)))
+        out.extend(self.robot.begin_step(self.step, now=self._ms(now), held=self._move_queued()))
         self._deciding = True
         self._act = True
 
@@ -320,8 +328,12 @@ class PibtBrain:
             if now - heard_at > self.crash_after and peer not in robot.crashed:
                 robot.crash(peer)
 
+    def _move_queued(self) -> bool:
+        """Whether a move (not a turn) waits in the queue: the robot is held until its claim is granted."""
+        return any(not isinstance(action, Heading) for action in self.queue)
+
     def _queue_decided(self) -> None:
-        """The robot decided for good: its move is queued now, before the decision phase ends (it cannot change)."""
+        """The robot decided for good: its move or turn is queued now, before the decision phase ends (it cannot change)."""
         robot = self.robot
         assert robot.target is not None
         self._decided = robot.target
@@ -329,26 +341,38 @@ class PibtBrain:
             cell = self.flat.cells[robot.target]
             self.queue.append(cell)
             self.moves.append((self.step, cell))
+        elif self.turning and robot.next_heading != robot.heading:
+            self.queue.append(robot.next_heading)
 
     def _finish_step(self) -> None:
         self._deciding = False
         robot = self.robot
         decided, self._decided = self._decided, None
-        before = robot.present
+        before, heading = robot.present, robot.heading
         after = robot.finish_step()
         assert decided is None or decided == after, "a robot's decision for good changed"
         if decided is None and after != before:
             cell = self.flat.cells[after]
             self.queue.append(cell)
             self.moves.append((self.step, cell))
+        elif decided is None and robot.heading != heading:
+            self.queue.append(robot.heading)
 
     # -- the body ---------------------------------------------------------------------------
 
-    def motion(self, now: float) -> tuple[Cell | None, list[Outgoing]]:
-        """The cell the standing body may start entering now (its claim won), if any, and the claims to send."""
+    def motion(self, now: float) -> tuple[Cell | Heading | None, list[Outgoing]]:
+        """What the standing body may start now, if anything, and the claims to send.
+
+        A cell to enter, once its claim won; or a heading to turn to in place,
+        at once (the body stays on the cell it owns).
+        """
         if self.moving or not self.queue:
             return None, []
         safety, cell = self.safety, self.queue[0]
+        if isinstance(cell, Heading):
+            self.queue.pop(0)
+            self.moving = True
+            return cell, []
         if safety.pending is None or safety.pending.cell != cell:
             if now - self._claimed_at < safety.retry_interval:
                 return None, []  # refused a moment ago: claim again after the retry interval
@@ -362,7 +386,7 @@ class PibtBrain:
         safety.begin_move(cell)
         self.queue.pop(0)
         self.moving = True
-        if not self.queue:
+        if not self._move_queued():
             self.robot.release()
             self._act = True
         return cell, []
@@ -370,6 +394,10 @@ class PibtBrain:
     def arrived_at(self, cell: Cell) -> None:
         """The body stands on ``cell``: the cell it left is released."""
         self.safety.end_move(cell)
+        self.moving = False
+
+    def turned(self) -> None:
+        """The body ended its turn in place."""
         self.moving = False
 
     @property
@@ -465,12 +493,14 @@ class PibtAgent(LiveDriver):
     ) -> None:
         timing = dataclasses.replace(timing, poll=max(timing.poll, POLL))
         super().__init__(scenario, index, transport, body, sealer, opener, timing, seed, clock)
-        turn_seconds = scenario.timing.turn_time / scenario.timing.cell_time * self.cell_seconds
+        turns_in_place = body_model(scenario.policy.body).turns_in_place  # a turn is a step of its own
+        turn_seconds = 0.0 if turns_in_place else scenario.timing.turn_time / scenario.timing.cell_time * self.cell_seconds
         self.pibt_timing = pibt if pibt is not None else PibtTiming.for_body(self.cell_seconds, turn_seconds)
         self.robot = PibtBrain(
             scenario, index, self.pibt_timing, claim_retry=min(timing.claim_retry, 0.05),
             crash_after=2 * timing.give_up_after,
         )  # fmt: skip
+        self._turning = False  # the body's action in progress is a turn in place
 
     # -- what the driver reads of the brain --------------------------------------------------
 
@@ -523,11 +553,20 @@ class PibtAgent(LiveDriver):
         brain, body = self.robot, self.body
         if body.moving:
             if body.poll(now):
-                brain.arrived_at(body.cell)
-                self._record_move(now, started, brain.settled)
+                if self._turning:
+                    self._turning = False
+                    brain.turned()
+                else:
+                    brain.arrived_at(body.cell)
+                    self._record_move(now, started, brain.settled)
         else:
-            target, out = brain.motion(now)
+            action, out = brain.motion(now)
             self._send(out)
-            if target is not None:
-                body.start_move(target, now)
+            if isinstance(action, Heading):
+                if not isinstance(body, TurnsInPlace):
+                    raise TypeError(f"robot {self.index}: its brain plans turns in place, its body cannot make them")
+                body.start_turn(action, now)
+                self._turning = True
+            elif action is not None:
+                body.start_move(action, now)
         return False

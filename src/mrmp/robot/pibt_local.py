@@ -245,6 +245,10 @@ class LocalPibtRobot(PibtRobot):
     Never for bodies that turn in place (``turning``): they follow one another but may not rotate.
     """
 
+    def _may_rotate(self) -> bool:
+        """Whether the robot may take the cell of a robot busy in its own call (:attr:`rotations`, never when ``turning``)."""
+        return self.rotations and not self.turning
+
     turns_by_staying = True
     """Bodies that turn in place decide for the cell ahead or their own (:attr:`PibtRobot.turns_by_staying`):
     a decision for good is never cancelled by a robot that turns."""
@@ -344,10 +348,7 @@ class LocalPibtRobot(PibtRobot):
             self._lost = False
             self.stats["withdrawn"] += 1
             self._finishing = None
-            if self._waiting is not None:
-                self._withdrawn = True  # the robot it asked may be deciding in its call: its answer comes first
-            else:
-                self._next_cell(out)
+            self._withdraw(out)
         elif not self._confirmed and self._may_confirm():
             self._confirmed = True
             if self._finishing is not None:
@@ -374,6 +375,13 @@ class LocalPibtRobot(PibtRobot):
             else:
                 self.stats["waits"] += 1
         return out
+
+    def _withdraw(self, out: list[Outgoing]) -> None:
+        """The reservation lost to a call of higher priority: the next cell, once the robot asked for it (if any) answered."""
+        if self._waiting is not None:
+            self._withdrawn = True  # the robot it asked may be deciding in its call: its answer comes first
+        else:
+            self._next_cell(out)
 
     def _next_cell(self, out: list[Outgoing]) -> None:
         """The reservation lost to a call of higher priority: try the next cell."""
@@ -510,9 +518,6 @@ class LocalPibtRobot(PibtRobot):
                 if occupant is not None and targets.get(occupant) == here:
                     self._next += 1  # would swap
                     continue
-                if self.turning and self._closes_cycle(occupant, cell):
-                    self._next += 1  # pushed, behind a robot that drives on: it could close a cycle
-                    continue
                 self._claim(cell, True, out)
                 return
             target = targets.get(occupant)
@@ -520,7 +525,7 @@ class LocalPibtRobot(PibtRobot):
                 self._next += 1  # the occupant moves into our cell: taking its cell would swap
                 continue
             if target is not None:
-                if self.rotations and not self.turning and self._calls.get(occupant) == self._root:
+                if self._may_rotate() and self._calls.get(occupant) == self._root:
                     self._reserve(cell, out)  # a robot of our own call leaves it (a rotation, as in PIBT)
                     self._finish(True, out)
                     return

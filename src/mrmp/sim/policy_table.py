@@ -113,6 +113,8 @@ class PolicyEntry:
     bodies:
         The body models (:mod:`mrmp.core.body`) its robots plan for and its
         simulator drives.
+    live_bodies:
+        The body models its live driver drives.
     """
 
     name: str
@@ -127,6 +129,7 @@ class PolicyEntry:
     always_guarded: bool = False
     records_messages: bool = False
     bodies: tuple[str, ...] = (DEFAULT_BODY,)
+    live_bodies: tuple[str, ...] = (DEFAULT_BODY,)
 
     @property
     def per_robot(self) -> bool:
@@ -219,6 +222,7 @@ POLICY_TABLE: dict[str, PolicyEntry] = {
             " (no driver can order live processes; sequencing: driver is the simulator's)"
         ),
         bodies=(DEFAULT_BODY, "turning"),
+        live_bodies=(DEFAULT_BODY, "turning"),
     ),
     "causal": PolicyEntry(
         "causal",
@@ -268,17 +272,19 @@ def body_problem(scenario: Scenario, *, live: bool = False, planned: bool = Fals
     """Why ``scenario``'s robots cannot run in its body model this way, or None when they can.
 
     A policy runs the bodies of its entry's :attr:`~PolicyEntry.bodies`, in
-    the simulator; a central plan is executed by every body of
-    :data:`EXECUTING_BODIES`, in the simulator and live; the live drivers of
-    the message-based policies drive ``omni`` bodies only so far.
+    the simulator, and those of its :attr:`~PolicyEntry.live_bodies` live; a
+    central plan is executed by every body of :data:`EXECUTING_BODIES`, in
+    the simulator and live.
 
     >>> from mrmp.core import Grid, RobotSpec
     >>> robots = (RobotSpec("A", (0, 0), (0, 1)),)
     >>> turning = Scenario(Grid(1, 2), robots, policy=PolicyOptions(name="pibt", body="turning", sequencing="driver"))
     >>> body_problem(turning) is None
     True
-    >>> print(body_problem(turning, live=True))
-    policy.body: pibt drives omni bodies live so far, not turning
+    >>> body_problem(turning, live=True) is None
+    True
+    >>> print(body_problem(turning.with_changes(policy=PolicyOptions(name="causal", body="turning")), live=True))
+    policy.body: causal drives omni bodies live so far, not turning
     >>> body_problem(turning, live=True, planned=True) is None
     True
     >>> print(body_problem(turning.with_changes(policy=PolicyOptions(name="astar", body="turning"))))
@@ -292,8 +298,8 @@ def body_problem(scenario: Scenario, *, live: bool = False, planned: bool = Fals
             return None
         return Problem("policy.body", f"central plans are executed by {', '.join(EXECUTING_BODIES)} bodies, not {body}")
     entry = policy_entry(scenario.policy.name)
-    if live:
-        return Problem("policy.body", f"{entry.name} drives {DEFAULT_BODY} bodies live so far, not {body}")
+    if live and body not in entry.live_bodies:
+        return Problem("policy.body", f"{entry.name} drives {', '.join(entry.live_bodies)} bodies live so far, not {body}")
     if body not in entry.bodies:
         return Problem("policy.body", f"{entry.name} plans for {', '.join(entry.bodies)} bodies, not {body}")
     return None
