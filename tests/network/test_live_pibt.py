@@ -6,6 +6,7 @@ simulator running the same brain (:class:`~mrmp.sim.live_rounds.LiveRoundsSimula
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 import signal
@@ -19,6 +20,7 @@ from test_live_interrupt import fleet_started, processes_mentioning
 from test_orphans import children, kill, left_running, wait_for
 
 from mrmp.core import Grid, PolicyOptions, RobotSpec, Scenario, Timing
+from mrmp.core.heading import Heading
 from mrmp.live.launcher import LiveOptions, run_live
 from mrmp.live.transport import LiveFaults
 from mrmp.live.transport_entry import free_ports
@@ -104,7 +106,7 @@ def test_a_live_fleet_moves_as_the_simulator_running_the_same_brain(tmp_path):
     assert counts.get("abandoned", 0) == 0 and counts.get("gave_up", 0) == 0, counts
     for index, robot in enumerate(simulated.robots):
         report = json.loads((results / f"agent-{index}.json").read_text())
-        assert distinct(cell for _, cell in report["believed_path"]) == distinct(robot.path), robot.robot_id
+        assert distinct(cell for _, cell in report["believed_path"]) == distinct(robot.path), robot.id
 
 
 def test_a_live_fleet_that_ends_its_own_steps_moves_as_the_simulator_running_the_same_brain(tmp_path):
@@ -120,7 +122,7 @@ def test_a_live_fleet_that_ends_its_own_steps_moves_as_the_simulator_running_the
     assert pibt_counts(live)["ahead"] > 0  # the robots were in steps of their own
     for index, robot in enumerate(simulated.robots):
         report = json.loads((results / f"agent-{index}.json").read_text())
-        assert distinct(cell for _, cell in report["believed_path"]) == distinct(robot.path), robot.robot_id
+        assert distinct(cell for _, cell in report["believed_path"]) == distinct(robot.path), robot.id
 
 
 def test_mrmp_agent_runs_a_pibt_robot(tmp_path):
@@ -209,3 +211,26 @@ def test_a_killed_robot_is_taken_for_crashed_and_the_robots_it_does_not_block_ar
     assert result.collisions == []
     assert [robot.arrived for robot in result.robots] == [True, True, False]
     assert pibt_counts(result)["crashed"] >= 2  # a and b each took c for crashed
+
+
+def turning_crossing(robots: tuple[RobotSpec, ...] = CROSS, **policy) -> Scenario:
+    """:func:`crossing` for bodies that turn in place (each a quarter turn per cell time), every robot facing EAST."""
+    headed = tuple(dataclasses.replace(robot, heading=Heading.EAST) for robot in robots)
+    options = PolicyOptions(name="pibt", body="turning", swap=False, **policy)
+    return crossing(robots=headed).with_changes(policy=options)
+
+
+def test_robots_that_turn_in_place_cross_over_lossy_udp(tmp_path):
+    """``body: turning``: the robots plan their quarter turns, and their bodies make exactly those, one at a time."""
+    robots = (*CROSS, RobotSpec("e", (0, 0), (4, 4)))
+    faults = LiveFaults(loss=0.2, delay_min=0.0, delay_max=0.01, duplicate=0.1)
+    for synchronizer in ("clock", "local"):
+        results = tmp_path / synchronizer
+        scenario = turning_crossing(robots, synchronizer=synchronizer)
+        result = run_live(scenario, LiveOptions(results=results, time_scale=10, faults=faults, seed=2))
+        assert result.collisions == [] and result.success, (synchronizer, result.stop_reason)
+        assert result.network["safety_granted"] == result.network["moves"]
+        for index in range(len(robots)):
+            report = json.loads((results / f"agent-{index}.json").read_text())
+            assert report["turns"] > 0 or index == 0  # robot a faces its goal from the start
+

@@ -223,7 +223,11 @@ class PibtBrain:
             starts=[flat.index(robot.start) for robot in scenario.robots],
         )  # fmt: skip
         self.safety = SafetyLayer(
-            index, [robot.start for robot in scenario.robots], claim_timeout=math.inf, retry_interval=claim_retry
+            index,
+            [robot.start for robot in scenario.robots],
+            claim_timeout=math.inf,
+            retry_interval=claim_retry,
+            waits_for_release=True,
         )
         self.dropped = self.robot.dropped
         self.queue: list[Cell | Heading] = []
@@ -448,7 +452,8 @@ class PibtBrain:
         if isinstance(message, ReplyMessage):
             return self._stamped(safety.handle_reply(message, now))
         if isinstance(message, ReleaseMessage):
-            return [Outgoing(self._stamp(safety.handle_release(message)), (sender,))]
+            acknowledgement = Outgoing(self._stamp(safety.handle_release(message)), (sender,))
+            return [acknowledgement, *self._stamped(safety.take_granted_on_release())]
         if isinstance(message, ReleaseAckMessage):
             safety.handle_release_ack(message)
             return []

@@ -212,6 +212,17 @@ class SafetyLayer:
         releases it, and its robot sends it no more, until it gives it up for
         another decision (``docs/protocol.md``, "A quiet fleet on a perfect network"). For a perfect
         network: a grant that is lost would leave it waiting.
+    waits_for_release:
+        Live bodies (no ``following``), any network: a claim refused by
+        replicas still holding the cell's last owner is not given up but
+        *waits*: its replicas keep it as refused and grant it the moment the
+        owner's release drops their record (the grant goes with the release's
+        acknowledgement, :meth:`take_granted_on_release`), and its robot sends
+        it again every ``retry_interval`` to the replicas that have not granted
+        it, in case a grant was lost; it is given up only when the robot gives
+        it up (``docs/protocol.md``, "Claims that wait for a release"). A robot
+        that follows another into its cell then starts as soon as the leader's
+        release is in, not a retry later.
     """
 
     def __init__(
@@ -225,6 +236,7 @@ class SafetyLayer:
         following: bool = False,
         resend_refused: bool = True,
         keep_refused: bool = False,
+        waits_for_release: bool = False,
     ) -> None:
         self.index = index
         self.fleet_size = len(starts)
@@ -236,6 +248,7 @@ class SafetyLayer:
         self.following = following
         self.resend_refused = resend_refused
         self.keep_refused = keep_refused and following
+        self.waits_for_release = waits_for_release and not following
         self.present_handed_off = False
         self.present: Cell = starts[index]
         self.present_claim = 0
@@ -388,6 +401,14 @@ class SafetyLayer:
                 if not pending.standing:
                     self.stats.refused += 1
                     pending.standing = True
+            elif self._lost(pending) and self.waits_for_release:
+                if not pending.standing:
+                    self.stats.refused += 1
+                    pending.standing = True  # it waits for the release, sent again to those that refused
+                if now - pending.sent_at >= self.retry_interval:
+                    pending.sent_at = now
+                    missing = tuple(replica for replica in self.claim_recipients(pending.cell) if replica not in pending.votes)
+                    sends.append((ClaimMessage(self.index, 0, pending.number, pending.cell), missing))
             elif self._lost(pending):
                 self.stats.refused += 1
                 self.cancel_claim()
@@ -499,7 +520,7 @@ class SafetyLayer:
             self._registry[cell] = _Registration(sender, message.claim)  # only newer claims get here
             self.stats.grants_given += 1
             return ReplyMessage(self.index, 0, sender, message.claim, cell, True)
-        if self.following:
+        if self.following or self.waits_for_release:
             self._deferred.setdefault(cell, {})[sender] = message.claim  # granted if the owner hands the cell off
         self.stats.refusals_given += 1
         return ReplyMessage(self.index, 0, sender, message.claim, cell, False)
@@ -617,7 +638,7 @@ class SafetyLayer:
         registration = self._registry.get(cell)
         if registration is not None and registration.owner == sender and registration.claim <= message.claim:
             del self._registry[cell]
-            if self.keep_refused:
+            if self.keep_refused or self.waits_for_release:
                 self.granted_on_release = self._grant_deferred(cell)
             else:
                 self._deferred.pop(cell, None)

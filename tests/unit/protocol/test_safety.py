@@ -33,8 +33,9 @@ def neighbours(cell):
 class Node:
     """A robot reduced to its safety layer, with a body that moves when allowed."""
 
-    def __init__(self, index, starts):
-        self.layer = SafetyLayer(index, starts, claim_timeout=400, retry_interval=60)
+    def __init__(self, index, starts, waits=False):
+        """``waits``: refused claims wait for releases (``waits_for_release``), as live ``pibt`` robots' do."""
+        self.layer = SafetyLayer(index, starts, claim_timeout=400, retry_interval=60, waits_for_release=waits)
         self.index = index
         self.seq = 0
         self.crashed = False
@@ -89,6 +90,7 @@ class Adversary:
             layer.handle_reply(message, 0)
         elif isinstance(message, ReleaseMessage):
             self.send(target, layer.handle_release(message), (message.sender,))
+            self.send_all(target, layer.take_granted_on_release())
         elif isinstance(message, ReleaseAckMessage):
             layer.handle_release_ack(message)
 
@@ -125,11 +127,11 @@ def assert_disjoint(nodes, now):
             assert not covered[i] & covered[j], f"step {now}: robots {i} and {j} both cover {covered[i] & covered[j]}"
 
 
-def run(seed, robots, steps, oldest_first=False):
+def run(seed, robots, steps, oldest_first=False, waits=False):
     rng = random.Random(seed)
     cells = [(x, y) for x in range(SIZE) for y in range(SIZE)]
     starts = rng.sample(cells, robots)
-    nodes = [Node(i, starts) for i in range(robots)]
+    nodes = [Node(i, starts, waits) for i in range(robots)]
     adversary = Adversary(nodes, rng, oldest_first)
     moves = 0
     for now in range(steps):
@@ -189,12 +191,12 @@ def stale_registrations(nodes):
     return stale
 
 
-def run_then_settle(seed, robots, steps=800):
+def run_then_settle(seed, robots, steps=800, waits=False):
     """A lossy, duplicating adversary for ``steps`` events (no crash), then a fair network: the stale registrations."""
     rng = random.Random(seed)
     cells = [(x, y) for x in range(SIZE) for y in range(SIZE)]
     starts = rng.sample(cells, robots)
-    nodes = [Node(i, starts) for i in range(robots)]
+    nodes = [Node(i, starts, waits) for i in range(robots)]
     adversary = Adversary(nodes, rng)
     for now in range(steps):
         node = rng.choice(nodes)
@@ -343,3 +345,66 @@ def test_the_adversary_catches_unsafe_variants(variant, monkeypatch):
 def test_the_liveness_check_catches_releases_sent_to_the_wrong_replicas(monkeypatch):
     monkeypatch.setattr(sys.modules[__name__], "SafetyLayer", ReleaseToWrongReplicas)
     assert any(run_then_settle(seed, robots=5) for seed in range(30))
+
+
+# -- claims that wait for a release ------------------------------------------------------------
+
+
+class GrantOnAnyRelease(SafetyLayer):
+    """Grants a waiting claim on every release of the cell, even one that leaves a newer registration in place."""
+
+    def handle_release(self, message):
+        acknowledgement = super().handle_release(message)
+        if not self.granted_on_release and message.cell in self._registry:
+            del self._registry[message.cell]
+            self.granted_on_release = self._grant_deferred(message.cell)
+        return acknowledgement
+
+
+@settings(max_examples=300, derandomize=True, deadline=None)
+@given(seed=st.integers(0, 10**9), robots=st.integers(2, 7))
+def test_no_overlap_when_refused_claims_wait_for_releases(seed, robots):
+    run(seed, robots, steps=1500, waits=True)
+    run(seed, robots, steps=1500, oldest_first=True, waits=True)
+
+
+def test_waiting_claims_still_move_and_leave_no_stale_registration():
+    assert sum(run(seed, 6, 1500, waits=True) for seed in range(10)) >= 20
+    assert all(run_then_settle(seed, robots=5, waits=True) == [] for seed in range(20))
+
+
+def test_the_adversary_catches_a_grant_on_a_release_that_dropped_nothing(monkeypatch):
+    monkeypatch.setattr(sys.modules[__name__], "SafetyLayer", GrantOnAnyRelease)
+    caught = 0
+    for seed in range(40):
+        try:
+            run(seed, 5, 1500, waits=True)
+        except AssertionError:
+            caught += 1
+    assert caught > 0
+
+
+def test_a_refused_claim_waits_and_is_granted_with_the_release_of_the_cell():
+    """Robot 0 claims robot 1's cell: refused; robot 1 leaves and releases it: the replicas grant at once."""
+    cell = next((0, y) for y in range(1, 9) if 0 not in replica_set((0, y), 5))  # robot 0 is none of its replicas
+    starts = [(0, 0), cell, (3, 3), (4, 4), (5, 5)]
+    layers = [SafetyLayer(index, starts, retry_interval=1.0, waits_for_release=True) for index in range(5)]
+    first, leader = layers[0], layers[1]
+    claim = first.start_claim(cell, now=0.0)
+    replies = [layers[replica].handle_claim(claim, claimant_outranks=False) for replica in first.claim_recipients(cell)]
+    for reply in replies:
+        first.handle_reply(reply, now=0.0)
+    assert not first.may_enter(cell)
+    assert first.expire(now=0.5) == [] and first.pending is not None  # refused: it waits, neither given up nor resent yet
+    assert [type(message).__name__ for message, _ in first.expire(now=1.5)] == ["ClaimMessage"]  # sent again, grants lost
+    leader.begin_move((1, cell[1]))  # unguarded here: the test is about the cell it leaves
+    leader.end_move((1, cell[1]))
+    grants = []
+    for message, recipients in leader.expire(now=2.0):
+        for replica in recipients:
+            layers[replica].handle_release(message)
+            grants.extend(message for message, _ in layers[replica].take_granted_on_release())
+    assert len(grants) == 2  # the replicas the release reached grant on it, with no claim sent again: a majority
+    for grant in grants:
+        first.handle_reply(grant, now=2.0)
+    assert first.may_enter(cell)
