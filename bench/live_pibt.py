@@ -81,10 +81,12 @@ BODY = DEFAULT_BODY
 
 def pibt_policy(policy: str = "pibt") -> PolicyOptions:
     """The policy of a live case: ``pibt`` with the chosen synchronizer and body, or ``policy`` with its defaults."""
-    named = {"synchronizer": SYNCHRONIZER} if policy == "pibt" and SYNCHRONIZER != "clock" else {}
-    if BODY != DEFAULT_BODY:  # named only when not the default: --before runs older code
-        named.update(body=BODY, swap=False)
-    return PolicyOptions(name=policy, **named)
+    synchronizer = SYNCHRONIZER if policy == "pibt" else "clock"
+    if BODY != DEFAULT_BODY:
+        return PolicyOptions(name=policy, synchronizer=synchronizer, body=BODY, swap=False)
+    if synchronizer != "clock":  # named only when not the default: --before runs older code
+        return PolicyOptions(name=policy, synchronizer=synchronizer)
+    return PolicyOptions(name=policy)
 
 
 def example(count: int | None = None, policy: str = "pibt") -> Scenario:
@@ -224,7 +226,8 @@ def row(label: str, scenario: Scenario, transport: str, loss: float, time_scale:
     else:
         sim_text, ratio = "-", "-"
     print(
-        f"{label}: {scenario.policy.name}{steps} {len(scenario.robots)} {scenario.policy.body} robots over {transport}, loss {loss:.0%}, "
+        f"{label}: {scenario.policy.name}{steps} {len(scenario.robots)} {scenario.policy.body} robots over {transport}, "
+        f"loss {loss:.0%}, "
         f"time scale {time_scale:g} (cell {cell:.2f} s): arrived {arrived}/{len(scenario.robots)}, "
         f"collisions {len(result.collisions)}, wall makespan {result.time_makespan_s:.2f} s, "
         f"simulator {sim_text}, ratio {ratio}, ideal {result.ideal_makespan_s or 0:.2f} s "

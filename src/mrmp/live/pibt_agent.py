@@ -77,6 +77,7 @@ from mrmp.core.seeds import Stream, stream_random
 from mrmp.live.body import Body, TurnsInPlace
 from mrmp.live.driver import AgentTiming, LiveDriver, fleet_wide
 from mrmp.live.transport import Transport
+from mrmp.policies.pibt_rules import DEAD_END_BONUS
 from mrmp.protocol.auth import OVERHEAD, TAG_BYTES, Opener, Sealer
 from mrmp.protocol.codec import DecodeError, decode
 from mrmp.protocol.messages import (
@@ -89,7 +90,6 @@ from mrmp.protocol.messages import (
     ReplyMessage,
     StateMessage,
 )
-from mrmp.policies.pibt_rules import DEAD_END_BONUS
 from mrmp.protocol.pibt_local import CallAckMessage
 from mrmp.protocol.safety import SafetyLayer
 from mrmp.robot.messaging import Outgoing

@@ -49,6 +49,14 @@ then acts):
 6. at the end of the step a robot moves if it has decided *finally*; one that
    has not (it did not finish in time) stays and counts an abandoned step.
 
+**Bodies that turn in place** (``turning``) follow the *ahead-or-stay* rule
+(:attr:`~mrmp.robot.pibt_robot.PibtRobot.turns_by_staying`): a robot decides
+for the cell ahead or for its own, turning toward the neighbour it chose,
+after asking that neighbour's occupant to leave; an answer says the robot
+asked drives away, turns to leave (its asker stays behind it), or cannot. No
+decision for good is cancelled afterwards, and calls do not rotate
+(``docs/protocol.md``, "Planning for ``turning`` bodies").
+
 Counted by the robot itself (:attr:`LocalPibtRobot.stats`): ``waits`` (times
 it looked at the start rule and could not start yet; a waiting robot looks
 again only once no robot it waits for is left), ``withdrawn`` (reservations lost to a call
@@ -541,16 +549,16 @@ class LocalPibtRobot(PibtRobot):
         self._claim(here, False, out)  # no candidate left: stay
 
     def _turns_toward(self, cell: int, occupant: int | None, out: list[Outgoing]) -> bool:
-        """Ahead-or-stay: the robot chose ``cell``, which its body does not face. Whether the call goes on elsewhere than the next candidate.
+        """Ahead-or-stay: the robot chose ``cell``, which its body does not face; False when it passes the cell by.
 
         It stays, turning toward ``cell``; an occupant that has not decided is
         first asked to leave (it may drive away now, or turn to leave next
         step), and the robot stays once it answers (:meth:`_take_answer`). A
-        cell whose occupant comes to this robot's cell is passed by.
+        cell whose occupant comes to this robot's cell, or is busy in a call, is
+        passed by (the next candidate is up); True otherwise (the call went on).
         """
         if occupant is not None and occupant != self.index and occupant not in self._final:
-            target = self._targets.get(occupant)
-            if target == self.present or target is not None:
+            if self._targets.get(occupant) is not None:
                 self._next += 1  # it comes here, or is busy in a call: turning toward it is no use
                 return False
             self._reserve(cell, out)

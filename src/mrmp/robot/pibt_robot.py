@@ -573,7 +573,7 @@ class PibtRobot:
         facing = turning_action(flat.neighbours, here, heading, chosen, table, flat.y_size)
         self.next_heading = Heading(facing)
         self.drives = self.target != here and facing == heading and self._occupants.get(self.target) not in self._staying
-        if not self.drives and moved and not self.turns_by_staying:  # on a failure the robot that pushed this one hears it in the answer
+        if not self.drives and moved and not self.turns_by_staying:  # on a failure its asker hears it in the answer
             self._tell_taker(out)
 
     def _tell_taker(self, out: list[Outgoing]) -> None:

@@ -17,6 +17,7 @@ it waited for an answer waits for that answer before its next cell.
 
 from __future__ import annotations
 
+import itertools
 import random
 from pathlib import Path
 
@@ -64,7 +65,7 @@ def assert_legal_actions(result) -> None:
     """Every tick is one action: a forward move that keeps the heading, or a quarter turn in place, or a wait."""
     for robot in result.robots:
         states = list(zip(robot.path, robot.headings))
-        for (cell, heading), (after, turned) in zip(states, states[1:]):
+        for (cell, heading), (after, turned) in itertools.pairwise(states):
             if after != cell:
                 assert turned == heading and after == heading.ahead(cell)
             else:
@@ -173,3 +174,38 @@ def test_a_claim_decided_for_good_holds_before_its_claimants_beacon_comes_in(bro
         robot.receive(message)
     robot.act()
     assert (robot.target == flat.index((0, 1))) == broken  # the broken rule claims the cell robot 1 stays on
+
+
+def drop_the_answer(self: LocalPibtRobot, out: list) -> None:
+    """The rule before: on a lost reservation, forget the robot asked and try the next cell at once."""
+    self._waiting = None
+    self._next_cell(out)
+
+
+@pytest.mark.parametrize("broken", [False, True])
+def test_a_robot_whose_reservation_lost_waits_for_the_answer_of_the_robot_it_asked(
+    broken: bool, monkeypatch: pytest.MonkeyPatch
+) -> None:
+    """Robot 0 at (1, 1) asked robot 1 to leave (1, 2); robot 2's call, of higher rank, then claimed (1, 2) too.
+
+    Robot 1 may have taken robot 0's request and be deciding within robot 0's
+    call: robot 0 tries its next cell only once robot 1 has answered, so that no
+    two branches of its call claim cells side by side (their claims carry one
+    rank: both could stand). The broken rule goes on at once.
+    """
+    if broken:
+        monkeypatch.setattr(LocalPibtRobot, "_withdraw", drop_the_answer)
+    flat = FlatMap(Grid(3, 3))
+    robot = LocalPibtRobot(0, flat.index((1, 1)), flat.index((1, 2)), flat, tie=1, swap=False)
+    robot.begin_step(1)
+    robot.receive_beacons(
+        [BeaconMessage(1, 1, 1, (1, 2), (0, 2), 0, 0, N), BeaconMessage(2, 1, 1, (2, 2), (2, 1), 0, 0, N)]
+    )
+    asked = [type(item.message).__name__ for item in robot.act()]
+    assert asked == ["CallReserveMessage", "CallInheritMessage"]
+    robot.receive(CallReserveMessage(2, 2, 1, (1, 2), 5, 9, 0, False))  # a call of higher rank claims (1, 2)
+    reservations = [item.message for item in robot.act() if isinstance(item.message, CallReserveMessage)]
+    assert bool(reservations) == broken  # the broken rule claims its next cell while robot 1 still decides
+    robot.receive(AnswerMessage(1, 3, 1, True))
+    after = [item.message for item in robot.act() if isinstance(item.message, CallReserveMessage)]
+    assert (after or broken) and robot.target != flat.index((1, 2))  # then, and only then, its next cell
