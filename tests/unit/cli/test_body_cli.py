@@ -34,10 +34,10 @@ def test_pibt_runs_turning_bodies_and_the_result_is_judged_in_their_model() -> N
     ("flags", "reason"),
     [
         (["--policy", "astar", "--body", "turning"], "policy.body: astar plans for omni bodies, not turning"),
-        (["--policy", "pibt", "--body", "turning"], "policy.body: turning bodies run with sequencing: driver so far"),
+        (["--policy", "causal", "--body", "turning"], "policy.body: causal plans for omni bodies, not turning"),
         (
-            ["--policy", "pibt", "--body", "turning", "--sequencing", "driver", "--live"],
-            "policy.body: pibt drives omni bodies live so far, not turning",
+            ["--policy", "causal", "--body", "turning", "--live"],
+            "policy.body: causal drives omni bodies live so far, not turning",
         ),
         (["--body", "thesis", "--planner", "lacam"], "policy.body: central plans are executed by omni, turning bodies, not thesis"),
         (["--body", "wheels"], "must be one of omni, thesis, turning, got 'wheels'"),
@@ -72,3 +72,12 @@ def test_a_ros2_drive_refuses_turning_bodies_in_one_line(tmp_path: Path) -> None
     assert result.exit_code == 2, result.output
     lines = [line for line in result.output.splitlines() if line.strip()]
     assert len(lines) == 1 and "--drive: drives the thesis's line-counting body" in lines[0], result.output
+
+
+@pytest.mark.parametrize("synchronizer", ["clock", "local"])
+def test_pibt_with_local_sequencing_plans_for_turning_bodies(synchronizer: str) -> None:
+    result = invoke("run", CROWD, "--policy", "pibt", "--body", "turning", "--synchronizer", synchronizer, "--json", "-")
+    assert result.exit_code == 0, result.output
+    run = json.loads(result.stdout)
+    assert run["success"] and run["collisions"] == [] and run["body"] == "turning"
+    assert sum(robot["turns"] for robot in run["robots"]) > 0
