@@ -238,6 +238,10 @@ class AnswerMessage(PibtMessage):
     moved: bool
     turns: bool = False
 
+    def __post_init__(self) -> None:
+        if self.moved and self.turns:
+            raise ValueError("an answer says moved or turns to leave, not both")
+
 
 @dataclass(frozen=True, slots=True)
 class ReserveMessage(PibtMessage):

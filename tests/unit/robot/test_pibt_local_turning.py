@@ -141,6 +141,8 @@ def test_answers_carry_whether_the_robot_turns_to_leave() -> None:
     moved_and_turns[-1] = 3
     with pytest.raises(DecodeError):
         decode(bytes(moved_and_turns))
+    with pytest.raises(ValueError, match="not both"):
+        AnswerMessage(1, 2, 3, True, turns=True)
 
 
 def occupant_first(self: LocalPibtRobot, claimant: int, holder: int, cell: int) -> bool:
