@@ -230,7 +230,9 @@ def test_robots_that_turn_in_place_cross_over_lossy_udp(tmp_path):
         result = run_live(scenario, LiveOptions(results=results, time_scale=10, faults=faults, seed=2))
         assert result.collisions == [] and result.success, (synchronizer, result.stop_reason)
         assert result.network["safety_granted"] == result.network["moves"]
-        for index in range(len(robots)):
+        for index in range(len(robots)):  # the referee judged every turn (its collisions include actions)
             report = json.loads((results / f"agent-{index}.json").read_text())
-            assert report["turns"] > 0 or index == 0  # robot a faces its goal from the start
+            trace = (results / f"trace-{index}.jsonl").read_text().splitlines()
+            turns = [line for line in trace if json.loads(line)["event"] == "heading"]
+            assert len(turns) == report["turns"] and (report["turns"] > 0 or index == 0)  # a faces its goal at once
 

@@ -1,8 +1,10 @@
 """Files of a live run: ground-truth traces, agent reports, the referee's verdict.
 
 * ``trace-<index>.jsonl``: one JSON object per line,
-  ``{"robot": i, "event": "enter"|"leave", "cell": [x, y], "t": seconds}``,
-  appended and flushed as events happen, so that nothing is lost if a process dies;
+  ``{"robot": i, "event": "enter"|"leave", "cell": [x, y], "t": seconds}``, and for
+  a body that turns in place ``{"robot": i, "event": "heading", "cell": [x, y],
+  "heading": "EAST", "t": seconds}`` when a turn ends, appended and flushed as
+  events happen, so that nothing is lost if a process dies;
 * ``agent-<index>.json``, ``referee.json``: JSON objects, written atomically.
 
 Examples
@@ -11,9 +13,10 @@ Examples
 >>> folder = pathlib.Path(tempfile.mkdtemp())
 >>> writer = TraceWriter(folder / "trace-0.jsonl", robot=0)
 >>> writer.write("enter", (1, 2), 3.5)
+>>> writer.write_heading((1, 2), Heading.NORTH, 4.5)
 >>> writer.close()
 >>> TraceReader(folder / "trace-0.jsonl").read_new()
-[(0, 'enter', (1, 2), 3.5)]
+[(0, 'enter', (1, 2), 3.5, None), (0, 'heading', (1, 2), 4.5, <Heading.NORTH: 1>)]
 """
 
 from __future__ import annotations
@@ -25,10 +28,12 @@ from typing import IO, Any
 
 from mrmp.core.cell import Cell
 from mrmp.core.errors import InputError, Problem
+from mrmp.core.heading import Heading
 from mrmp.core.limits import MIN_KEY_BYTES
 from mrmp.io._files import PathLike, atomic_write_text, read_bytes, read_text
 
-TraceEvent = tuple[int, str, Cell, float]
+TraceEvent = tuple[int, str, Cell, float, Heading | None]
+"""A trace's event: robot, ``"enter"``, ``"leave"`` or ``"heading"``, cell, time, and the heading of a ``"heading"``."""
 
 
 class TraceWriter:
@@ -42,6 +47,13 @@ class TraceWriter:
         """Append one event."""
         if self._file is not None:
             self._file.write(json.dumps({"robot": self.robot, "event": event, "cell": list(cell), "t": t}) + "\n")
+            self._file.flush()
+
+    def write_heading(self, cell: Cell, heading: Heading, t: float) -> None:
+        """Append that the body, on ``cell``, ended a turn in place facing ``heading``."""
+        if self._file is not None:
+            item = {"robot": self.robot, "event": "heading", "cell": list(cell), "heading": heading.name, "t": t}
+            self._file.write(json.dumps(item) + "\n")
             self._file.flush()
 
     def close(self) -> None:
@@ -76,7 +88,8 @@ class TraceReader:
             try:
                 item = json.loads(line)
                 cell = (int(item["cell"][0]), int(item["cell"][1]))
-                events.append((int(item["robot"]), str(item["event"]), cell, float(item["t"])))
+                heading = Heading[item["heading"]] if "heading" in item else None
+                events.append((int(item["robot"]), str(item["event"]), cell, float(item["t"]), heading))
             except (ValueError, KeyError, TypeError, IndexError, RecursionError):
                 continue
         return events

@@ -49,15 +49,27 @@ class OccupancyRecorder:
     the process dies.
     """
 
-    def __init__(self, sink: Callable[[str, Cell, float], None] | None = None) -> None:
+    def __init__(
+        self,
+        sink: Callable[[str, Cell, float], None] | None = None,
+        heading_sink: Callable[[Cell, Heading, float], None] | None = None,
+    ) -> None:
         self.sink = sink
+        self.heading_sink = heading_sink
         self.events: list[tuple[str, Cell, float]] = []
+        self.headings: list[tuple[Cell, Heading, float]] = []
 
     def record(self, event: str, cell: Cell, t: float) -> None:
         """Record that the body started to enter (``"enter"``) or has left (``"leave"``) ``cell`` at ``t``."""
         self.events.append((event, cell, t))
         if self.sink is not None:
             self.sink(event, cell, t)
+
+    def record_heading(self, cell: Cell, heading: Heading, t: float) -> None:
+        """Record that the body, on ``cell``, ended a turn in place facing ``heading`` at ``t`` (a ``turning`` body)."""
+        self.headings.append((cell, heading, t))
+        if self.heading_sink is not None:
+            self.heading_sink(cell, heading, t)
 
 
 @runtime_checkable
@@ -173,6 +185,7 @@ class SimulatedBody:
         self.model = model
         self._segments: list[_Segment] = []
         self._target: Cell = start
+        self._turning = False  # the action in progress is a turn in place
 
     def _scale(self) -> float:
         """Seconds of this action per second of the timing: the time scale, and this action's jitter."""
@@ -198,6 +211,7 @@ class SimulatedBody:
         self._target = self.cell
         self.moving = True
         self._entered = 0
+        self._turning = True
 
     def start_move(self, target: Cell, now: float) -> None:
         """Plan the turns and the drive into ``target``; record when each cell is entered.
@@ -237,6 +251,7 @@ class SimulatedBody:
         self._target = target
         self.moving = True
         self._entered = 0
+        self._turning = False
 
     def next_event(self) -> float | None:
         """When the next cell is entered or the move ends (``inf`` when not moving): poll then, not before.
@@ -272,6 +287,9 @@ class SimulatedBody:
         for segment in self._segments:
             if segment.source != segment.target:
                 self.recorder.record("leave", segment.source, segment.end)
+        if self._turning:
+            self.recorder.record_heading(last.target, self.heading, last.end)
+            self._turning = False
         self.true_cell = last.target
         self.cell = self._target  # what the line count says
         self.moving = False

@@ -27,6 +27,7 @@ from mrmp.core.seeds import Stream, derive_seed, stream_random
 from mrmp.io.lifetime import STOP_SIGNALS, release_held_signals, watch_parent
 from mrmp.io.live_files import TraceReader, TraceWriter, write_json
 from mrmp.io.plans import read_share, read_share_dependents
+from mrmp.live.action_referee import TurningActions
 from mrmp.live.agent import Agent, AgentReport, AgentTiming
 from mrmp.live.body import Body, OccupancyRecorder, OdometryLineBody, SimulatedBody
 from mrmp.live.causal_agent import CausalAgent
@@ -276,7 +277,7 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
                 jitter=options.jitter,
                 miss_line=options.miss_line,
                 rng=stream_random(options.seed, Stream.BODY, index),
-                recorder=OccupancyRecorder(sink),
+                recorder=OccupancyRecorder(sink, heading_sink=trace.write_heading),
                 model=body_model(scenario.policy.body),
             )
         sealer = Sealer(options.key, options.session)
@@ -416,8 +417,11 @@ def run_referee(
     readers = [TraceReader(results / f"trace-{index}.jsonl") for index in range(len(scenario.robots))]
     pending = [event for reader in readers for event in reader.read_new()]
     if start_time is None:
-        start_time = min((t for *_, t in pending), default=time.monotonic())
+        start_time = min((t for _, _, _, t, _ in pending), default=time.monotonic())
     referee = IntervalReferee(scenario.grid, ids, starts, start_time)
+    actions = None
+    if body_model(scenario.policy.body).turns_in_place:  # its actions are judged too
+        actions = TurningActions(ids, starts, [robot.heading for robot in scenario.robots], start_time)
     reported = 0
     finishing = False
     collisions = referee.collisions()
@@ -426,10 +430,14 @@ def run_referee(
         for reader in readers:
             pending.extend(reader.read_new())
         if pending:  # the collisions change only with new events: no new events, no new judgement
-            for robot, event, cell, t in pending:
+            for robot, event, cell, t, heading in pending:
                 referee.feed(robot, event, cell, t)
+                if actions is not None:
+                    actions.feed(robot, event, cell, t, heading)
             pending = []
             collisions = referee.collisions()
+            if actions is not None:
+                collisions = sorted(collisions + actions.collisions(), key=lambda collision: collision.tick)
         for collision in collisions[reported:]:
             report(f"referee: {collision.describe()} (tick = milliseconds since the start)")
         reported = max(reported, len(collisions))
