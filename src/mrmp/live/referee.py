@@ -9,6 +9,9 @@ referee reports, as the lockstep referee does (:mod:`mrmp.sim.referee`):
 * ``swap``: two robots each moving into the cell the other is leaving, at overlapping times;
 * ``obstacle`` / ``off_grid``: a robot entering a blocked cell or leaving the grid.
 
+For bodies that turn in place, the referee process judges their actions too
+(``action``: :mod:`mrmp.live.action_referee`).
+
 Times are seconds on the clock every process of the run shares
 (``time.monotonic`` on one machine); collisions carry the time in milliseconds
 since the run's start as their ``tick``.
