@@ -17,14 +17,15 @@ it waited for an answer waits for that answer before its next cell.
 
 from __future__ import annotations
 
+import dataclasses
 import itertools
 import random
 from pathlib import Path
 
 import pytest
+from test_pibt_local import crowd as omni_crowd
 
 from mrmp.core import Grid, NetworkFaults, PolicyOptions, RobotSpec, Scenario
-from mrmp.core.grid import connected_regions
 from mrmp.core.heading import Heading
 from mrmp.io.scenario_file import load_scenario
 from mrmp.protocol.codec import DecodeError, decode, encode
@@ -45,20 +46,11 @@ def local_turning(synchronizer: str = "clock", radius: int = 2) -> PolicyOptions
 
 
 def crowd(seed: int, faults: NetworkFaults | None = None, synchronizer: str = "clock", density: float = 0.5) -> Scenario:
-    """A random map with up to ``density`` of its largest region's cells holding robots, headings at random."""
+    """``test_pibt_local``'s random crowd at ``density``, every robot facing a heading drawn with ``seed``."""
+    scenario = omni_crowd(seed, density=density, swap=False, max_ticks=3000)
     rng = random.Random(seed)
-    x_size, y_size = rng.randint(4, 10), rng.randint(4, 10)
-    cells = [(x, y) for x in range(x_size) for y in range(y_size)]
-    grid = Grid(x_size, y_size, set(rng.sample(cells, k=rng.randint(0, len(cells) // 6))))
-    free = sorted(max(connected_regions(grid, grid.free_cells())[1], key=len))
-    count = rng.randint(1, max(1, int(len(free) * density)))
-    starts, goals = rng.sample(free, count), rng.sample(free, count)
-    robots = tuple(
-        RobotSpec(f"r{i}", start, goal, heading=Heading(rng.randint(1, 4))) for i, (start, goal) in enumerate(zip(starts, goals))
-    )
-    return Scenario(
-        grid, robots, network=faults or NetworkFaults(), policy=local_turning(synchronizer), seed=seed, max_ticks=3000
-    )
+    robots = tuple(dataclasses.replace(robot, heading=Heading(rng.randint(1, 4))) for robot in scenario.robots)
+    return scenario.with_changes(robots=robots, network=faults or NetworkFaults(), policy=local_turning(synchronizer))
 
 
 def assert_legal_actions(result) -> None:
@@ -95,9 +87,10 @@ def test_crowds_arrive_without_collision_on_perfect_and_faulty_networks(seed: in
 
 def test_the_central_rule_with_cancellations_collides_under_local_sequencing(monkeypatch: pytest.MonkeyPatch) -> None:
     """A decision for good that a later StayMessage would cancel: the robot has moved already."""
-    assert all(not pibt_simulator(crowd(seed)).run().collisions for seed in range(8))
+    short = [crowd(seed).with_changes(max_ticks=60) for seed in range(8)]
+    assert all(not pibt_simulator(scenario).run().collisions for scenario in short)
     monkeypatch.setattr(LocalPibtRobot, "turns_by_staying", False)
-    assert any(pibt_simulator(crowd(seed)).run().collisions for seed in range(8))
+    assert any(pibt_simulator(scenario).run().collisions for scenario in short)
 
 
 def test_no_cycle_of_robots_follows_round_a_loop_and_the_referee_catches_one(monkeypatch: pytest.MonkeyPatch) -> None:
