@@ -11,6 +11,7 @@ durations.
 from __future__ import annotations
 
 import importlib.util
+import signal
 from pathlib import Path
 
 import pytest
@@ -24,6 +25,18 @@ collect_ignore = [] if importlib.util.find_spec("cyclonedds") else ["src/mrmp/li
 
 settings.register_profile("mrmp", deadline=None)
 settings.load_profile("mrmp")
+
+
+def pytest_configure(config: pytest.Config) -> None:
+    """Let Ctrl-C reach the processes the tests start, even from a test run that ignores it.
+
+    Tests interrupt runs with SIGINT, as a terminal does. A shell starts a
+    background job with SIGINT ignored, and an ignored signal stays ignored in
+    every process started from it (Python then installs no KeyboardInterrupt):
+    the test run takes SIGINT back, so its children start with the default.
+    """
+    if signal.getsignal(signal.SIGINT) == signal.SIG_IGN:
+        signal.signal(signal.SIGINT, signal.default_int_handler)
 
 
 @pytest.fixture(autouse=True)

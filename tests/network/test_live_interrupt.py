@@ -58,4 +58,4 @@ def test_ctrl_c_stops_everything_and_writes_results(tmp_path):
     assert len(data["robots"]) == 2 and (results / "referee.json").exists()
     for index in range(2):
         report = json.loads((results / f"agent-{index}.json").read_text())
-        assert report["stop_reason"] == "interrupted"
+        assert report["stop_reason"] == "interrupted", text

@@ -181,7 +181,7 @@ def test_ctrl_c_on_a_live_pibt_run_stops_everything_and_writes_results(tmp_path)
     data = json.loads((tmp_path / "result.json").read_text())
     assert data["success"] is False and data["mode"] == "live" and (results / "referee.json").exists()
     for index in range(2):
-        assert json.loads((results / f"agent-{index}.json").read_text())["stop_reason"] == "interrupted"
+        assert json.loads((results / f"agent-{index}.json").read_text())["stop_reason"] == "interrupted", text
 
 
 def test_a_killed_live_pibt_launcher_leaves_nothing_running(tmp_path):
