@@ -59,9 +59,8 @@ from enum import Enum
 
 from mrmp.core.body import body_model
 from mrmp.core.cell import Cell
-from mrmp.core.errors import MrmpError
 from mrmp.core.scenario import Scenario
-from mrmp.live.body import Body, TurnsInPlace
+from mrmp.live.body import Body
 from mrmp.live.driver import AgentReport, AgentTiming, LiveDriver, believed_near, live_state_radius
 from mrmp.live.transport import Transport
 from mrmp.policies.base import Policy, interaction_radius
@@ -128,7 +127,6 @@ class Agent(LiveDriver):
             state_radius=None if radius is None else live_state_radius(radius),
             body=body_model(scenario.policy.body),
         )
-        self._turning = False  # the body's action in progress is a turn in place, not a move
         self._repeat_at = math.inf  # when the state goes again after an arrival (a robot that listens for nothing)
         self._phase = Phase.LISTEN
         self._next_decision = 0.0
@@ -218,20 +216,11 @@ class Agent(LiveDriver):
         return due
 
     def _start_turn(self, now: float) -> bool:
-        """Start the quarter turn in place the robot decided, if any (module docstring); whether one started.
-
-        Raises
-        ------
-        MrmpError
-            If the robot turns in place and its body cannot.
-        """
+        """Start the quarter turn in place the robot decided, if any (module docstring); whether one started."""
         heading = self.robot.turn(now)
         if heading is None:
             return False
-        if not isinstance(self.body, TurnsInPlace):
-            raise MrmpError(f"robot {self.robot.id}: its body cannot turn in place (policy.body {self.robot.body.name})")
-        self.body.start_turn(heading, now)
-        self._turning = True
+        self._start_turn_in_place(heading, now)
         return True
 
     def _step(self, now: float, started: float) -> bool:
@@ -240,8 +229,7 @@ class Agent(LiveDriver):
         sent_state = False
         if body.moving:
             if body.poll(now):
-                if self._turning:
-                    self._turning = False
+                if self._ended_a_turn():
                     robot.turned(body.heading)
                 else:
                     robot.arrived_at(body.cell, body.heading)

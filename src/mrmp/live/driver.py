@@ -56,9 +56,11 @@ from dataclasses import dataclass, field
 from typing import Any, Protocol
 
 from mrmp.core.cell import Cell
+from mrmp.core.errors import MrmpError
+from mrmp.core.heading import Heading
 from mrmp.core.scenario import Scenario
 from mrmp.core.seeds import Stream, stream_random
-from mrmp.live.body import Body
+from mrmp.live.body import Body, TurnsInPlace
 from mrmp.live.client_thread import ClientThread
 from mrmp.live.transport import FaultyTransport, Transport
 from mrmp.protocol.auth import Opener, Sealer
@@ -327,6 +329,7 @@ class LiveDriver:
         """Seconds the body takes for a cell (a body without a time scale runs in real time)."""
         self._hellos = HelloSchedule((), 0.0, timing.heartbeat, timing.fleet_heartbeat)
         """While waiting for the fleet: when each peer not heard from is asked for its state."""
+        self._turning = False  # the body's action in progress is a turn in place, not a move
 
     # -- what a policy's driver supplies ----------------------------------------------------
 
@@ -398,6 +401,24 @@ class LiveDriver:
         """Ask the run to stop (from a signal handler or another thread); the main loop wakes at once."""
         self.stop_requested.set()
         self._inbox.wake()
+
+    def _start_turn_in_place(self, heading: Heading, now: float) -> None:
+        """Start the body's quarter turn in place to ``heading``; :meth:`_ended_a_turn` tells its end from a move's.
+
+        Raises
+        ------
+        MrmpError
+            If the body does not turn in place.
+        """
+        if not isinstance(self.body, TurnsInPlace):
+            raise MrmpError(f"robot {self.index}: its brain turns in place, its body cannot")
+        self.body.start_turn(heading, now)
+        self._turning = True
+
+    def _ended_a_turn(self) -> bool:
+        """Whether the body's action that has just ended was a turn in place (not a move)."""
+        turning, self._turning = self._turning, False
+        return turning
 
     def _record_move(self, now: float, started: float, on_goal: bool) -> None:
         """The body ended a move, on the goal or not: count it, log the cell, keep the arrival time."""

@@ -74,7 +74,7 @@ from mrmp.core.cell import Cell
 from mrmp.core.heading import Heading
 from mrmp.core.scenario import Scenario
 from mrmp.core.seeds import Stream, stream_random
-from mrmp.live.body import Body, TurnsInPlace
+from mrmp.live.body import Body
 from mrmp.live.driver import AgentTiming, LiveDriver, fleet_wide
 from mrmp.live.transport import Transport
 from mrmp.policies.pibt_rules import DEAD_END_BONUS
@@ -505,7 +505,6 @@ class PibtAgent(LiveDriver):
             scenario, index, self.pibt_timing, claim_retry=min(timing.claim_retry, 0.05),
             crash_after=2 * timing.give_up_after,
         )  # fmt: skip
-        self._turning = False  # the body's action in progress is a turn in place
 
     # -- what the driver reads of the brain --------------------------------------------------
 
@@ -558,8 +557,7 @@ class PibtAgent(LiveDriver):
         brain, body = self.robot, self.body
         if body.moving:
             if body.poll(now):
-                if self._turning:
-                    self._turning = False
+                if self._ended_a_turn():
                     brain.turned()
                 else:
                     brain.arrived_at(body.cell)
@@ -568,10 +566,7 @@ class PibtAgent(LiveDriver):
             action, out = brain.motion(now)
             self._send(out)
             if isinstance(action, Heading):
-                if not isinstance(body, TurnsInPlace):
-                    raise TypeError(f"robot {self.index}: its brain plans turns in place, its body cannot make them")
-                body.start_turn(action, now)
-                self._turning = True
+                self._start_turn_in_place(action, now)
             elif action is not None:
                 body.start_move(action, now)
         return False
