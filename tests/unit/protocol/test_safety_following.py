@@ -26,6 +26,7 @@ import sys
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
+from test_safety import GrantsOnAnyRelease, caught
 
 from mrmp.centralized.dependencies import rotations_at
 from mrmp.protocol.messages import ClaimMessage, HandoffMessage, ReleaseAckMessage, ReleaseMessage, ReplyMessage
@@ -294,49 +295,20 @@ class StaleHandoff(SafetyLayer):
         return super().handle_handoff(message)
 
 
-class GrantsOnAnyRelease(SafetyLayer):
-    """Grants a standing claim on any release of the cell, also one that did not free it (a stale or foreign one)."""
-
-    def handle_release(self, message):
-        ack = super().handle_release(message)
-        if self.keep_refused and not self.granted_on_release and message.cell in self._deferred:
-            self._registry.pop(message.cell, None)
-            self.granted_on_release = self._grant_deferred(message.cell)
-        return ack
-
-
 def test_the_adversary_catches_a_replica_that_grants_standing_claims_on_any_release(monkeypatch):
     monkeypatch.setattr(sys.modules[__name__], "SafetyLayer", GrantsOnAnyRelease)
-    caught = 0
-    for seed in range(30):
-        try:
-            run(seed, 5, 150, keep_refused=True)
-        except AssertionError:
-            caught += 1
-    assert caught > 0
+    assert caught(lambda seed: run(seed, 5, 150, keep_refused=True), range(30)) > 0
 
 
 @pytest.mark.parametrize("variant", [EagerHandoff, GivesItsCellWhileClaiming, CommittedButStays])
 def test_the_adversary_catches_broken_following(variant, monkeypatch):
     monkeypatch.setattr(sys.modules[__name__], "SafetyLayer", variant)
-    caught = 0
-    for seed in range(30):
-        try:
-            run(seed, 5, 150)
-        except AssertionError:
-            caught += 1
-    assert caught > 0
+    assert caught(lambda seed: run(seed, 5, 150), range(30)) > 0
 
 
 def test_the_adversary_catches_a_replica_that_takes_stale_handoffs(monkeypatch):
     monkeypatch.setattr(sys.modules[__name__], "SafetyLayer", StaleHandoff)
-    caught = 0
-    for seed in range(60):
-        try:
-            run(seed, 5, 300)
-        except AssertionError:
-            caught += 1
-    assert caught > 0
+    assert caught(lambda seed: run(seed, 5, 300), range(60)) > 0
 
 
 def test_a_swap_is_refused_a_chain_follows_in_one_tick():
