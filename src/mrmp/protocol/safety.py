@@ -137,7 +137,8 @@ class PendingClaim:
     refusers: set[int] = field(default_factory=set)
     committed: bool = False
     standing: bool = False
-    """Refused, and kept past the step for a grant on a handoff or a release (``keep_refused``)."""
+    """Refused, and kept for a grant on a handoff or a release: past the step (``keep_refused``), or until its
+    robot gives it up (``waits_for_release``)."""
     handoff_repeated: bool = False
     """Committed, and its handoff sent once more (:meth:`SafetyLayer.repeat_handoff`, a lossy network's driver)."""
 
