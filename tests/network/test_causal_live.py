@@ -1,5 +1,6 @@
 """Causal-PIBT live: one OS process per robot, real time, over UDP or Zenoh with loss; judged by the referee process."""
 
+import json
 import time
 from pathlib import Path
 
@@ -13,20 +14,30 @@ from mrmp.live.transport import LiveFaults
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
-def test_four_robots_cross_over_lossy_udp(tmp_path):
-    """Two head-on pairs on a 5x5 grid with a pillar, 20% of datagrams lost, late and duplicated."""
+@pytest.mark.parametrize("body", ["omni", "turning"])
+def test_four_robots_cross_over_lossy_udp(tmp_path, body):
+    """Two head-on pairs on a 5x5 grid with a pillar, 20% of datagrams lost, late and duplicated; ``turning``
+    bodies turn a quarter at a time toward the head they may enter, and the referee judges those actions too."""
     robots = (
         RobotSpec("a", (0, 2), (4, 2)),
         RobotSpec("b", (4, 2), (0, 2)),
         RobotSpec("c", (2, 0), (2, 4)),
         RobotSpec("d", (2, 4), (2, 0)),
     )
-    scenario = Scenario(Grid(5, 5, [(2, 2)]), robots, timing=Timing(1.0, 0.5), policy=PolicyOptions(name="causal"), name="causal-four")
+    policy = PolicyOptions(name="causal", body=body)
+    scenario = Scenario(Grid(5, 5, [(2, 2)]), robots, timing=Timing(1.0, 0.5), policy=policy, name="causal-four")
     faults = LiveFaults(loss=0.2, delay_min=0.0, delay_max=0.02, duplicate=0.1)
-    result = run_live(scenario, LiveOptions(results=tmp_path / "run", time_scale=10, faults=faults, seed=2))
+    results = tmp_path / "run"
+    result = run_live(scenario, LiveOptions(results=results, time_scale=10, faults=faults, seed=2))
     assert result.collisions == [] and result.success, result.stop_reason
     assert result.policy == "causal" and result.network["injected_lost"] > 0
     assert all(robot.arrived and robot.messages_sent > 0 for robot in result.robots)
+    if body == "turning":  # every robot faces north and must turn; each turn is in its trace
+        for index in range(len(robots)):
+            report = json.loads((results / f"agent-{index}.json").read_text())
+            trace = (results / f"trace-{index}.jsonl").read_text().splitlines()
+            turns = [line for line in trace if json.loads(line)["event"] == "heading"]
+            assert len(turns) == report["turns"] > 0
 
 
 @pytest.mark.slow

@@ -19,6 +19,7 @@ Examples
 from __future__ import annotations
 
 import itertools
+from collections.abc import Callable
 from enum import IntEnum
 
 from mrmp.core.cell import Cell
@@ -131,17 +132,44 @@ def minimum_right_turns(current: Heading, needed: frozenset[Heading] | set[Headi
     >>> minimum_right_turns(Heading.EAST, {Heading.NORTH})
     3
     """
+    return _fewest_turns(current, needed, right_turns)
+
+
+def quarter_turns(current: Heading, target: Heading) -> int:
+    """Quarter turns from ``current`` to ``target`` for a body that turns either way: the shorter way round.
+
+    >>> [quarter_turns(Heading.NORTH, h) for h in HEADINGS]
+    [0, 1, 2, 1]
+    """
+    clockwise = right_turns(current, target)
+    return min(clockwise, 4 - clockwise)
+
+
+def minimum_quarter_turns(current: Heading, needed: frozenset[Heading] | set[Heading]) -> int:
+    """A lower bound on the quarter turns, either way, needed to face every heading in ``needed``.
+
+    The bound of :func:`minimum_right_turns` for a body that turns a quarter
+    either way (the ``turning`` body of :mod:`mrmp.core.body`).
+
+    >>> minimum_quarter_turns(Heading.EAST, {Heading.NORTH})
+    1
+    >>> minimum_quarter_turns(Heading.SOUTH, {Heading.NORTH, Heading.EAST})
+    2
+    """
+    return _fewest_turns(current, needed, quarter_turns)
+
+
+def _fewest_turns(
+    current: Heading, needed: frozenset[Heading] | set[Heading], turns: Callable[[Heading, Heading], int]
+) -> int:
+    """The fewest ``turns`` that face every heading of ``needed``, from ``current``, in the best order."""
     order = sorted(needed)
-    if not order:
-        return 0
-    if len(order) == 1:
-        return right_turns(current, order[0])
     best = None
     for permutation in itertools.permutations(order):
         total = 0
         facing = current
         for heading in permutation:
-            total += right_turns(facing, heading)
+            total += turns(facing, heading)
             facing = heading
         best = total if best is None else min(best, total)
     return best if best is not None else 0

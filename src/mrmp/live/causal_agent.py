@@ -10,7 +10,9 @@ clock. Every turn of the driver's loop (:mod:`mrmp.live.driver`):
   acknowledgements, claim replies);
 * when the body reports the end of its move, tell the brain (it contracts on
   its head and announces its state); else start the move the safety layer
-  allows, if any;
+  allows, if any; a body that turns in place (``turning``) and does not face
+  that head first turns toward it, a quarter at a time (each end told to the
+  brain, which announces its heading), on the tail it still holds;
 * when the robot's next activation is due, activate it (an activation locks
   the robots within two cells, runs one Causal-PIBT transition and releases
   them); activations come every ``listen_time`` seconds, times a random factor
@@ -34,7 +36,9 @@ from __future__ import annotations
 import time
 from collections.abc import Callable
 
+from mrmp.core.body import body_model
 from mrmp.core.cell import Cell
+from mrmp.core.heading import Heading
 from mrmp.core.scenario import Scenario
 from mrmp.core.seeds import Stream, stream_random
 from mrmp.live.body import Body
@@ -84,6 +88,7 @@ class CausalAgent(LiveDriver):
             claim_timeout=timing.claim_timeout,
             heading=spec.heading,
             state_radius=live_state_radius(LOCK_RADIUS),
+            body=body_model(scenario.policy.body),
         )
         self._next_activation = 0.0
         self._extended_at: float | None = None
@@ -141,15 +146,21 @@ class CausalAgent(LiveDriver):
         sent_state = False
         if body.moving:
             if body.poll(now):
-                self._send(robot.arrived_at(body.cell, now, body.heading))
                 sent_state = True
-                self._record_move(now, started, robot.body_on_goal)
+                if self._ended_a_turn():
+                    self._send(robot.turned(body.heading))
+                    head = robot.head
+                    assert head is not None  # a robot turns only toward the head it may enter
+                    self._drive_toward(head, now)
+                else:
+                    self._send(robot.arrived_at(body.cell, now, body.heading))
+                    self._record_move(now, started, robot.body_on_goal)
         else:
             if robot.mode_name == "extended" and self._extended_at is None:
                 self._extended_at = now
             target = robot.motion(now)
             if target is not None:
-                body.start_move(target, now)
+                self._drive_toward(target, now)
                 if self._extended_at is not None:
                     report.decision_latency.append(now - self._extended_at)
                 self._extended_at = None
@@ -159,3 +170,12 @@ class CausalAgent(LiveDriver):
         if not robot.body_on_goal:
             report.arrival_time = None
         return sent_state
+
+    def _drive_toward(self, target: Cell, now: float) -> None:
+        """Start the body's next action toward ``target``: a quarter turn when it turns in place and does not face it."""
+        body = self.body
+        turn = self.robot.body.first_turn(body.heading, Heading.between(body.cell, target))
+        if turn is not None:
+            self._start_turn_in_place(turn, now)
+        else:
+            body.start_move(target, now)

@@ -24,6 +24,7 @@ corridors and livelock in crowds, and the referee reports it.
 
 from __future__ import annotations
 
+from mrmp.core.body import DEFAULT_BODY, BodyModel, body_model
 from mrmp.core.cell import Cell
 from mrmp.core.errors import NoPathError
 from mrmp.core.heading import Heading
@@ -48,6 +49,11 @@ class AstarPolicy:
         Plan over (cell, heading) so that right turns cost ``timing.turn_time``.
     timing:
         The robot's timing, used when ``heading_aware``.
+    body:
+        The robot's body model (:mod:`mrmp.core.body`). A body that turns in
+        place (``turning``) always plans over (cell, heading), each quarter
+        turn either way costing one cell time, since its turns are actions of
+        their own; a ``thesis`` body charges its right turns when ``heading_aware``.
     search:
         The planner of its paths (:data:`mrmp.search.choices.SEARCH_TABLE`); A* when omitted.
     """
@@ -65,11 +71,14 @@ class AstarPolicy:
         heading_aware: bool = False,
         timing: Timing | None = None,
         search: Planner = astar,
+        body: BodyModel | None = None,
     ) -> None:
         self.resolve = resolve
         self.search = search
-        self.heading_aware = heading_aware
+        self.body = body or body_model(DEFAULT_BODY)
+        self.heading_aware = heading_aware or self.body.turns_in_place
         self.timing = timing or Timing()
+        self._search_body = self.body if self.body.headed else None
         self._path: list[Cell] = []
         self._parked: dict[int, Cell] = {}
         self.held: frozenset[Cell] = frozenset()
@@ -86,7 +95,13 @@ class AstarPolicy:
             return None if cached is None else list(cached)
         try:
             result = self.search(
-                situation.grid, situation.present, situation.goal, blocked=blocked, heading=heading, timing=self.timing
+                situation.grid,
+                situation.present,
+                situation.goal,
+                blocked=blocked,
+                heading=heading,
+                timing=self.timing,
+                body=self._search_body,
             )
         except NoPathError:
             result = None
@@ -114,14 +129,14 @@ class AstarPolicy:
             return Decision(present, "arrived" if present == situation.goal else "wait")
         conflicts = conflicting_peers(intended, situation.peers)
         if not conflicts:
-            self._advance(intended)
+            self._advance(situation, intended)
             return Decision(intended, "clear")
         conflict_ids = tuple(peer.index for peer in conflicts)
         parked = self._remember_parked(situation)
         blocked_by_parked = any(peer.parked for peer in conflicts)
         if not blocked_by_parked:
             if outranks_all(present, situation.index, conflicts):
-                self._advance(intended)
+                self._advance(situation, intended)
                 return Decision(intended, "priority", conflict_ids)
             if self.resolve == "wait":
                 return Decision(present, "wait", conflict_ids)
@@ -132,7 +147,7 @@ class AstarPolicy:
             return Decision(present, "blocked", conflict_ids)
         step = path[1]
         self._path = path
-        self._advance(step)
+        self._advance(situation, step)
         return Decision(step, "divert", conflict_ids)
 
     def _remember_parked(self, situation: Situation) -> frozenset[Cell]:
@@ -146,6 +161,16 @@ class AstarPolicy:
                 remembered.pop(index, None)
         return frozenset(remembered.values())
 
-    def _advance(self, entered: Cell) -> None:
+    def _advance(self, situation: Situation, entered: Cell) -> None:
+        """Step along the plan into ``entered``, the cell just decided, unless the body spends this tick turning.
+
+        A body that turns in place and does not face ``entered`` turns a
+        quarter toward it this tick and stays on its cell, on the plan it chose
+        (a diversion included); it drives on once it faces the cell. Without
+        this, a diverted robot would find itself off its plan after the turn,
+        plan afresh, and turn back: robots would spin in place in a crowd.
+        """
+        if self.body.turns_in_place and Heading.between(situation.present, entered) != situation.heading:
+            return
         if len(self._path) > 1 and self._path[1] == entered:
             self._path.pop(0)

@@ -43,6 +43,7 @@ Examples
 
 from __future__ import annotations
 
+from mrmp.core.body import BodyModel
 from mrmp.core.cell import Cell, step_toward
 from mrmp.core.errors import NoPathError
 from mrmp.policies.base import Decision, Situation
@@ -91,6 +92,11 @@ class ThesisPolicy:
     search:
         The planner whose path gives Next (:data:`mrmp.search.choices.SEARCH_TABLE`);
         the thesis's update coordinate method when omitted.
+    body:
+        The robot's body model (:mod:`mrmp.core.body`). For a body that turns
+        in place (``turning``) the search runs over (cell, heading), a quarter
+        turn either way costing one cell time; the update coordinate method's
+        L is the same whatever the heading, so the thesis's Next is unchanged.
 
     Examples
     --------
@@ -110,9 +116,12 @@ class ThesisPolicy:
     own_search = "update-coordinate"
     """The search :data:`~mrmp.core.options.POLICY_DEFAULT_SEARCH` stands for."""
 
-    def __init__(self, resolve: str = "divert", search: Planner = update_coordinate_path) -> None:
+    def __init__(
+        self, resolve: str = "divert", search: Planner = update_coordinate_path, body: BodyModel | None = None
+    ) -> None:
         self.resolve = resolve
         self.search = search
+        self._turning_body = body if body is not None and body.turns_in_place else None
 
     def intend(self, situation: Situation) -> Cell:
         """The first step of the search's path to the destination (or Present once arrived).
@@ -122,8 +131,10 @@ class ThesisPolicy:
         present, goal = situation.present, situation.goal
         if present == goal:
             return present
+        body = self._turning_body
+        heading = situation.heading if body is not None else None
         try:
-            return self.search(situation.grid, present, goal).path[1]
+            return self.search(situation.grid, present, goal, heading=heading, body=body).path[1]
         except NoPathError:
             return update_coordinate_step(present, goal)
 

@@ -60,6 +60,7 @@ import random
 from collections import Counter
 from collections.abc import Sequence
 
+from mrmp.core.body import DEFAULT_BODY, BodyModel, body_model
 from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
 from mrmp.core.heading import Heading
@@ -128,6 +129,11 @@ class CausalRobot(MessageEndpoint):
         The map's flat form with its distance tables (shared by robots simulated in one process).
     heading:
         The body's initial heading.
+    body:
+        The body model (:mod:`mrmp.core.body`; ``omni`` when omitted). A body
+        that turns in place ranks its candidates in its own model; its driver
+        turns it toward the head it may enter (:meth:`motion`) before it drives
+        there, reporting each quarter turn with :meth:`turned`.
     state_radius:
         Send states to the robots within this many cells of the tail (a radius
         broadcast) rather than to every peer (None: every peer); at least
@@ -148,6 +154,7 @@ class CausalRobot(MessageEndpoint):
         flat: FlatMap | None = None,
         heading: Heading = Heading.NORTH,
         state_radius: int | None = None,
+        body: BodyModel | None = None,
     ) -> None:
         if state_radius is not None and state_radius < LOCK_RADIUS:
             raise ValueError(f"state radius {state_radius} is below the lock radius {LOCK_RADIUS}")
@@ -155,12 +162,12 @@ class CausalRobot(MessageEndpoint):
         self.state_radius = state_radius
         self.grid = grid
         self.retry_interval = retry_interval
-        self.heading = heading
         self.seq = 0
         self.dropped: Counter[str] = Counter()
         self.stats: Counter[str] = Counter()
         rng = rng if rng is not None else random.Random(index)
-        self.transitions = CausalTransitions(grid, goal, rng, flat, self.stats)
+        self.body = body if body is not None else body_model(DEFAULT_BODY)
+        self.transitions = CausalTransitions(grid, goal, rng, flat, self.stats, self.body, heading)
         self.state: CausalState = self.transitions.initial_state(index, starts[index])
         self.peers = KnownPeers(index, starts)
         self.locks = NeighbourLocks(index, self._grant, retry_interval, lock_timeout, self.stats, self.dropped)
@@ -364,6 +371,20 @@ class CausalRobot(MessageEndpoint):
         self.moving = True
         self.stats["moves"] += 1
         return head
+
+    @property
+    def heading(self) -> Heading:
+        """The body's heading (the one its transitions rank candidates from)."""
+        return self.transitions.heading
+
+    @heading.setter
+    def heading(self, heading: Heading) -> None:
+        self.transitions.heading = heading
+
+    def turned(self, heading: Heading) -> list[Outgoing]:
+        """The body has ended a quarter turn in place, toward its head, and now faces ``heading``; it says so."""
+        self.heading = heading
+        return [self._state_outgoing()]
 
     def arrived_at(self, cell: Cell, now: float, heading: Heading | None = None) -> list[Outgoing]:
         """The body stands on ``cell`` (its head); contract now, or once no peer holds this robot's lock."""

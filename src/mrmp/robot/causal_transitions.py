@@ -51,8 +51,10 @@ import random
 from collections import Counter
 from collections.abc import Mapping
 
+from mrmp.core.body import BodyModel
 from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
+from mrmp.core.heading import Heading
 from mrmp.protocol.messages import ADD_CHILD, CLEAR_PARENT, CONTRACT, REMOVE_CHILD, SET_VISITED, LockReleaseMessage
 from mrmp.robot.causal_views import CausalState, Mode, PeerView
 from mrmp.search.flat_map import FlatMap
@@ -78,6 +80,12 @@ class CausalTransitions:
         The map's flat form with its distance tables (shared by robots simulated in one process).
     stats:
         Counts ``inherited`` and ``backtracked`` transitions.
+    body:
+        The robot's body model (:mod:`mrmp.core.body`; ``omni`` when omitted).
+        For a body that turns in place (``turning``) the candidates are ranked
+        in its own model (:meth:`next_cell`), from :attr:`heading`.
+    heading:
+        The body's heading on its tail (kept up to date by the robot).
     """
 
     def __init__(
@@ -87,13 +95,23 @@ class CausalTransitions:
         rng: random.Random,
         flat: FlatMap | None = None,
         stats: Counter[str] | None = None,
+        body: BodyModel | None = None,
+        heading: Heading = Heading.NORTH,
     ) -> None:
         self.grid = grid
         self.flat = flat if flat is not None else FlatMap(grid)
         self.rng = rng
         self.stats: Counter[str] = stats if stats is not None else Counter()
+        self.turns_in_place = body is not None and body.turns_in_place
+        self.heading = heading
         self.goal = goal
-        self._distances = self.flat.distances(self.flat.index(goal))
+        self._distances = self._table(goal)
+
+    def _table(self, goal: Cell) -> list[float]:
+        """The distances to ``goal`` that rank the candidates: by cell, or by (cell, heading) for a turning body."""
+        if self.turns_in_place:
+            return self.flat.heading_distances(self.flat.index(goal), 1.0, both_ways=True)
+        return self.flat.distances(self.flat.index(goal))
 
     def initial_state(self, index: int, tail: Cell) -> CausalState:
         """A robot contracted on ``tail``, alone in its tree, its candidates reset."""
@@ -104,7 +122,7 @@ class CausalTransitions:
     def set_goal(self, state: CausalState, goal: Cell) -> None:
         """A new goal (lifelong runs): the robot is away from a goal again."""
         self.goal = goal
-        self._distances = self.flat.distances(self.flat.index(goal))
+        self._distances = self._table(goal)
         state.away = int(state.tail != goal)
         if not state.has_parent:
             state.inherited = state.own_priority
@@ -221,14 +239,21 @@ class CausalTransitions:
         self.stats["inherited"] += 1
 
     def next_cell(self, state: CausalState, peers: PeerViews) -> Cell:
-        """The authors' ``nextNode``: the candidate nearest the goal; ties to free cells, then wider ones, then at random."""
+        """The authors' ``nextNode``: the candidate nearest the goal; ties to free cells, then wider ones, then at random.
+
+        For a body that turns in place, "nearest" counts ticks of its actions
+        (:func:`~mrmp.policies.pibt_rules.turning_candidates`'s ranking): a
+        neighbour in direction ``d`` costs the quarter turns toward ``d``, its
+        entry and the (cell, heading) distance from it facing ``d``; the tail
+        costs a tick of waiting and its distance as the body faces.
+        """
         candidates = state.candidates
         if state.tail in candidates and state.tail == self.goal:
             return state.tail
-        flat = self.flat
-        distances = self._distances
-        best = min(distances[flat.index(cell)] for cell in candidates)
-        nearest = [cell for cell in candidates if distances[flat.index(cell)] == best]
+        cost = self._turning_cost if self.turns_in_place else self._cell_cost
+        costs = {cell: cost(state.tail, cell) for cell in candidates}
+        best = min(costs.values())
+        nearest = [cell for cell in candidates if costs[cell] == best]
         if len(nearest) == 1:
             return nearest[0]
         free = [cell for cell in nearest if not self._covered(cell, peers)]
@@ -238,6 +263,18 @@ class CausalTransitions:
             widest = max(len(self.grid.neighbours(cell)) for cell in free)
             return self.rng.choice([cell for cell in free if len(self.grid.neighbours(cell)) == widest])
         return self.rng.choice(nearest)
+
+    def _cell_cost(self, tail: Cell, cell: Cell) -> float:
+        return self._distances[self.flat.index(cell)]
+
+    def _turning_cost(self, tail: Cell, cell: Cell) -> float:
+        facing = int(self.heading)
+        if cell == tail:
+            return round(1.0 + self._distances[4 * self.flat.index(tail) + facing - 1], 9)
+        direction = int(Heading.between(tail, cell))
+        quarters = (direction - facing) % 4
+        entry = self.grid.cost(cell)
+        return round(min(quarters, 4 - quarters) + entry + self._distances[4 * self.flat.index(cell) + direction - 1], 9)
 
     def _backtrack(self, state: CausalState, peers: PeerViews) -> None:
         """No candidate left: write S into the parent requesting this tail, and make it contract."""

@@ -19,7 +19,12 @@ The engine searches one of two state spaces, chosen once by the caller:
 * ``(cell, heading)`` pairs, when the robot's heading is given (the Khepera III
   only turns right, thesis section 3.3): moving to the neighbour in direction
   ``d`` from heading ``h`` costs ``right_turns(h, d) * turn_time +
-  cell_time * cost(neighbour)`` and leaves the robot facing ``d``.
+  cell_time * cost(neighbour)`` and leaves the robot facing ``d``. With a
+  body model (:mod:`mrmp.core.body`) the turns are the body's: a ``turning``
+  body turns a quarter either way in one tick, so the move costs
+  ``quarter_turns(h, d) * cell_time`` more (the ``(cell, heading)`` search of
+  the League of Robot Runners' ``MAPF_T`` model); a ``thesis`` body turns
+  right at ``turn_time`` as above; an ``omni`` body's turns cost nothing.
 
 Heuristics (both admissible and consistent, so A* with a closed list returns
 optimal paths, Hart et al. 1968, theorems 1-3):
@@ -32,7 +37,9 @@ optimal paths, Hart et al. 1968, theorems 1-3):
   where ``needed`` holds NORTH/SOUTH if the goal's x is above/below and
   EAST/WEST if its y is east/west: every path must move in (so face) each
   needed direction, and :func:`~mrmp.core.heading.minimum_right_turns` is the
-  fewest right turns that face them all in any order. For consistency: a
+  fewest right turns that face them all in any order (for a body turning
+  either way, :func:`~mrmp.core.heading.minimum_quarter_turns`, the same
+  argument with the quarter-turn count, also a cyclic distance). For consistency: a
   move in direction ``d`` from heading ``h`` costs ``right_turns(h, d)``
   turns, and every direction needed before the move is ``d`` or still needed
   after it. Facing ``d`` first and then the new needed set in its best order
@@ -63,9 +70,10 @@ from collections.abc import Set as AbstractSet
 from dataclasses import dataclass
 from typing import Protocol, TypeVar
 
+from mrmp.core.body import BodyModel
 from mrmp.core.cell import Cell
 from mrmp.core.errors import NoPathError
-from mrmp.core.heading import HEADINGS, Heading, minimum_right_turns, right_turns
+from mrmp.core.heading import HEADINGS, Heading, minimum_quarter_turns, minimum_right_turns, quarter_turns, right_turns
 from mrmp.core.scenario import Timing
 from mrmp.search.graph import GridMap, check_endpoints
 from mrmp.search.result import SearchResult
@@ -155,7 +163,12 @@ _TURN_BOUND: list[tuple[tuple[int, ...], ...]] = [()] + [
     tuple(tuple(minimum_right_turns(heading, _X_NEED[sx] | _Y_NEED[sy]) for sy in (-1, 0, 1)) for sx in (-1, 0, 1))
     for heading in HEADINGS
 ]
+_QUARTER_BOUND: list[tuple[tuple[int, ...], ...]] = [()] + [
+    tuple(tuple(minimum_quarter_turns(heading, _X_NEED[sx] | _Y_NEED[sy]) for sy in (-1, 0, 1)) for sx in (-1, 0, 1))
+    for heading in HEADINGS
+]
 _TURNS: list[list[int]] = [[]] + [[0] + [right_turns(h, d) for d in HEADINGS] for h in HEADINGS]
+_QUARTERS: list[list[int]] = [[]] + [[0] + [quarter_turns(h, d) for d in HEADINGS] for h in HEADINGS]
 _DIRECTION_OF: dict[Cell, int] = {heading.delta: int(heading) for heading in HEADINGS}
 
 State = TypeVar("State", bound=Hashable)
@@ -202,7 +215,11 @@ class _CellModel:
 
 
 class _HeadingModel:
-    """States are ``(cell, heading number)``; a move charges right turns, then the entered cell."""
+    """States are ``(cell, heading number)``; a move charges the turns toward it, then the entered cell.
+
+    The turns are right turns at ``timing.turn_time`` each without a body
+    model, else the body's turns at the body's time per quarter turn.
+    """
 
     def __init__(
         self,
@@ -212,14 +229,21 @@ class _HeadingModel:
         blocked: AbstractSet[Cell],
         heading: Heading,
         timing: Timing,
+        body: BodyModel | None = None,
     ) -> None:
         self.grid = grid
         self.start = (start, int(Heading(heading)))
         self.goal = goal
         self.blocked = blocked
         self.cell_time = timing.cell_time
-        self.turn_time = timing.turn_time
         self.unit = grid.min_cost * timing.cell_time
+        if body is None:
+            self.turn_time = timing.turn_time
+        else:
+            self.turn_time = body.turn_ticks(timing.turn_time, timing.cell_time) * timing.cell_time
+        both_ways = body is not None and not body.clockwise_only
+        self.turn_counts = _QUARTERS if both_ways else _TURNS
+        self.turn_bound = _QUARTER_BOUND if both_ways else _TURN_BOUND
 
     def cell(self, state: tuple[Cell, int]) -> Cell:
         return state[0]
@@ -227,7 +251,7 @@ class _HeadingModel:
     def successors(self, state: tuple[Cell, int]) -> Iterable[tuple[tuple[Cell, int], float]]:
         cell, heading = state
         x, y = cell
-        turns = _TURNS[heading]
+        turns = self.turn_counts[heading]
         blocked, cost, cell_time, turn_time = self.blocked, self.grid.cost, self.cell_time, self.turn_time
         result = []
         for n in self.grid.neighbours(cell):
@@ -244,7 +268,7 @@ class _HeadingModel:
         dx, dy = self.goal[0] - x, self.goal[1] - y
         sx = (dx > 0) - (dx < 0)
         sy = (dy > 0) - (dy < 0)
-        return self.unit * (abs(dx) + abs(dy)) + self.turn_time * _TURN_BOUND[heading][sx + 1][sy + 1]
+        return self.unit * (abs(dx) + abs(dy)) + self.turn_time * self.turn_bound[heading][sx + 1][sy + 1]
 
 
 def _search(model: _Model[State], goal: Cell, strategy: Strategy) -> tuple[list[State], float, int]:
@@ -301,6 +325,7 @@ def best_first_search(
     blocked: Collection[Cell] = frozenset(),
     heading: Heading | None = None,
     timing: Timing | None = None,
+    body: BodyModel | None = None,
 ) -> SearchResult:
     """Search ``grid`` from ``start`` to ``goal`` in the order ``strategy`` gives.
 
@@ -323,6 +348,9 @@ def best_first_search(
     timing:
         Cell and turn durations; ``Timing()`` when omitted. Without a heading
         only ``cell_time`` is used (it scales every step).
+    body:
+        The body model whose turns a heading-aware search charges (module
+        docstring); right turns at ``timing.turn_time`` when omitted.
 
     Returns
     -------
@@ -343,6 +371,14 @@ def best_first_search(
     >>> result = best_first_search(Grid(3, 3), (0, 0), (1, 1), ASTAR, heading=Heading.EAST)
     >>> result.path, [h.name for h in result.headings], result.cost
     (((0, 0), (0, 1), (1, 1)), ['EAST', 'EAST', 'NORTH'], 3.5)
+
+    A ``turning`` body facing EAST turns a quarter left, one tick, instead of three right turns:
+
+    >>> from mrmp.core.body import body_model
+    >>> best_first_search(Grid(3, 3), (0, 0), (2, 0), ASTAR, heading=Heading.EAST, body=body_model("turning")).cost
+    3.0
+    >>> best_first_search(Grid(3, 3), (0, 0), (2, 0), ASTAR, heading=Heading.EAST).cost
+    3.5
     """
     if not isinstance(blocked, AbstractSet):
         blocked = frozenset(blocked)
@@ -351,7 +387,7 @@ def best_first_search(
         cell_time = 1.0 if timing is None else timing.cell_time
         cells, cost, expansions = _search(_CellModel(grid, start, goal, blocked, cell_time), goal, strategy)
         return SearchResult(path=tuple(cells), cost=cost, expansions=expansions)
-    model = _HeadingModel(grid, start, goal, blocked, heading, timing or Timing())
+    model = _HeadingModel(grid, start, goal, blocked, heading, timing or Timing(), body)
     states, cost, expansions = _search(model, goal, strategy)
     return SearchResult(
         path=tuple(cell for cell, _ in states),

@@ -26,6 +26,7 @@ from collections.abc import Collection, Sequence
 from itertools import pairwise
 from typing import Protocol, runtime_checkable
 
+from mrmp.core.body import BodyModel
 from mrmp.core.cell import Cell
 from mrmp.core.errors import NoPathError
 from mrmp.core.heading import Heading, right_turns
@@ -105,6 +106,10 @@ class Planner(Protocol):
         ``timing.turn_time`` per right turn and returns the headings.
     timing:
         How long a cell and a right turn take (``Timing()`` when omitted).
+    body:
+        The body model (:mod:`mrmp.core.body`) whose turns a heading-aware
+        planner charges instead of right turns: a ``turning`` body turns a
+        quarter either way, one cell time each.
 
     Returns
     -------
@@ -134,6 +139,7 @@ class Planner(Protocol):
         blocked: Collection[Cell] = ...,
         heading: Heading | None = None,
         timing: Timing | None = None,
+        body: BodyModel | None = None,
     ) -> SearchResult:
         """Plan a path from ``start`` to ``goal``."""
         ...
@@ -217,13 +223,15 @@ def path_cost(
     *,
     heading: Heading | None = None,
     timing: Timing | None = None,
+    body: BodyModel | None = None,
 ) -> float:
     """The cost of following ``path``, as every planner of :mod:`mrmp.search` counts it.
 
     The sum of ``cost(cell)`` over every cell entered (all but ``path[0]``),
     times ``timing.cell_time`` when ``timing`` is given; when ``heading`` is
     given, plus ``timing.turn_time`` per right turn (thesis section 3.3: the
-    robot only turns right, ``(h2 - h) mod 4`` turns from ``h`` to ``h2``).
+    robot only turns right, ``(h2 - h) mod 4`` turns from ``h`` to ``h2``), or,
+    with a ``body``, the body's turns at its time per quarter turn.
 
     Parameters
     ----------
@@ -235,6 +243,8 @@ def path_cost(
         The heading on ``path[0]``; ``None`` to ignore turns.
     timing:
         Cell and turn durations; ``Timing()`` when omitted.
+    body:
+        The body model whose turns count (:mod:`mrmp.core.body`); right turns when omitted.
 
     Returns
     -------
@@ -254,12 +264,19 @@ def path_cost(
     4.0
     >>> path_cost(grid, [(0, 0), (0, 1), (1, 1)], heading=Heading.NORTH, timing=Timing(2.0, 0.5))
     10.0
+    >>> from mrmp.core.body import body_model
+    >>> path_cost(grid, [(0, 0), (0, 1), (1, 1)], heading=Heading.NORTH, timing=Timing(2.0, 0.5), body=body_model("turning"))
+    12.0
     """
-    cell_time = 1.0 if timing is None else timing.cell_time
-    total = cell_time * sum(grid.cost(cell) for cell in path[1:])
+    timing = timing or Timing()
+    total = timing.cell_time * sum(grid.cost(cell) for cell in path[1:])
     if heading is not None:
-        turn_time = Timing().turn_time if timing is None else timing.turn_time
         headings = path_headings(path, heading)
-        turns = sum(right_turns(before, after) for before, after in pairwise(headings))
+        if body is None:
+            turn_time = timing.turn_time
+            turns = sum(right_turns(before, after) for before, after in pairwise(headings))
+        else:
+            turn_time = body.turn_ticks(timing.turn_time, timing.cell_time) * timing.cell_time
+            turns = sum(body.quarter_turns(before, after) for before, after in pairwise(headings))
         total += turn_time * turns
     return total

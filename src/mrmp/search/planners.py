@@ -20,6 +20,7 @@ from __future__ import annotations
 from collections.abc import Collection, Mapping
 from types import MappingProxyType
 
+from mrmp.core.body import BodyModel
 from mrmp.core.cell import Cell
 from mrmp.core.heading import Heading
 from mrmp.core.scenario import Timing
@@ -39,6 +40,7 @@ def dijkstra(
     blocked: Collection[Cell] = frozenset(),
     heading: Heading | None = None,
     timing: Timing | None = None,
+    body: BodyModel | None = None,
 ) -> SearchResult:
     """Find a cheapest path by uniform-cost search (Dijkstra 1959, "A note on two problems in connexion with graphs").
 
@@ -58,6 +60,9 @@ def dijkstra(
         ``timing.turn_time`` each and the result carries the headings.
     timing:
         Cell and turn durations; ``Timing()`` when omitted.
+    body:
+        The body model whose turns a heading-aware search charges
+        (:mod:`mrmp.search.best_first_engine`); right turns when omitted.
 
     Returns
     -------
@@ -77,7 +82,7 @@ def dijkstra(
     >>> result.path, result.cost
     (((1, 0), (2, 0), (2, 1), (2, 2), (1, 2)), 4.0)
     """
-    return best_first_search(grid, start, goal, DIJKSTRA, blocked=blocked, heading=heading, timing=timing)
+    return best_first_search(grid, start, goal, DIJKSTRA, blocked=blocked, heading=heading, timing=timing, body=body)
 
 
 def greedy_best_first(
@@ -88,6 +93,7 @@ def greedy_best_first(
     blocked: Collection[Cell] = frozenset(),
     heading: Heading | None = None,
     timing: Timing | None = None,
+    body: BodyModel | None = None,
 ) -> SearchResult:
     """Find a path by greedy best-first search (Pearl 1984, *Heuristics*).
 
@@ -109,6 +115,9 @@ def greedy_best_first(
         ``timing.turn_time`` each and the result carries the headings.
     timing:
         Cell and turn durations; ``Timing()`` when omitted.
+    body:
+        The body model whose turns a heading-aware search charges
+        (:mod:`mrmp.search.best_first_engine`); right turns when omitted.
 
     Returns
     -------
@@ -128,7 +137,7 @@ def greedy_best_first(
     >>> greedy_best_first(grid, (1, 0), (1, 2)).cost   # straight through the 9
     10.0
     """
-    return best_first_search(grid, start, goal, GREEDY_BEST_FIRST, blocked=blocked, heading=heading, timing=timing)
+    return best_first_search(grid, start, goal, GREEDY_BEST_FIRST, blocked=blocked, heading=heading, timing=timing, body=body)
 
 
 def astar(
@@ -139,6 +148,7 @@ def astar(
     blocked: Collection[Cell] = frozenset(),
     heading: Heading | None = None,
     timing: Timing | None = None,
+    body: BodyModel | None = None,
 ) -> SearchResult:
     """Find a cheapest path by A* (Hart, Nilsson & Raphael 1968).
 
@@ -163,6 +173,9 @@ def astar(
         and the result carries the headings.
     timing:
         Cell and turn durations; ``Timing()`` when omitted.
+    body:
+        The body model whose turns a heading-aware search charges
+        (:mod:`mrmp.search.best_first_engine`); right turns when omitted.
 
     Returns
     -------
@@ -189,7 +202,7 @@ def astar(
     ...
     mrmp.core.errors.NoPathError: no path: goal (4, 4) cannot be reached (searched 1 states)
     """
-    return best_first_search(grid, start, goal, ASTAR, blocked=blocked, heading=heading, timing=timing)
+    return best_first_search(grid, start, goal, ASTAR, blocked=blocked, heading=heading, timing=timing, body=body)
 
 
 PLANNERS: Mapping[str, Planner] = MappingProxyType(

@@ -18,6 +18,7 @@ from __future__ import annotations
 
 from collections.abc import Collection
 
+from mrmp.core.body import BodyModel
 from mrmp.core.cell import Cell, step_toward
 from mrmp.core.errors import NoPathError
 from mrmp.core.heading import Heading
@@ -66,6 +67,7 @@ def update_coordinate_path(
     blocked: Collection[Cell] = frozenset(),
     heading: Heading | None = None,
     timing: Timing | None = None,
+    body: BodyModel | None = None,
 ) -> SearchResult:
     """Plan with the thesis's update-coordinate method (sections 3.1 item 4, 3.2 assumption 2).
 
@@ -86,6 +88,8 @@ def update_coordinate_path(
         headings and its cost includes ``timing.turn_time`` per right turn.
     timing:
         Cell and turn durations; ``Timing()`` when omitted.
+    body:
+        The body model whose turns the cost counts (:func:`~mrmp.search.graph.path_cost`); right turns when omitted.
 
     Returns
     -------
@@ -117,6 +121,6 @@ def update_coordinate_path(
     for cell in path[1:]:
         if not grid.is_free(cell) or cell in blocked:
             raise NoPathError(f"update-coordinate path from {start} to {goal} is blocked at {cell}")
-    cost = path_cost(grid, path, heading=heading, timing=timing)
+    cost = path_cost(grid, path, heading=heading, timing=timing, body=body)
     headings = None if heading is None else path_headings(path, heading)
     return SearchResult(path=path, cost=cost, expansions=len(path), headings=headings)

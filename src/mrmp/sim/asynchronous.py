@@ -13,7 +13,12 @@ is event-driven and seeded:
   loses, delays, duplicates and reorders it as the scenario's network (and its
   per-link faults) say, through :func:`mrmp.core.faults.message_fates`;
 * a body is on its tail until its move ends, then on its head; the referee
-  (:class:`~mrmp.sim.referee.Referee`) judges the fleet at the end of every tick;
+  (:class:`~mrmp.sim.referee.Referee`) judges the fleet, in the body's model,
+  at the end of every tick;
+* a body that turns in place (``policy.body: turning``) and does not face the
+  head it may enter first turns toward it a quarter at a time, each turn
+  taking a random ``pace`` to ``2 * pace`` ticks, on its tail (which it still
+  holds), then drives straight ahead;
 * a robot's state goes to the robots whose bodies stand within its state radius
   (the lock radius plus the heartbeat period and the longest delay, in cells:
   the farthest a robot can have come since a peer's last state), found
@@ -42,6 +47,7 @@ import math
 import time
 from collections import Counter
 
+from mrmp.core.body import body_model
 from mrmp.core.cell import Cell
 from mrmp.core.heading import Heading, right_turns
 from mrmp.core.limits import MAX_TICKS
@@ -96,6 +102,7 @@ class AsynchronousSimulator:
         retry, lock_timeout, claim_timeout, self.heartbeat_period = causal_timers(worst.delay_max)
         self._random = stream_random(scenario.seed, Stream.PACES)
         self.paces = [self._random.randint(1, SLOWEST_PACE) for _ in scenario.robots]
+        self.body = body_model(scenario.policy.body)
         self.robots = [
             CausalRobot(
                 index,
@@ -109,11 +116,12 @@ class AsynchronousSimulator:
                 flat=flat,
                 heading=spec.heading,
                 state_radius=LOCK_RADIUS + self.heartbeat_period + worst.delay_max,
+                body=self.body,
             )
             for index, spec in enumerate(scenario.robots)
         ]
         self.network = scenario_network(scenario)
-        self.referee = Referee(grid, [spec.id for spec in scenario.robots])
+        self.referee = Referee(grid, [spec.id for spec in scenario.robots], self.body)
         self.lengths = shortest_steps(scenario)
         self.max_ticks = scenario.max_ticks or self.default_max_ticks()
         self.tick = 0
@@ -122,6 +130,9 @@ class AsynchronousSimulator:
         """Where every body stands: the simulated radio delivers radius broadcasts through it."""
         self._next_activation = [self._random.randint(0, 2 * pace) for pace in self.paces]
         self._arrival_at: list[int | None] = [None] * len(self.robots)
+        """When each body's action under way (a move, or a quarter turn toward its head) ends."""
+        self._turning_to: list[Heading | None] = [None] * len(self.robots)
+        """The heading of each body's quarter turn under way, if it is turning."""
         self._heartbeat_at = [self._random.randint(1, self.heartbeat_period) for _ in self.robots]
         self._results = [
             RobotResult(spec.id, spec.start, spec.goal, path=[spec.start], headings=[spec.heading])
@@ -161,6 +172,7 @@ class AsynchronousSimulator:
         tick = self.tick
         robots = self.robots
         before = list(self.bodies)
+        headings_before = [robot.heading for robot in robots]
         self._drain()
         for robot in robots:
             if self._next_activation[robot.index] <= tick:
@@ -170,14 +182,12 @@ class AsynchronousSimulator:
         for robot in robots:
             target = robot.motion(tick)
             if target is not None:
-                pace = self.paces[robot.index]
-                cost = self.scenario.grid.cost(target)
-                self._arrival_at[robot.index] = tick + max(1, math.ceil(self._random.randint(pace, 2 * pace) * cost))
+                self._start_action(robot, target)
         for robot in robots:
             index = robot.index
             if self._arrival_at[index] == tick:
                 self._arrival_at[index] = None
-                self._end_move(robot)
+                self._end_action(robot)
             self._send(robot, robot.expire(tick))
             if self._heartbeat_at[index] <= tick:
                 self._heartbeat_at[index] = tick + self.heartbeat_period
@@ -187,10 +197,35 @@ class AsynchronousSimulator:
             result = self._results[robot.index]
             result.path.append(self.bodies[robot.index])
             result.headings.append(robot.heading)
-        self.referee.check_tick(tick, before, self.bodies)
+        self.referee.check_tick(tick, before, self.bodies, headings_before, [robot.heading for robot in robots])
         self._count_goals()
         if self.on_tick is not None:
             self.on_tick(tick, list(self.bodies))
+
+    def _start_action(self, robot: CausalRobot, target: Cell) -> None:
+        """Start the body's next action toward ``target``: a quarter turn when it turns in place and does not face it,
+        else the move."""
+        index = robot.index
+        pace = self.paces[index]
+        turn = self.body.first_turn(robot.heading, Heading.between(self.bodies[index], target))
+        self._turning_to[index] = turn
+        if turn is not None:
+            self._arrival_at[index] = self.tick + self._random.randint(pace, 2 * pace)
+            return
+        cost = self.scenario.grid.cost(target)
+        self._arrival_at[index] = self.tick + max(1, math.ceil(self._random.randint(pace, 2 * pace) * cost))
+
+    def _end_action(self, robot: CausalRobot) -> None:
+        """The body's action is done: after a quarter turn, its next action toward the head; after a move, the arrival."""
+        turn = self._turning_to[robot.index]
+        if turn is None:
+            self._end_move(robot)
+            return
+        self._results[robot.index].turns += 1
+        self._send(robot, robot.turned(turn))
+        head = robot.head
+        assert head is not None
+        self._start_action(robot, head)
 
     def _end_move(self, robot: CausalRobot) -> None:
         """The body of ``robot`` stands on its head now."""
@@ -199,7 +234,8 @@ class AsynchronousSimulator:
         target = robot.head
         assert target is not None
         heading = Heading.between(source, target)
-        self._results[index].turns += right_turns(robot.heading, heading)
+        if not self.body.turns_in_place:
+            self._results[index].turns += right_turns(robot.heading, heading)
         self.bodies[index] = target
         self.radio.move(index, source, target)
         self._send(robot, robot.arrived_at(target, self.tick, heading))

@@ -40,7 +40,7 @@ from contextlib import contextmanager
 from dataclasses import dataclass
 from typing import Any, Protocol
 
-from mrmp.core.body import DEFAULT_BODY
+from mrmp.core.body import DEFAULT_BODY, BodyModel, body_model
 from mrmp.core.errors import InputError, Problem
 from mrmp.core.result import RunResult
 from mrmp.core.scenario import PolicyOptions, Scenario, Timing
@@ -72,8 +72,9 @@ class Simulation(Protocol):
 SimulatorFactory = Callable[..., Simulation]
 """A simulator class (or function) called as ``simulator(scenario, on_tick=on_tick)``."""
 
-DecisionRule = Callable[[Any, Timing], Policy]
-"""Builds one robot's per-robot :class:`~mrmp.policies.base.Policy` from the policy's options and the robots' timing."""
+DecisionRule = Callable[[Any, Timing, BodyModel], Policy]
+"""Builds one robot's per-robot :class:`~mrmp.policies.base.Policy` from the policy's options, the robots' timing
+and their body model."""
 
 
 @dataclass(frozen=True)
@@ -150,7 +151,7 @@ class PolicyEntry:
         """
         if self.decision_rule is None:
             raise InputError(Problem("policy.name", f"{self.name!r} {self.runs}, not as a per-robot policy"))
-        return self.decision_rule(self.options_of(policy), timing)
+        return self.decision_rule(self.options_of(policy), timing, body_model(policy.body))
 
     def simulation(self, scenario: Scenario, on_tick: TickObserver | None = None) -> Simulation:
         """This message-based policy's simulator, set up for ``scenario``."""
@@ -191,24 +192,29 @@ POLICY_TABLE: dict[str, PolicyEntry] = {
         "thesis",
         ThesisOptions,
         Robot,
-        decision_rule=lambda options, timing: ThesisPolicy(
-            resolve=options.resolve, search=chosen_search(options.search, ThesisPolicy.own_search).planner
+        decision_rule=lambda options, timing, body: ThesisPolicy(
+            resolve=options.resolve, search=chosen_search(options.search, ThesisPolicy.own_search).planner, body=body
         ),
         live_driver="agent",
         records_messages=True,
+        bodies=(DEFAULT_BODY, "turning"),
+        live_bodies=(DEFAULT_BODY, "turning"),
     ),
     "astar": PolicyEntry(
         "astar",
         AstarOptions,
         Robot,
-        decision_rule=lambda options, timing: AstarPolicy(
+        decision_rule=lambda options, timing, body: AstarPolicy(
             resolve=options.resolve,
             heading_aware=options.heading_aware,
             timing=timing,
+            body=body,
             search=chosen_search(options.search, AstarPolicy.own_search).planner,
         ),
         live_driver="agent",
         records_messages=True,
+        bodies=(DEFAULT_BODY, "turning"),
+        live_bodies=(DEFAULT_BODY, "turning"),
     ),
     "pibt": PolicyEntry(
         "pibt",
@@ -232,6 +238,8 @@ POLICY_TABLE: dict[str, PolicyEntry] = {
         runs="runs asynchronously (mrmp.sim.asynchronous)",
         live_driver="causal",
         always_guarded=True,
+        bodies=(DEFAULT_BODY, "turning"),
+        live_bodies=(DEFAULT_BODY, "turning"),
     ),
 }
 """Every policy a scenario or ``--policy`` may name, in the order they are listed and compared."""
@@ -283,12 +291,14 @@ def body_problem(scenario: Scenario, *, live: bool = False, planned: bool = Fals
     True
     >>> body_problem(turning, live=True) is None
     True
-    >>> print(body_problem(turning.with_changes(policy=PolicyOptions(name="causal", body="turning")), live=True))
-    policy.body: causal drives omni bodies live so far, not turning
+    >>> print(body_problem(turning.with_changes(policy=PolicyOptions(name="causal", body="thesis")), live=True))
+    policy.body: causal drives omni, turning bodies live so far, not thesis
     >>> body_problem(turning, live=True, planned=True) is None
     True
-    >>> print(body_problem(turning.with_changes(policy=PolicyOptions(name="astar", body="turning"))))
-    policy.body: astar plans for omni bodies, not turning
+    >>> body_problem(turning.with_changes(policy=PolicyOptions(name="astar", body="turning")), live=True) is None
+    True
+    >>> print(body_problem(turning.with_changes(policy=PolicyOptions(name="astar", body="thesis"))))
+    policy.body: astar plans for omni, turning bodies, not thesis
     """
     body = scenario.policy.body
     if body == DEFAULT_BODY:

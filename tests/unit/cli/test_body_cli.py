@@ -19,8 +19,11 @@ def invoke(*args: object):
     return runner.invoke(app, [str(arg) for arg in args])
 
 
-def test_pibt_runs_turning_bodies_and_the_result_is_judged_in_their_model() -> None:
-    result = invoke("run", CROWD, "--policy", "pibt", "--body", "turning", "--sequencing", "driver", "--json", "-")
+@pytest.mark.parametrize(
+    "policy", [["--policy", "pibt", "--sequencing", "driver"], ["--policy", "astar"], ["--policy", "causal"]]
+)
+def test_planners_run_turning_bodies_and_the_result_is_judged_in_their_model(policy: list[str]) -> None:
+    result = invoke("run", CROWD, *policy, "--body", "turning", "--json", "-")
     assert result.exit_code == 0, result.output
     run = json.loads(result.stdout)
     assert run["success"] and run["collisions"] == []
@@ -33,11 +36,10 @@ def test_pibt_runs_turning_bodies_and_the_result_is_judged_in_their_model() -> N
 @pytest.mark.parametrize(
     ("flags", "reason"),
     [
-        (["--policy", "astar", "--body", "turning"], "policy.body: astar plans for omni bodies, not turning"),
-        (["--policy", "causal", "--body", "turning"], "policy.body: causal plans for omni bodies, not turning"),
+        (["--policy", "causal", "--body", "thesis"], "policy.body: causal plans for omni, turning bodies, not thesis"),
         (
-            ["--policy", "causal", "--body", "turning", "--live"],
-            "policy.body: causal drives omni bodies live so far, not turning",
+            ["--policy", "astar", "--body", "thesis", "--live"],
+            "policy.body: astar drives omni, turning bodies live so far, not thesis",
         ),
         (["--body", "thesis", "--planner", "lacam"], "policy.body: central plans are executed by omni, turning bodies, not thesis"),
         (["--body", "wheels"], "must be one of omni, thesis, turning, got 'wheels'"),

@@ -1,8 +1,18 @@
 """Turning (thesis section 3.3) and the discrepancy with the thesis's |h' - h|."""
 
+import itertools
+
 import pytest
 
-from mrmp.core.heading import HEADINGS, Heading, minimum_right_turns, right_turns, thesis_turn_count
+from mrmp.core.heading import (
+    HEADINGS,
+    Heading,
+    minimum_quarter_turns,
+    minimum_right_turns,
+    quarter_turns,
+    right_turns,
+    thesis_turn_count,
+)
 
 
 def test_thesis_constants():
@@ -61,3 +71,22 @@ def test_minimum_right_turns_is_a_lower_bound():
     assert minimum_right_turns(Heading.NORTH, set()) == 0
     assert minimum_right_turns(Heading.NORTH, {Heading.NORTH, Heading.EAST}) == 1
     assert minimum_right_turns(Heading.WEST, {Heading.NORTH, Heading.EAST}) == 2
+
+
+@pytest.mark.parametrize("current", HEADINGS)
+def test_minimum_quarter_turns_is_the_fewest_over_every_order(current: Heading) -> None:
+    """Brute force over every sequence of up to four quarter turns either way: the fewest that face each needed
+    heading at some point equals the bound, for every set of headings a path may need."""
+    sequences = [sequence for length in range(5) for sequence in itertools.product((1, -1), repeat=length)]
+    for size in range(3):
+        for needed in itertools.combinations(HEADINGS, size):
+            fewest = min(len(sequence) for sequence in sequences if set(needed) <= set(_faced(current, sequence)))
+            assert minimum_quarter_turns(current, set(needed)) == fewest, needed
+    assert [quarter_turns(current, target) for target in HEADINGS].count(2) == 1
+
+
+def _faced(current: Heading, sequence: tuple[int, ...]) -> list[Heading]:
+    faced = [current]
+    for step in sequence:
+        faced.append(Heading((int(faced[-1]) - 1 + step) % 4 + 1))
+    return faced

@@ -4,11 +4,13 @@ import random
 
 import pytest
 
+from mrmp.core.body import body_model
 from mrmp.core.errors import NoPathError
 from mrmp.core.grid import Grid
-from mrmp.core.heading import HEADINGS
+from mrmp.core.heading import HEADINGS, Heading
 from mrmp.core.scenario import Timing
 from mrmp.search import astar
+from mrmp.search.graph import path_cost
 from mrmp.search.heading_distance import heading_distances
 
 
@@ -35,6 +37,41 @@ def test_every_state_costs_what_heading_aware_astar_finds(seed, turn_cost):
             except NoPathError:
                 expected = float("inf")
             assert value == pytest.approx(expected), (cell, heading)
+
+
+@pytest.mark.parametrize("seed", range(8))
+@pytest.mark.parametrize("cell_time", [1.0, 0.4])
+def test_a_turning_body_costs_what_its_either_way_table_counts(seed, cell_time):
+    """A* for a body that turns a quarter either way in one tick (the ``turning`` body, LoRR's MAPF_T) finds, from
+    every state, the cost the backward table with ``both_ways`` counts, in cell times; its path costs that too."""
+    grid = random_grid(seed)
+    free = grid.free_cells()
+    goal = random.Random(seed).choice(free)
+    table = heading_distances(grid, goal, 1.0, both_ways=True)
+    turning = body_model("turning")
+    for cell in free:
+        for heading in HEADINGS:
+            value = table[4 * (cell[0] * grid.y_size + cell[1]) + int(heading) - 1] * cell_time
+            try:
+                result = astar(grid, cell, goal, heading=heading, timing=Timing(cell_time, 0.5), body=turning)
+            except NoPathError:
+                assert value == float("inf"), (cell, heading)
+                continue
+            assert result.cost == pytest.approx(value), (cell, heading)
+            timing = Timing(cell_time, 0.5)
+            assert path_cost(grid, result.path, heading=heading, timing=timing, body=turning) == pytest.approx(value)
+
+
+def test_a_turning_body_turns_the_short_way_where_the_thesis_body_turns_right_three_times():
+    corridor = Grid(3, 1)  # a column: north is +x
+    turning = astar(corridor, (0, 0), (2, 0), heading=Heading.WEST, timing=Timing(1.0, 1.0), body=body_model("turning"))
+    thesis = astar(corridor, (0, 0), (2, 0), heading=Heading.WEST, timing=Timing(1.0, 1.0), body=body_model("thesis"))
+    assert (turning.cost, thesis.cost) == (3.0, 3.0)  # one quarter counter-clockwise; one right turn from WEST
+    turning = astar(corridor, (0, 0), (2, 0), heading=Heading.EAST, timing=Timing(1.0, 1.0), body=body_model("turning"))
+    thesis = astar(corridor, (0, 0), (2, 0), heading=Heading.EAST, timing=Timing(1.0, 1.0), body=body_model("thesis"))
+    assert (turning.cost, thesis.cost) == (3.0, 5.0)  # EAST to NORTH: one left quarter, or three right turns
+    omni = astar(corridor, (0, 0), (2, 0), heading=Heading.EAST, timing=Timing(1.0, 1.0), body=body_model("omni"))
+    assert omni.cost == 2.0
 
 
 def test_blocked_cells_are_unreachable_and_bad_arguments_are_refused():

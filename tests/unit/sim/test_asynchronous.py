@@ -1,6 +1,7 @@
 """The asynchronous simulator: seeded, speeds that differ, faults counted, dispatched by simulate()."""
 
 from mrmp.core import Grid, NetworkFaults, PolicyOptions, RobotSpec, Scenario
+from mrmp.core.heading import Heading
 from mrmp.sim.asynchronous import SLOWEST_PACE, AsynchronousSimulator
 from mrmp.sim.simulator import simulate
 
@@ -48,3 +49,34 @@ def test_the_tick_limit_ends_a_run_partially():
     result = AsynchronousSimulator(crossing(max_ticks=3)).run()
     assert result.ticks == 3 and result.stop_reason == "tick limit" and not result.success
     assert all(len(robot.path) == 4 for robot in result.robots)
+
+
+class DrivesWithoutTurning(AsynchronousSimulator):
+    """Broken: a turning body drives into its head whatever it faces, as an ``omni`` body would."""
+
+    def _start_action(self, robot, target):
+        self._turning_to[robot.index] = None
+        self._arrival_at[robot.index] = self.tick + self.paces[robot.index]
+
+
+def test_turning_bodies_turn_toward_their_head_first_and_the_referee_judges_their_actions():
+    """Causal-PIBT for ``turning`` bodies: every robot arrives, each move straight ahead after its quarter turns;
+    a body that drives sideways is reported as an ``action`` collision."""
+    faults = NetworkFaults(loss=0.2, delay_max=2, duplicate=0.1, reorder=0.2)
+    scenario = crossing(network=faults, policy=PolicyOptions(name="causal", body="turning"))
+    result = AsynchronousSimulator(scenario).run()
+    assert result.success and result.collisions == [] and result.body == "turning"
+    assert sum(robot.turns for robot in result.robots) > 0
+    broken = DrivesWithoutTurning(scenario).run()
+    assert any(collision.kind == "action" for collision in broken.collisions)
+
+
+def test_turning_bodies_rank_their_candidates_by_the_turns_they_cost():
+    """Two routes as long round the obstacle: a robot facing one of them takes it (no turn before its first move)."""
+    for heading, first in ((Heading.EAST, (0, 1)), (Heading.NORTH, (1, 0))):
+        robots = (RobotSpec("a", (0, 0), (2, 2), heading=heading),)
+        scenario = Scenario(Grid(3, 3, [(1, 1)]), robots, policy=PolicyOptions(name="causal", body="turning"), seed=1)
+        result = AsynchronousSimulator(scenario).run()
+        assert result.success
+        assert next(cell for cell in result.robots[0].path if cell != (0, 0)) == first
+        assert result.robots[0].turns == 1
