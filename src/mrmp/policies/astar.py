@@ -117,6 +117,8 @@ class AstarPolicy:
         present = situation.present
         if present == situation.goal:
             return present
+        if self._path[1:2] == [present]:
+            del self._path[0]  # it turned at its decision, then drove into the cell it had chosen (see _advance)
         stale = len(self._path) < 2 or self._path[0] != present or self._path[-1] != situation.goal
         if stale or not self.held.isdisjoint(self._path[1:]):
             self._path = self._plan(situation, self.held) or [present]
@@ -169,6 +171,9 @@ class AstarPolicy:
         (a diversion included); it drives on once it faces the cell. Without
         this, a diverted robot would find itself off its plan after the turn,
         plan afresh, and turn back: robots would spin in place in a crowd.
+        A live robot drives into the cell it claimed as soon as it faces it,
+        with no decision in between: :meth:`intend` then finds it on the plan's
+        next cell and steps on.
         """
         if self.body.turns_in_place and Heading.between(situation.present, entered) != situation.heading:
             return

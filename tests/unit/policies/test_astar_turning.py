@@ -21,6 +21,7 @@ from mrmp.core.heading import Heading
 from mrmp.core.scenario import Timing
 from mrmp.policies.astar import AstarPolicy
 from mrmp.policies.base import Situation
+from mrmp.search.planners import astar
 from mrmp.sim.simulator import simulate
 
 ROOT = Path(__file__).resolve().parents[3]
@@ -68,3 +69,23 @@ def test_a_crowd_of_turning_robots_arrives_where_stepping_while_turning_spins() 
     broken = crowd(StepsWhileTurning)
     assert broken.collisions == []
     assert sum(robot.arrived for robot in broken.robots) < len(broken.robots), "the broken variant should jam"
+
+
+def test_a_live_robot_that_turned_then_drove_on_stays_on_its_plan() -> None:
+    """Live, a robot drives into the cell it claimed once its turn toward it ends, with no decision in between:
+    the policy finds it on its plan's next cell and steps on, without planning again (a diversion would be lost)."""
+    searches: list[Cell] = []
+
+    def counted(grid, start, goal, **options):
+        searches.append(start)
+        return astar(grid, start, goal, **options)
+
+    policy = AstarPolicy(body=body_model("turning"), search=counted)
+    grid = Grid(3, 3)
+    facing_north = Situation(0, (0, 0), Heading.NORTH, (0, 2), grid, {})
+    first = policy.intend(facing_north)
+    assert first == (0, 1) and policy.decide(facing_north, first).next == (0, 1)  # east: a quarter turn first
+    assert policy._path[0] == (0, 0)  # its decision was a turn: the plan has not stepped
+    drove_on = Situation(0, (0, 1), Heading.EAST, (0, 2), grid, {})
+    assert policy.intend(drove_on) == (0, 2)
+    assert searches == [(0, 0)]
