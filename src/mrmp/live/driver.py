@@ -212,6 +212,45 @@ class HelloSchedule:
 
 
 @dataclass
+class _FleetWait:
+    """Where a robot's wait for its fleet stands (:meth:`LiveDriver.fleet_wait_turn`)."""
+
+    deadline: float
+    last_fleet_state: float
+    unheard: tuple[int, ...]
+
+
+@dataclass
+class _RunTimes:
+    """When the main loop last did what it does now and then (:meth:`LiveDriver.turn`)."""
+
+    started: float
+    last_state: float
+    last_fleet_state: float
+    last_progress: float
+    linger: float
+    on_progress: Callable[[AgentReport], None] | None
+    progress_every: float
+    everyone_done_since: float | None = None
+
+
+class Sending(Protocol):
+    """Where a driver's sealed datagrams go: its client thread, or a virtual network (:mod:`mrmp.live.virtual_time`)."""
+
+    def start(self) -> None:
+        """Begin sending."""
+        ...
+
+    def send(self, data: bytes, recipient: int | None) -> None:
+        """Send ``data`` to ``recipient`` (every peer when None)."""
+        ...
+
+    def close(self) -> None:
+        """Send what is queued, then stop."""
+        ...
+
+
+@dataclass
 class AgentReport:
     """What one robot did in a live run (written to ``agent-<index>.json``)."""
 
@@ -324,7 +363,7 @@ class LiveDriver:
         self._peers = len(scenario.robots) - 1
         self._waiting_on: int | None = None
         """The peer that kept :meth:`_everyone_done` False last time (asked first next time)."""
-        self._client = ClientThread(transport, name=f"robot-{index}-client")
+        self._client: Sending = ClientThread(transport, name=f"robot-{index}-client")
         self.cell_seconds = scenario.timing.cell_time / getattr(body, "time_scale", 1.0)
         """Seconds the body takes for a cell (a body without a time scale runs in real time)."""
         self._hellos = HelloSchedule((), 0.0, timing.heartbeat, timing.fleet_heartbeat)
@@ -397,6 +436,11 @@ class LiveDriver:
         """
         return False
 
+    def send_through(self, client: Sending) -> None:
+        """Send through ``client`` instead of the client thread (a driver run on a virtual clock, which sends as it
+        goes, from the one thread that runs every robot: :mod:`mrmp.live.virtual_time`)."""
+        self._client = client
+
     def request_stop(self) -> None:
         """Ask the run to stop (from a signal handler or another thread); the main loop wakes at once."""
         self.stop_requested.set()
@@ -435,12 +479,15 @@ class LiveDriver:
     def _receive_loop(self) -> None:
         while self._receiving.is_set():
             data = self.transport.receive(0.05)
-            if data is None:
-                continue
-            with self._lock:
-                message = self.opener.open(data)
-            if message is not None:
-                self._inbox.put(message)
+            if data is not None:
+                self.take_datagram(data)
+
+    def take_datagram(self, data: bytes) -> None:
+        """Open a datagram that arrived and queue its message for the main loop (dropped and counted if it is bad)."""
+        with self._lock:
+            message = self.opener.open(data)
+        if message is not None:
+            self._inbox.put(message)
 
     def _drain_inbox(self, now: float) -> None:
         """Hand the brain every message the receiving thread queued, and send its answers; answer a hello with the
@@ -469,11 +516,19 @@ class LiveDriver:
         turn. Otherwise it sleeps until ``until``, and the first message to
         arrive wakes it at once.
         """
-        timeout = until - self.clock()
-        if timers and not self._timers_idle():
-            self._nap(max(0.0, min(timeout, self.timing.poll)))
+        now = self.clock()
+        wake, woken_by_messages = self.wake_rule(now, until, timers)
+        if woken_by_messages:
+            self._inbox.wait(max(0.0, wake - now))
         else:
-            self._inbox.wait(max(0.0, timeout))
+            self._nap(max(0.0, wake - now))
+
+    def wake_rule(self, now: float, until: float, timers: bool = True) -> tuple[float, bool]:
+        """When the main loop, about to sleep at ``now`` until ``until``, wakes at the latest, and whether a
+        message arriving earlier wakes it (:meth:`_sleep`; a driver on a virtual clock follows the same rule)."""
+        if timers and not self._timers_idle():
+            return min(until, now + self.timing.poll), False
+        return until, True
 
     def _nap(self, seconds: float) -> None:
         """Sleep ``seconds`` whatever arrives (a poll's sleep)."""
@@ -508,77 +563,108 @@ class LiveDriver:
     # -- the main loop ---------------------------------------------------------------------
 
     def run(self, on_progress: Callable[[AgentReport], None] | None = None, progress_every: float = 1.0) -> AgentReport:
-        """Run until done, timed out or stopped; returns (and keeps in :attr:`report`) the report."""
-        timing, report = self.timing, self.report
+        """Run until done, timed out or stopped; returns (and keeps in :attr:`report`) the report.
+
+        The receiving and client threads run beside the main loop; the main
+        loop waits for the fleet, then runs :meth:`turn` and sleeps until what
+        it returns (or a message wakes it: :meth:`wake_rule`).
+        """
         clock = self.clock
         self._receiving.set()
         receiver = threading.Thread(target=self._receive_loop, name=f"robot-{self.index}-server", daemon=True)
         receiver.start()
         self._client.start()
-        self._wait_for_fleet()
-        started = clock()
-        report.started_at = started
-        report.believed_path.append((started, self._present()))
-        if on_progress is not None:  # the launcher learns at once when this robot's run began
-            self._fill_report(started)
-            on_progress(report)
-        self._send(fleet_wide(self._state_messages(started)))
-        last_state = last_fleet_state = started
-        self._begin(started)
-        everyone_done_since: float | None = None
-        last_progress = started
-        linger = max(timing.linger, timing.fleet_heartbeat + timing.heartbeat)  # a far peer's news takes a fleet heartbeat
         try:
+            self.begin_fleet_wait(clock())
             while not self.stop_requested.is_set():
-                now = clock()
-                if now - started > timing.timeout:
-                    report.stop_reason = "timeout"
+                wake = self.fleet_wait_turn(clock())
+                if wake is None:
                     break
-                self._drain_inbox(now)
-                if self._step(now, started):
-                    last_state = now
-                self._send(self.robot.expire(now))
-                if now - last_fleet_state >= timing.fleet_heartbeat:
-                    self._send(fleet_wide(self._state_messages(now)))
-                    last_state = last_fleet_state = now
-                elif now - last_state >= timing.heartbeat:
-                    self._send(self._state_messages(now))
-                    last_state = now
-                if self._everyone_done(now):
-                    everyone_done_since = everyone_done_since if everyone_done_since is not None else now
-                    if now - everyone_done_since >= linger:
-                        report.stop_reason = "all arrived" if not report.silent_peers else "arrived; peers silent"
-                        self._send(fleet_wide(self._state_messages(now)))  # every peer's last news of it is fresh
-                        break
-                else:
-                    everyone_done_since = None
-                if on_progress is not None and now - last_progress >= progress_every:
-                    last_progress = now
-                    self._fill_report(now)
-                    on_progress(report)
-                self._sleep(
-                    min(
-                        self._due(),
-                        last_state + timing.heartbeat,
-                        last_fleet_state + timing.fleet_heartbeat,
-                        started + timing.timeout,
-                        math.inf if everyone_done_since is None else everyone_done_since + linger,
-                        math.inf if on_progress is None else last_progress + progress_every,
-                    )
-                )
+                self._sleep(wake, timers=False)  # no brain timers run before the start
+            self.begin_run(clock(), on_progress, progress_every)
+            while not self.stop_requested.is_set():
+                wake = self.turn(clock())
+                if wake is None:
+                    break
+                self._sleep(wake)
             else:
-                report.stop_reason = "interrupted"
+                self.report.stop_reason = "interrupted"
         finally:
             try:
                 self._client.close()  # what is queued still goes out, while the receiving thread answers
             finally:
                 self._receiving.clear()
                 receiver.join(timeout=1.0)
-                self._fill_report(clock())
-        return report
+                self.fill_report(clock())
+        return self.report
 
-    def _wait_for_fleet(self) -> None:
-        """Send the state, and answer, until every peer has been heard (or ``start_wait`` passes).
+    def begin_run(
+        self, now: float, on_progress: Callable[[AgentReport], None] | None = None, progress_every: float = 1.0
+    ) -> None:
+        """Start the run at ``now`` (the fleet has been waited for): tell every peer, and begin the first step."""
+        report = self.report
+        report.started_at = now
+        report.believed_path.append((now, self._present()))
+        if on_progress is not None:  # the launcher learns at once when this robot's run began
+            self.fill_report(now)
+            on_progress(report)
+        self._send(fleet_wide(self._state_messages(now)))
+        linger = max(self.timing.linger, self.timing.fleet_heartbeat + self.timing.heartbeat)  # a far peer's news
+        self._loop = _RunTimes(now, now, now, now, linger, on_progress, progress_every)
+        self._begin(now)
+
+    def turn(self, now: float) -> float | None:
+        """One turn of the main loop at ``now``; when to wake for the next (:meth:`wake_rule`), or None: the run is over.
+
+        Hand the brain what arrived, run the policy's step and the brain's
+        timers, send the heartbeats due, end the run when this robot and every
+        peer are done (after a linger) or at the timeout, and report progress.
+        """
+        loop, timing, report = self._loop, self.timing, self.report
+        if now - loop.started > timing.timeout:
+            report.stop_reason = "timeout"
+            return None
+        self._drain_inbox(now)
+        if self._step(now, loop.started):
+            loop.last_state = now
+        self._send(self.robot.expire(now))
+        if now - loop.last_fleet_state >= timing.fleet_heartbeat:
+            self._send(fleet_wide(self._state_messages(now)))
+            loop.last_state = loop.last_fleet_state = now
+        elif now - loop.last_state >= timing.heartbeat:
+            self._send(self._state_messages(now))
+            loop.last_state = now
+        if self._everyone_done(now):
+            if loop.everyone_done_since is None:
+                loop.everyone_done_since = now
+            if now - loop.everyone_done_since >= loop.linger:
+                report.stop_reason = "all arrived" if not report.silent_peers else "arrived; peers silent"
+                self._send(fleet_wide(self._state_messages(now)))  # every peer's last news of it is fresh
+                return None
+        else:
+            loop.everyone_done_since = None
+        if loop.on_progress is not None and now - loop.last_progress >= loop.progress_every:
+            loop.last_progress = now
+            self.fill_report(now)
+            loop.on_progress(report)
+        return min(
+            self._due(),
+            loop.last_state + timing.heartbeat,
+            loop.last_fleet_state + timing.fleet_heartbeat,
+            loop.started + timing.timeout,
+            math.inf if loop.everyone_done_since is None else loop.everyone_done_since + loop.linger,
+            math.inf if loop.on_progress is None else loop.last_progress + loop.progress_every,
+        )
+
+    def begin_fleet_wait(self, now: float) -> None:
+        """Start waiting for the fleet at ``now`` (:meth:`fleet_wait_turn`)."""
+        unheard = self._unheard_peers()
+        self._fleet_wait = _FleetWait(now + self.timing.start_wait, -math.inf, unheard)
+        self._hellos = HelloSchedule(unheard, now, self.timing.heartbeat, self.timing.fleet_heartbeat)
+
+    def fleet_wait_turn(self, now: float) -> float | None:
+        """One turn of the wait for the fleet: send the state, and answer, until every peer has been heard (or
+        ``start_wait`` passes); when to wake for the next turn, or None: the wait is over.
 
         The state goes every fleet heartbeat to every peer, and at once to a
         peer heard from for the first time (it is up: now it hears this robot
@@ -589,28 +675,22 @@ class LiveDriver:
         flood with hellos the robots already up, nor the addresses of those not up yet;
         a hello from a peer not heard from (it is up) starts its gaps again from a heartbeat.
         """
-        clock, timing = self.clock, self.timing
-        started = clock()
-        deadline = started + timing.start_wait
-        last_fleet_state = -math.inf
-        unheard = self._unheard_peers()
-        hellos = self._hellos = HelloSchedule(unheard, started, timing.heartbeat, timing.fleet_heartbeat)
-        while not self.stop_requested.is_set() and self._peers_heard() < self._peers and clock() < deadline:
-            now = clock()
-            self._drain_inbox(now)
-            still_unheard = self._unheard_peers()
-            newly_heard = tuple(sorted(set(unheard) - set(still_unheard)))
-            unheard = still_unheard
-            if newly_heard and now - last_fleet_state < timing.fleet_heartbeat:  # answered at once
-                self._send(self._fleet_wait_to(newly_heard))
-            if now - last_fleet_state >= timing.fleet_heartbeat:
-                self._send(fleet_wide(self._fleet_wait_messages()))
-                last_fleet_state = now
-            due = hellos.take_due(unheard, now)
-            if due:
-                self._send(self._hellos_to(due))
-            next_event = min(hellos.next_due(unheard), last_fleet_state + timing.fleet_heartbeat, deadline)
-            self._sleep(next_event, timers=False)  # no brain timers run before the start
+        wait, timing, hellos = self._fleet_wait, self.timing, self._hellos
+        if self._peers_heard() >= self._peers or now >= wait.deadline:
+            return None
+        self._drain_inbox(now)
+        still_unheard = self._unheard_peers()
+        newly_heard = tuple(sorted(set(wait.unheard) - set(still_unheard)))
+        wait.unheard = still_unheard
+        if newly_heard and now - wait.last_fleet_state < timing.fleet_heartbeat:  # answered at once
+            self._send(self._fleet_wait_to(newly_heard))
+        if now - wait.last_fleet_state >= timing.fleet_heartbeat:
+            self._send(fleet_wide(self._fleet_wait_messages()))
+            wait.last_fleet_state = now
+        due = hellos.take_due(wait.unheard, now)
+        if due:
+            self._send(self._hellos_to(due))
+        return min(hellos.next_due(wait.unheard), wait.last_fleet_state + timing.fleet_heartbeat, wait.deadline)
 
     def _fleet_wait_to(self, peers: tuple[int, ...]) -> list[Outgoing]:
         """The fleet-wait state addressed to ``peers`` only."""
@@ -655,7 +735,7 @@ class LiveDriver:
             return "silent"
         return "running"
 
-    def _fill_report(self, now: float) -> None:
+    def fill_report(self, now: float) -> None:
         report, robot = self.report, self.robot
         report.ended_at = now
         report.arrived = self._arrived()

@@ -537,15 +537,12 @@ class PibtAgent(LiveDriver):
 
     # -- the receiving thread: repeats of PIBT messages pass --------------------------------
 
-    def _receive_loop(self) -> None:
-        while self._receiving.is_set():
-            data = self.transport.receive(0.05)
-            if data is None:
-                continue
-            with self._lock:
-                message = open_repeat(self.opener, data)
-            if message is not None:
-                self._inbox.put(message)
+    def take_datagram(self, data: bytes) -> None:
+        """Open a datagram that arrived (a repeat of a PIBT message too: :func:`open_repeat`) and queue its message."""
+        with self._lock:
+            message = open_repeat(self.opener, data)
+        if message is not None:
+            self._inbox.put(message)
 
     # -- the step ----------------------------------------------------------------------------
 

@@ -141,6 +141,15 @@ def _on_stop_signals(action: Callable[[], None]) -> None:
 
 
 @dataclass(frozen=True)
+class DriverOptions:
+    """What a live driver takes besides its robot's scenario, transport, body and envelope."""
+
+    timing: AgentTiming
+    seed: int = 0
+    guarded: bool = True
+
+
+@dataclass(frozen=True)
 class AgentOptions:
     """Everything one robot process needs besides the scenario."""
 
@@ -176,7 +185,7 @@ def _per_robot_agent(
     body: Body,
     sealer: Sealer,
     opener: Opener,
-    options: AgentOptions,
+    options: DriverOptions,
     policy: PlanFollowingPolicy | None,
 ) -> Agent:
     """The live driver of a per-robot policy (or of a central plan's share)."""
@@ -193,7 +202,7 @@ def _causal_agent(
     body: Body,
     sealer: Sealer,
     opener: Opener,
-    options: AgentOptions,
+    options: DriverOptions,
     policy: PlanFollowingPolicy | None,
 ) -> CausalAgent:
     """The live driver of Causal-PIBT (always through the safety layer)."""
@@ -207,7 +216,7 @@ def _pibt_agent(
     body: Body,
     sealer: Sealer,
     opener: Opener,
-    options: AgentOptions,
+    options: DriverOptions,
     policy: PlanFollowingPolicy | None,
 ) -> PibtAgent:
     """The live driver of ``pibt``: locally sequenced, in steps on a common clock, always through the safety layer."""
@@ -215,7 +224,7 @@ def _pibt_agent(
 
 
 LiveDriver = Callable[
-    [Scenario, int, Transport, Body, Sealer, Opener, "AgentOptions", "PlanFollowingPolicy | None"],
+    [Scenario, int, Transport, Body, Sealer, Opener, "DriverOptions", "PlanFollowingPolicy | None"],
     "Agent | CausalAgent | PibtAgent",
 ]
 
@@ -283,7 +292,7 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
         sealer = Sealer(options.key, options.session)
         opener = Opener(options.key, options.session, fleet_size=len(scenario.robots))
         agent = LIVE_DRIVERS[driver_kind(scenario, following_plan=policy is not None)](
-            scenario, index, transport, body, sealer, opener, options, policy
+            scenario, index, transport, body, sealer, opener, DriverOptions(options.timing, options.seed, options.guarded), policy
         )
         _on_stop_signals(agent.request_stop)
         watch_parent(agent.request_stop)
@@ -412,7 +421,8 @@ def run_referee(
     """
     if stop is None:
         stop = stop_on_signals()
-    watch_parent(stop.set)
+    if done_file is not None:  # following a run: it ends with its parent
+        watch_parent(stop.set)
     ids, starts = [robot.id for robot in scenario.robots], [robot.start for robot in scenario.robots]
     readers = [TraceReader(results / f"trace-{index}.jsonl") for index in range(len(scenario.robots))]
     pending = [event for reader in readers for event in reader.read_new()]

@@ -1,0 +1,124 @@
+"""Live ``pibt`` fleets larger than this machine, on a virtual clock: datagrams per move, makespan against the bound.
+
+Each case runs the live fleet (every robot's live driver, brain, safety layer
+and body, unchanged) in one process on a virtual clock over a simulated network
+(:mod:`mrmp.live.virtual_time`: a latency, seeded loss, and a processor per
+robot that takes ``--turn-us`` per turn of its main loop and ``--datagram-us``
+per datagram it takes in or sends). It prints, per case: robots arrived,
+collisions (the live referee's), the virtual makespan, the simulator's makespan
+(``pibt`` with local sequencing over a perfect network, one cell time a step)
+and the execution bound (those decisions carried out by live bodies, with no
+time for messages: :func:`mrmp.centralized.body_time.execution_seconds`, a
+body entering a cell once its occupant has arrived elsewhere) with the ratio
+to each, moves, datagrams per move, the robots' own counts (steps begun held,
+held robots that gave up, abandoned steps, retransmissions), and what the
+harness cost: its CPU seconds and microseconds per datagram handled (the same
+code a robot process runs, without sockets and threads).
+
+Cases (``--cases``, comma-separated ``MAP:ROBOTS``): a map of ``maps/`` with
+its ``-random-1`` scenario's first ``ROBOTS`` agents, or ``causal-32:N`` for
+``examples/causal-32.yaml``'s first ``N`` robots.
+
+Usage: python bench/live_virtual.py [--cases random-64-64-10:200,random-64-64-10:1000] [--loss 0.1]
+       [--time-scale 5] [--synchronizer clock|local] [--body omni|turning] [--turn-us 50] [--datagram-us 30]
+"""
+
+from __future__ import annotations
+
+import argparse
+import tempfile
+from pathlib import Path
+
+from mrmp.centralized.body_time import execution_seconds
+from mrmp.centralized.dependencies import PlanDeadlockError
+from mrmp.core import NetworkFaults
+from mrmp.core.body import body_model
+from mrmp.core.scenario import PolicyOptions, Scenario
+from mrmp.io import load_movingai_scenario, load_scenario
+from mrmp.live.transport import LiveFaults
+from mrmp.live.virtual_time import ProcessingCosts, VirtualOptions, run_virtual
+from mrmp.sim.local_rounds import LocalRoundsSimulator
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+def case_scenario(case: str, synchronizer: str, body: str) -> Scenario:
+    """The scenario of a case ``MAP:ROBOTS`` (module docstring), run by live ``pibt``."""
+    name, count = case.split(":")
+    robots = int(count)
+    if name == "causal-32":
+        loaded = load_scenario(ROOT / "examples" / "causal-32.yaml")
+        loaded = loaded.with_changes(robots=loaded.robots[:robots])
+    else:
+        loaded = load_movingai_scenario(ROOT / "maps" / f"{name}.map", ROOT / "maps" / f"{name}-random-1.scen", robots)
+    policy = PolicyOptions(name="pibt", synchronizer=synchronizer, body=body, swap=body == "omni")
+    return loaded.with_changes(policy=policy, name=f"{name}-{robots}")
+
+
+def simulated_seconds(scenario: Scenario, time_scale: float) -> tuple[int, float | None]:
+    """The simulator's makespan in ticks (``pibt``, local sequencing, perfect network) and its execution bound."""
+    policy = PolicyOptions(name="pibt", sequencing="local", body=scenario.policy.body, swap=scenario.policy.body == "omni")
+    run = LocalRoundsSimulator(scenario.with_changes(policy=policy, network=NetworkFaults())).run()
+    if not run.success:
+        return -1, None
+    cells = [robot.path for robot in run.robots]
+    starts = [robot.heading for robot in scenario.robots]
+    headings = [robot.headings for robot in run.robots]
+    live_body = body_model("turning") if scenario.policy.body == "turning" else body_model("thesis")
+    try:
+        bound = execution_seconds(cells, starts, scenario.timing, time_scale, live_body, headings, follows=False)
+    except PlanDeadlockError:  # a rotation of the simulator's: live bodies that never follow cannot carry it out
+        bound = None
+    return run.makespan, bound
+
+
+def row(case: str, arguments: argparse.Namespace) -> None:
+    scenario = case_scenario(case, arguments.synchronizer, arguments.body)
+    costs = ProcessingCosts(turn=arguments.turn_us * 1e-6, datagram=arguments.datagram_us * 1e-6)
+    folder = Path(tempfile.mkdtemp(prefix=f"mrmp-virtual-{scenario.name}-"))
+    options = VirtualOptions(
+        results=folder, time_scale=arguments.time_scale, faults=LiveFaults(loss=arguments.loss), seed=arguments.seed, costs=costs
+    )
+    result = run_virtual(scenario, options)
+    network = result.network
+    moves = max(1, network.get("moves", 0))
+    cell = scenario.timing.cell_time / arguments.time_scale
+    ticks, bound = simulated_seconds(scenario, arguments.time_scale)
+    simulated = ticks * cell
+    makespan = result.time_makespan_s
+    bound_text = "-" if bound is None else f"{bound:.2f} s (x{makespan / bound:.2f})"
+    arrived = sum(robot.arrived for robot in result.robots)
+    print(
+        f"{scenario.name}: live pibt (steps end by {arguments.synchronizer}), {scenario.policy.body} bodies, "
+        f"loss {arguments.loss:.0%}, time scale {arguments.time_scale:g}, virtual time: arrived "
+        f"{arrived}/{len(scenario.robots)}, collisions {len(result.collisions)}, makespan {makespan:.2f} s; "
+        f"simulator {ticks} ticks = {simulated:.2f} s (x{makespan / simulated:.2f}), execution bound {bound_text}; "
+        f"moves {moves}, messages/move {result.messages / moves:.1f}, "
+        f"held {network.get('safety_pibt_held', 0)}, gave up {network.get('safety_pibt_gave_up', 0)}, "
+        f"abandoned {network.get('safety_pibt_abandoned', 0)}, "
+        f"retransmissions {network.get('safety_pibt_retransmissions', 0)}; stop: {result.stop_reason}; "
+        f"harness {result.wall_time_s:.1f} CPU s, "
+        f"{1e6 * result.wall_time_s / max(1, network['virtual_datagrams']):.1f} us per datagram handled; "
+        f"results in {folder}",
+        flush=True,
+    )
+
+
+def main() -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--cases", default="random-64-64-10:200,random-64-64-10:1000")
+    parser.add_argument("--loss", type=float, default=0.1)
+    parser.add_argument("--time-scale", type=float, default=5.0)
+    parser.add_argument("--synchronizer", choices=("clock", "local"), default="clock")
+    parser.add_argument("--body", choices=("omni", "turning"), default="omni")
+    parser.add_argument("--turn-us", type=float, default=ProcessingCosts().turn * 1e6, help="processor time per turn")
+    parser.add_argument("--datagram-us", type=float, default=ProcessingCosts().datagram * 1e6, help="per datagram")
+    parser.add_argument("--seed", type=int, default=0)
+    arguments = parser.parse_args()
+    for case in arguments.cases.split(","):
+        row(case, arguments)
+    return 0
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())

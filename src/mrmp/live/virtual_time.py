@@ -1,0 +1,380 @@
+"""The live fleet on a virtual clock: every robot's live driver, brain, safety layer and body, unchanged, in one process.
+
+Two cores cannot host hundreds of robot processes, so what a live fleet of 200
+or 1,000 robots does cannot be measured with processes here. This module runs
+the very objects a robot process runs (:data:`mrmp.live.process.LIVE_DRIVERS`:
+the driver, its sans-IO brain and safety layer, a
+:class:`~mrmp.live.body.SimulatedBody`, the sealed and authenticated envelope)
+with the clock they are given reading a virtual time instead of the wall
+clock, and the datagrams they send crossing a simulated network instead of
+sockets. The main loop of each driver is the one a process runs
+(:meth:`~mrmp.live.driver.LiveDriver.fleet_wait_turn`,
+:meth:`~mrmp.live.driver.LiveDriver.turn`), and it sleeps by the same rule
+(:meth:`~mrmp.live.driver.LiveDriver.wake_rule`): until its next timer, or
+until a message arrives when its timers are idle.
+
+What the harness adds is what a real fleet has and a single process does not:
+
+* **a network** (:class:`VirtualNetwork`): each datagram arrives after a
+  ``latency`` plus a delay drawn from the faults' range, is lost or duplicated
+  with the faults' probabilities (seeded), and goes to one peer or every peer;
+* **a computer per robot**: a turn of a robot's main loop takes
+  ``costs.turn`` seconds plus ``costs.datagram`` per datagram it took in or sent
+  (:class:`ProcessingCosts`); its datagrams leave when the turn ends, and the
+  robot's next turn starts no sooner. Each robot has its own processor, as
+  each real robot has; nothing is shared but the network.
+
+The run writes what a live run writes (``agent-<i>.json``, ``trace-<i>.jsonl``,
+``referee.json``) and is judged by the same referee and result builder
+(:func:`mrmp.live.process.run_referee`, :func:`mrmp.live.results.live_result`),
+its times in virtual seconds; its ``wall_time_s`` is the CPU time the
+harness spent, and its ``network`` counts the turns run (``virtual_turns``)
+and the datagrams taken in or sent (``virtual_datagrams``). It is
+deterministic for a seed: one thread, one seeded network, seeded bodies and
+drivers (the fleet key and session only change the bytes, not their fate).
+
+Examples
+--------
+>>> import tempfile
+>>> from pathlib import Path
+>>> from mrmp.core import Grid, PolicyOptions, RobotSpec, Scenario, Timing
+>>> robots = (RobotSpec("A", (0, 2), (4, 2)), RobotSpec("B", (4, 2), (0, 2)))
+>>> swap = Scenario(Grid(5, 5), robots, timing=Timing(1.0, 0.5), policy=PolicyOptions(name="pibt"))
+>>> result = run_virtual(swap, VirtualOptions(results=Path(tempfile.mkdtemp()), time_scale=10))
+>>> result.success, result.collisions, result.mode
+(True, [], 'live')
+"""
+
+from __future__ import annotations
+
+import heapq
+import itertools
+import math
+import os
+import random
+import threading
+import time
+from collections.abc import Iterator
+from dataclasses import dataclass, field, replace
+from pathlib import Path
+
+from mrmp.core.body import body_model
+from mrmp.core.errors import InputError, Problem
+from mrmp.core.limits import MAX_RUN_SECONDS
+from mrmp.core.result import RunResult
+from mrmp.core.scenario import Scenario
+from mrmp.core.seeds import Stream, derive_seed, stream_random
+from mrmp.io.live_files import TraceWriter, read_json, write_json
+from mrmp.live.body import OccupancyRecorder, SimulatedBody
+from mrmp.live.driver import AgentTiming, LiveDriver
+from mrmp.live.process import LIVE_DRIVERS, DriverOptions, driver_kind, fleet_timing, run_referee
+from mrmp.live.results import ideal_makespan, live_result
+from mrmp.live.transport import FaultCounts, LiveFaults
+from mrmp.protocol.auth import Opener, Sealer
+from mrmp.sim.policy_table import body_problem
+
+__all__ = ["ProcessingCosts", "VirtualNetwork", "VirtualOptions", "run_virtual"]
+
+
+@dataclass(frozen=True)
+class ProcessingCosts:
+    """Seconds of a robot's processor: per turn of its main loop, and per datagram it takes in or sends.
+
+    The defaults are of the order this machine's robot processes spend
+    (``bench/live_virtual.py`` measures the harness's own cost per turn and per
+    datagram, which is the same code). A turn must cost some time: a driver
+    whose timers are due turns again at once, as a process does, and only the
+    turn's cost moves its clock on.
+
+    >>> ProcessingCosts(turn=0.0)
+    Traceback (most recent call last):
+    ...
+    ValueError: processing costs: a turn must take some time and a datagram none or more, got 0.0, 3e-05
+    """
+
+    turn: float = 50e-6
+    datagram: float = 30e-6
+
+    def __post_init__(self) -> None:
+        if not self.turn > 0 or not self.datagram >= 0:
+            raise ValueError(
+                f"processing costs: a turn must take some time and a datagram none or more, got {self.turn}, {self.datagram}"
+            )  # a driver whose timers are due polls again at once: with no cost, virtual time would stand still
+
+
+@dataclass(frozen=True)
+class VirtualOptions:
+    """How a fleet runs on the virtual clock (module docstring); the live run's options where they are the same."""
+
+    results: Path
+    time_scale: float = 1.0
+    faults: LiveFaults = field(default_factory=LiveFaults)
+    jitter: float = 0.0
+    seed: int = 0
+    latency: float = 200e-6
+    """Seconds a datagram takes on a perfect network (loopback is about 50 microseconds, a wireless LAN a few ms)."""
+    costs: ProcessingCosts = field(default_factory=ProcessingCosts)
+    timing: AgentTiming = field(default_factory=AgentTiming)
+    timeout: float | None = None
+    """Virtual seconds before every robot stops (None: as a live run's launcher chooses)."""
+
+
+class VirtualNetwork:
+    """The simulated network of a virtual fleet: datagrams with a latency, seeded loss, delay and duplication.
+
+    >>> network = VirtualNetwork(3, LiveFaults(), latency=0.001, seed=0)
+    >>> network.post(0, b"hello", None, at=1.0)
+    >>> network.next_arrival(), [(recipient, data) for _, recipient, data in network.take_due(2.0)]
+    (1.001, [(1, b'hello'), (2, b'hello')])
+    """
+
+    def __init__(self, robots: int, faults: LiveFaults, latency: float, seed: int) -> None:
+        self.robots = robots
+        self.faults = faults
+        self.latency = latency
+        self.random = random.Random(seed)
+        self.counts = [FaultCounts() for _ in range(robots)]
+        self._queue: list[tuple[float, int, int, bytes]] = []
+        self._order = itertools.count()
+
+    def post(self, sender: int, data: bytes, recipient: int | None, at: float) -> None:
+        """``sender`` sends ``data`` at time ``at`` to ``recipient``, or to every other robot when None."""
+        recipients = range(self.robots) if recipient is None else (recipient,)
+        faults, rng, counts = self.faults, self.random, self.counts[sender]
+        for peer in recipients:
+            if peer == sender:
+                continue
+            counts.sent += 1
+            if faults.loss and rng.random() < faults.loss:
+                counts.lost += 1
+                continue
+            copies = 1
+            if faults.duplicate and rng.random() < faults.duplicate:
+                counts.duplicated += 1
+                copies = 2
+            for _ in range(copies):
+                delay = self.latency
+                if faults.delay_max > 0:
+                    delay += rng.uniform(faults.delay_min, faults.delay_max)
+                    counts.delayed += 1
+                heapq.heappush(self._queue, (at + delay, next(self._order), peer, data))
+
+    def next_arrival(self) -> float:
+        """When the next datagram arrives (``inf``: none is on its way)."""
+        return self._queue[0][0] if self._queue else math.inf
+
+    def take_due(self, now: float) -> Iterator[tuple[float, int, bytes]]:
+        """The datagrams that have arrived by ``now``, in order of arrival: ``(time, recipient, data)``."""
+        queue = self._queue
+        while queue and queue[0][0] <= now:
+            arrival, _, recipient, data = heapq.heappop(queue)
+            yield arrival, recipient, data
+
+
+class _Outbox:
+    """A virtual robot's datagrams of one turn, held until the turn's processing ends (:class:`~mrmp.live.driver.Sending`)."""
+
+    def __init__(self) -> None:
+        self.datagrams: list[tuple[bytes, int | None]] = []
+
+    def start(self) -> None:
+        """Nothing to start: the harness sends."""
+
+    def send(self, data: bytes, recipient: int | None) -> None:
+        self.datagrams.append((data, recipient))
+
+    def close(self) -> None:
+        """Nothing to flush: the harness sends after every turn."""
+
+
+@dataclass
+class _Robot:
+    """One robot of the virtual fleet: its driver, where its main loop stands, and when it next runs."""
+
+    driver: LiveDriver
+    outbox: _Outbox
+    trace: TraceWriter
+    running: bool = False
+    """Past its wait for the fleet."""
+    done: bool = False
+    wake_at: float = 0.0
+    woken_by_messages: bool = True
+    busy_until: float = 0.0
+    version: int = 0
+    """Bumped whenever ``wake_at`` changes: a queued wake-up of another version is stale."""
+
+
+class _VirtualFleet:
+    """The robots, the network and the clock of one virtual run (module docstring)."""
+
+    def __init__(self, scenario: Scenario, options: VirtualOptions) -> None:
+        self.scenario = scenario
+        self.options = options
+        self.now = 0.0
+        robots = len(scenario.robots)
+        self.network = VirtualNetwork(robots, options.faults, options.latency, derive_seed(options.seed, Stream.LIVE_FAULTS, 0))
+        key, session = os.urandom(32), random.Random(options.seed).randrange(1, 2**31)
+        timing = fleet_timing(options.timing, robots)
+        timeout = options.timeout or max(30.0, 10.0 * ideal_makespan(scenario, options.time_scale) + 3.0 * robots)
+        self.timing = replace(timing, timeout=min(timeout, MAX_RUN_SECONDS))
+        kind = LIVE_DRIVERS[driver_kind(scenario, following_plan=False)]
+        self.robots: list[_Robot] = []
+        for index, spec in enumerate(scenario.robots):
+            trace = TraceWriter(options.results / f"trace-{index}.jsonl", index)
+            body = SimulatedBody(
+                spec.start,
+                spec.heading,
+                scenario.grid,
+                scenario.timing,
+                time_scale=options.time_scale,
+                jitter=options.jitter,
+                rng=stream_random(options.seed, Stream.BODY, index),
+                recorder=OccupancyRecorder(trace.write, heading_sink=trace.write_heading),
+                model=body_model(scenario.policy.body),
+            )
+            sealer, opener = Sealer(key, session), Opener(key, session, fleet_size=robots)
+            driver = kind(scenario, index, _NoSockets(), body, sealer, opener, DriverOptions(self.timing, options.seed), None)
+            driver.clock = self.clock
+            outbox = _Outbox()
+            driver.send_through(outbox)
+            self.robots.append(_Robot(driver, outbox, trace))
+        self._wakes: list[tuple[float, int, int]] = [(0.0, index, 0) for index in range(robots)]
+        self.turns = 0
+        """Turns of the robots' main loops run."""
+        self.datagrams = 0
+        """Datagrams the robots took in or sent."""
+
+    def clock(self) -> float:
+        """The virtual time: what every driver's clock reads."""
+        return self.now
+
+    def run(self) -> None:
+        """Run every robot until each has stopped (or the virtual timeout passes)."""
+        for robot in self.robots:
+            robot.driver.begin_fleet_wait(0.0)
+        end = self.timing.timeout + self.timing.start_wait + 1.0
+        network = self.network
+        while self._wakes or network.next_arrival() < math.inf:
+            next_robot = self._wakes[0][0] if self._wakes else math.inf
+            self.now = min(next_robot, network.next_arrival())
+            if self.now > end:
+                break
+            if network.next_arrival() <= next_robot:
+                for arrival, recipient, data in network.take_due(self.now):
+                    self._deliver(recipient, data, arrival)
+                continue
+            _, index, version = heapq.heappop(self._wakes)
+            robot = self.robots[index]
+            if version == robot.version and not robot.done:
+                self._turn(index, robot)
+        for robot in self.robots:
+            if not robot.done:
+                robot.driver.report.stop_reason = robot.driver.report.stop_reason or "timeout"
+                robot.done = True
+
+    def _deliver(self, recipient: int, data: bytes, arrival: float) -> None:
+        robot = self.robots[recipient]
+        if robot.done:
+            return  # its process has ended
+        robot.driver.take_datagram(data)
+        if robot.woken_by_messages and robot.wake_at > arrival:
+            self._schedule(recipient, robot, max(arrival, robot.busy_until), woken_by_messages=False)
+
+    def _turn(self, index: int, robot: _Robot) -> None:
+        """One turn of the robot's main loop at the current time; its datagrams leave when its processing ends."""
+        driver, report, now = robot.driver, robot.driver.report, self.now
+        taken_in, sent = report.messages_received, report.datagrams_sent
+        if not robot.running:
+            wake = driver.fleet_wait_turn(now)
+            timers = False
+            if wake is None:
+                robot.running = True
+                driver.begin_run(now)
+                wake, timers = driver.turn(now), True
+        else:
+            wake, timers = driver.turn(now), True
+        datagrams = report.messages_received - taken_in + report.datagrams_sent - sent
+        self.turns += 1
+        self.datagrams += datagrams
+        costs = self.options.costs
+        robot.busy_until = now + costs.turn + costs.datagram * datagrams
+        for data, recipient in robot.outbox.datagrams:
+            self.network.post(index, data, recipient, at=robot.busy_until)
+        robot.outbox.datagrams.clear()
+        if wake is None:
+            robot.done = True
+            driver.fill_report(now)
+            return
+        at, woken_by_messages = driver.wake_rule(now, wake, timers)
+        self._schedule(index, robot, max(at, robot.busy_until), woken_by_messages)
+
+    def _schedule(self, index: int, robot: _Robot, at: float, woken_by_messages: bool) -> None:
+        robot.version += 1
+        robot.wake_at, robot.woken_by_messages = at, woken_by_messages
+        heapq.heappush(self._wakes, (at, index, robot.version))
+
+    def finish(self) -> list[dict]:
+        """Every robot's report, written as a live robot writes it (its injected faults included)."""
+        reports = []
+        for index, robot in enumerate(self.robots):
+            robot.trace.close()
+            report = robot.driver.report
+            report.faults = dict(self.network.counts[index].__dict__)
+            written = report.as_dict()
+            write_json(self.options.results / f"agent-{index}.json", written)
+            reports.append(written)
+        return reports
+
+
+class _NoSockets:
+    """The transport of a virtual robot: it has none (its driver sends through the harness, which delivers)."""
+
+    def send(self, data: bytes, recipient: int | None = None) -> None:
+        raise RuntimeError("a virtual robot sends through its harness")
+
+    def receive(self, timeout: float) -> bytes | None:
+        return None
+
+    def close(self) -> None:
+        """Nothing to release."""
+
+
+def run_virtual(scenario: Scenario, options: VirtualOptions) -> RunResult:
+    """Run ``scenario``'s live fleet on a virtual clock (module docstring); return the judged result.
+
+    Raises
+    ------
+    InputError
+        If the scenario's robots cannot run live in its body model, or the
+        results folder cannot be made.
+    """
+    body_issue = body_problem(scenario, live=True)
+    if body_issue is not None:
+        raise InputError(body_issue)
+    try:
+        options.results.mkdir(parents=True, exist_ok=True)
+    except OSError as error:
+        raise InputError(Problem("--results", f"cannot make {options.results}: {error.strerror}")) from None
+    for stale in (*options.results.glob("agent-*.json"), *options.results.glob("trace-*.jsonl")):
+        stale.unlink()
+    started = time.process_time()
+    fleet = _VirtualFleet(scenario, options)
+    fleet.run()
+    reports = fleet.finish()
+    start_time = min(float(report["started_at"]) for report in reports)
+    run_referee(scenario, options.results, start_time, None, lambda text: None, stop=threading.Event())
+    verdict = read_json(options.results / "referee.json")
+    stop_reasons = {str(report["stop_reason"]) for report in reports}
+    stop_reason = "all arrived" if stop_reasons <= {"all arrived", "arrived; peers silent"} else ", ".join(sorted(stop_reasons))
+    result = live_result(
+        scenario,
+        reports,
+        verdict,
+        stop_reason=stop_reason,
+        wall_time_s=time.process_time() - started,
+        tick_seconds=scenario.timing.cell_time / options.time_scale / 4,
+        time_scale=options.time_scale,
+    )
+    harness = {"virtual_turns": fleet.turns, "virtual_datagrams": fleet.datagrams}
+    return replace(result, network={**result.network, **harness})
+

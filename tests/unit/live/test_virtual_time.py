@@ -1,0 +1,101 @@
+"""The live fleet on a virtual clock: the live drivers unchanged, one process, a simulated network and processors."""
+
+from __future__ import annotations
+
+import json
+from dataclasses import replace
+from pathlib import Path
+
+import pytest
+
+from mrmp.api import load
+from mrmp.core import Grid, PolicyOptions, RobotSpec, Scenario, Timing
+from mrmp.core.errors import InputError
+from mrmp.live.transport import LiveFaults
+from mrmp.live.virtual_time import ProcessingCosts, VirtualNetwork, VirtualOptions, run_virtual
+from mrmp.sim.live_rounds import LiveRoundsSimulator
+from mrmp.sim.synchronized_rounds import SynchronizedRoundsSimulator
+
+ROOT = Path(__file__).resolve().parents[3]
+CROSS = (
+    RobotSpec("a", (0, 2), (4, 2)),
+    RobotSpec("b", (4, 2), (0, 2)),
+    RobotSpec("c", (2, 0), (2, 4)),
+    RobotSpec("d", (2, 4), (2, 0)),
+)
+
+
+def crossing(**policy: object) -> Scenario:
+    options = PolicyOptions(name="pibt", radius=8, **policy)  # type: ignore[arg-type]
+    return Scenario(Grid(5, 5, [(2, 2)]), CROSS, timing=Timing(1.0, 0.5), policy=options, name="pibt-cross")
+
+
+def distinct(cells) -> list:
+    kept: list = []
+    for cell in cells:
+        if not kept or kept[-1] != tuple(cell):
+            kept.append(tuple(cell))
+    return kept
+
+
+def believed_paths(results: Path, robots: int) -> list[list]:
+    reports = [json.loads((results / f"agent-{index}.json").read_text()) for index in range(robots)]
+    return [distinct(cell for _, cell in report["believed_path"]) for report in reports]
+
+
+@pytest.mark.parametrize(("synchronizer", "simulator"), [("clock", None), ("local", SynchronizedRoundsSimulator)])
+def test_a_virtual_fleet_moves_as_the_simulator_running_the_same_brain(tmp_path, synchronizer, simulator):
+    """Perfect network, a radius that covers the map: the cells each robot enters are the simulator's, as for a live
+    fleet of processes (``tests/network/test_live_pibt.py``)."""
+    scenario = crossing(synchronizer=synchronizer)
+    simulated = (simulator or (lambda s: LiveRoundsSimulator(s, step_ticks=4)))(scenario).run()
+    virtual = run_virtual(scenario, VirtualOptions(results=tmp_path, time_scale=10))
+    assert virtual.success and virtual.collisions == [], virtual.stop_reason
+    assert believed_paths(tmp_path, len(CROSS)) == [distinct(robot.path) for robot in simulated.robots]
+
+
+def test_the_same_seed_runs_the_same_fleet(tmp_path):
+    faults = LiveFaults(loss=0.2, delay_max=0.01, duplicate=0.1)
+    runs = [run_virtual(crossing(), VirtualOptions(results=tmp_path / str(run), time_scale=10, faults=faults, seed=4)) for run in range(2)]
+    first, again = runs
+    assert first.success and first.network["injected_lost"] > 0
+    assert first.network == {**again.network} and first.time_makespan_s == again.time_makespan_s
+    assert believed_paths(tmp_path / "0", 4) == believed_paths(tmp_path / "1", 4)
+
+
+def test_a_slower_processor_makes_a_slower_fleet(tmp_path):
+    """The processing costs are real: robots whose computers take far longer per turn and datagram arrive later."""
+    scenario = crossing(synchronizer="local")  # steps end when the robots are done, not on a clock
+    quick = run_virtual(scenario, VirtualOptions(results=tmp_path / "quick", time_scale=10, costs=ProcessingCosts(1e-6, 0)))
+    slow_costs = ProcessingCosts(turn=1e-3, datagram=5e-3)
+    slow = run_virtual(scenario, VirtualOptions(results=tmp_path / "slow", time_scale=10, costs=slow_costs))
+    assert quick.success and slow.success
+    assert slow.time_makespan_s > 1.2 * quick.time_makespan_s
+
+
+def test_a_lossy_crowd_of_turning_robots_is_run_and_judged_as_live(tmp_path):
+    """24 turning robots of ``causal-32`` ending their own steps over a network losing 20%: all arrive, no collision;
+    every robot wrote its report and trace, and the referee judged them (its turns among them)."""
+    scenario = load(ROOT / "examples" / "causal-32.yaml")
+    policy = replace(scenario.policy, name="pibt", body="turning", synchronizer="local")
+    scenario = scenario.with_changes(robots=scenario.robots[:24], policy=policy)
+    result = run_virtual(scenario, VirtualOptions(results=tmp_path, time_scale=5, faults=LiveFaults(loss=0.2), seed=2))
+    assert result.success and result.collisions == [] and result.body == "turning", result.stop_reason
+    assert result.network["injected_lost"] > 0 and result.network["virtual_datagrams"] > result.network["datagrams_sent"]
+    assert sum(robot.turns for robot in result.robots) > 0
+    assert (tmp_path / "referee.json").exists() and len(list(tmp_path.glob("trace-*.jsonl"))) == 24
+
+
+def test_a_body_the_policy_cannot_drive_live_is_refused(tmp_path):
+    scenario = crossing().with_changes(policy=PolicyOptions(name="pibt", body="thesis"))
+    with pytest.raises(InputError, match=r"policy\.body"):
+        run_virtual(scenario, VirtualOptions(results=tmp_path))
+
+
+def test_the_network_loses_and_duplicates_as_seeded():
+    network = VirtualNetwork(2, LiveFaults(loss=0.5, duplicate=0.5), latency=0.0, seed=1)
+    for number in range(1000):
+        network.post(0, bytes([number % 256]), 1, at=0.0)
+    arrived = len(list(network.take_due(0.0)))
+    counts = network.counts[0]
+    assert counts.sent == 1000 and 400 < counts.lost < 600 and arrived == 1000 - counts.lost + counts.duplicated
