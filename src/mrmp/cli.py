@@ -31,6 +31,7 @@ from mrmp.core.limits import (
     MAX_STEP_SECONDS,
     MAX_TICKS,
     MAX_TIME_SCALE,
+    MAX_VIRTUAL_ROBOTS,
     MIN_TIME_SCALE,
     shown,
 )
@@ -447,12 +448,14 @@ def print_result(result: RunResult, console: Console) -> None:
         else:
             moves_said = f"moves {moves}"
         arrivals = sum(robot.time_s for robot in result.robots if robot.arrived)
+        virtual = "virtual_turns" in network  # a fleet on a virtual clock: its times are virtual, its wall time CPU
+        clock, spent = ("virtual", "CPU time") if virtual else ("wall-clock", "wall time")
         console.print(
-            f"{verdict} ({result.stop_reason}): wall-clock makespan {result.time_makespan_s:.2f} s "
+            f"{verdict} ({result.stop_reason}): {clock} makespan {result.time_makespan_s:.2f} s "
             f"(ideal {result.ideal_makespan_s or 0:.2f} s: the longest single-robot path at this speed), "
             f"sum of arrival times {arrivals:.2f} s, "
             f"{moves_said} (lower bound {result.lower_bound}), collisions: {len(result.collisions)}, "
-            f"messages {result.messages}, wall time {result.wall_time_s:.1f} s"
+            f"messages {result.messages}, {spent} {result.wall_time_s:.1f} s"
         )
         console.print(f"  dropped by robots: {rejected}; injected faults: {injected}", markup=False)
         if network.get("missed_lines"):
@@ -575,13 +578,14 @@ def run(
     results: Annotated[Path | None, typer.Option(help="Folder for the robots' traces and reports (mrmp agent's --results, for the whole fleet).", show_default="a new temporary folder", rich_help_panel=LIVE)] = None,
     kill: Annotated[list[str] | None, typer.Option(help="Kill robot ID's process S wall-clock seconds after the fleet's start (repeatable).", metavar="ID@S", show_default=False, rich_help_panel=LIVE)] = None,
     ros2: Annotated[bool, typer.Option("--ros2", help="Every robot process publishes its pose and state on ROS 2 topics (DDS, domain ROS_DOMAIN_ID; the ros2 extra; docs/ros2.md).", rich_help_panel=LIVE)] = False,
+    virtual_clock: Annotated[bool, typer.Option("--virtual-clock", help="With --live: run every robot's live driver, brain and body in this process on a virtual clock, over a simulated network with a processor per robot (fleets larger than the machine; times in virtual seconds).", rich_help_panel=LIVE)] = False,
 ) -> None:
     """Run a scenario (lockstep simulator, or --live processes) and report what happened."""
     # --resolve, --heading-aware, --radius, --swap and --search come from PolicyOptions' fields (with_policy_flags)
     request = RunRequest(
         None if json_path is None else str(json_path), animate, show_messages, watch, watch_fps, planner, time_limit, live, transport, time_scale,
         delay_ms, jitter, miss_line, results, kill or [], unsafe, goal_lines=goal_lines, colour_by=colour_by, speed=speed,
-        record=record, ros2=ros2, lorr_output=lorr_output,
+        record=record, ros2=ros2, lorr_output=lorr_output, virtual_clock=virtual_clock,
     )
     console = Console(stderr=request.json_path == "-", highlight=False)
     try:
@@ -637,6 +641,7 @@ class RunRequest:
     record: Path | None = None
     ros2: bool = False
     lorr_output: Path | None = None
+    virtual_clock: bool = False
 
 
 def _validate_run(scenario: Scenario, request: RunRequest) -> None:
@@ -679,6 +684,8 @@ def _validate_run(scenario: Scenario, request: RunRequest) -> None:
         raise InputError(Problem("--lorr-output", "writes the run of a LoRR problem (a .json problem file)"))
     if request.lorr_output is not None and not body_model(scenario.policy.body).turns_in_place:
         raise InputError(Problem("--lorr-output", f"LoRR's actions are those of turning bodies, not {scenario.policy.body}"))
+    if request.virtual_clock and not request.live:
+        raise InputError(Problem("--virtual-clock", "runs a live fleet on a virtual clock: add --live"))
     if request.ros2 and not request.live:
         raise InputError(Problem("--ros2", "publishes the robots of a live run: add --live"))
     if request.ros2:
@@ -691,7 +698,9 @@ def _validate_live(scenario: Scenario, request: RunRequest) -> None:
     """Refuse, before any process starts, what a live run cannot do: too many robots, a results folder that is a file."""
     from mrmp.io.live_files import prepare_folder
 
-    if len(scenario.robots) > MAX_LIVE_ROBOTS:
+    if request.virtual_clock:
+        _validate_virtual_clock(scenario, request)
+    elif len(scenario.robots) > MAX_LIVE_ROBOTS:
         reason = f"a live run starts one process per robot, at most {MAX_LIVE_ROBOTS}; this scenario has {len(scenario.robots)}"
         raise InputError(Problem("--live", reason))
     live_faults(scenario, request.time_scale, request.delay_ms)
@@ -703,6 +712,18 @@ def _validate_live(scenario: Scenario, request: RunRequest) -> None:
             prepare_folder(request.results)
         except InputError as error:
             raise InputError(Problem("--results", str(error))) from None
+
+
+def _validate_virtual_clock(scenario: Scenario, request: RunRequest) -> None:
+    """Refuse what a live fleet on a virtual clock cannot do: processes to kill, ROS 2, a plan, another transport."""
+    if len(scenario.robots) > MAX_VIRTUAL_ROBOTS:
+        reason = f"runs at most {MAX_VIRTUAL_ROBOTS} robots in one process; this scenario has {len(scenario.robots)}"
+        raise InputError(Problem("--virtual-clock", reason))
+    for given, flag in ((request.kill, "--kill"), (request.ros2, "--ros2"), (request.planner, "--planner")):
+        if given:
+            raise InputError(Problem("--virtual-clock", f"runs the fleet's own policy with no processes: not with {flag}"))
+    if request.transport != "udp":
+        raise InputError(Problem("--virtual-clock", "has its own simulated network: not with --transport"))
 
 
 def _simulated_run(
@@ -750,6 +771,8 @@ class StepTimer:
 
 def _live_run(scenario: Scenario, request: RunRequest, plan: PlanningResult | None, console: Console) -> RunResult:
     """Run ``scenario`` live: one OS process per robot over a loopback network, its progress shown on a terminal."""
+    if request.virtual_clock:
+        return _virtual_run(scenario, request, console)
     from mrmp.live.launcher import LiveOptions, run_live
 
     options = LiveOptions(
@@ -772,6 +795,24 @@ def _live_run(scenario: Scenario, request: RunRequest, plan: PlanningResult | No
             scenario, options, say=lambda text: console.print(text, markup=False),
             on_progress=progress.on_progress if console.is_terminal else None,
         )  # fmt: skip
+
+
+def _virtual_run(scenario: Scenario, request: RunRequest, console: Console) -> RunResult:
+    """Run ``scenario``'s live fleet in this process on a virtual clock (:mod:`mrmp.live.virtual_time`)."""
+    import tempfile
+
+    from mrmp.live.virtual_time import VirtualOptions, run_virtual
+
+    results = request.results if request.results is not None else Path(tempfile.mkdtemp(prefix="mrmp-virtual-"))
+    options = VirtualOptions(
+        results=results,
+        time_scale=time_scale_checked(request.time_scale),
+        faults=live_faults(scenario, request.time_scale, request.delay_ms),
+        jitter=_fraction(request.jitter, "--jitter"),
+        seed=scenario.seed,
+    )
+    console.print(f"live: {len(scenario.robots)} robots on a virtual clock in this process; results in {results}", markup=False)
+    return run_virtual(scenario, options)
 
 
 def _output_run(

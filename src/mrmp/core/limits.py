@@ -16,6 +16,7 @@ bound                        value           what it bounds
 ``MAX_GRID_CELLS``           4,194,304       cells of a map (width x height; 2048 x 2048)
 ``MAX_ROBOTS``               10,000          robots of a scenario (and of a benchmark run)
 ``MAX_LIVE_ROBOTS``          256             robots of a ``--live`` run (one process each, on one machine)
+``MAX_VIRTUAL_ROBOTS``       2,000           robots of a ``--live --virtual-clock`` run (one process, about 6 MB each)
 ``MAX_RADIUS``               64              ``policy.radius`` (cells)
 ``MAX_DELAY_TICKS``          1,000           a simulated message delay (``network.delay``, ``--delay``)
 ``MAX_TICKS``                1,000,000       ``max_ticks``, and the tick limit a run sets itself
@@ -59,6 +60,9 @@ MAX_ROBOTS = 10_000
 
 MAX_LIVE_ROBOTS = 256
 """Robots of a ``--live`` run, which starts one process per robot on this machine."""
+
+MAX_VIRTUAL_ROBOTS = 2_000
+"""Robots of a ``--live --virtual-clock`` run, all in one process (each robot's tables take a few megabytes)."""
 
 MAX_RADIUS = 64
 """The largest ``policy.radius`` (cells, Manhattan)."""

@@ -575,12 +575,7 @@ class LiveDriver:
         receiver.start()
         self._client.start()
         try:
-            self.begin_fleet_wait(clock())
-            while not self.stop_requested.is_set():
-                wake = self.fleet_wait_turn(clock())
-                if wake is None:
-                    break
-                self._sleep(wake, timers=False)  # no brain timers run before the start
+            self._wait_for_fleet()
             self.begin_run(clock(), on_progress, progress_every)
             while not self.stop_requested.is_set():
                 wake = self.turn(clock())
@@ -655,6 +650,15 @@ class LiveDriver:
             math.inf if loop.everyone_done_since is None else loop.everyone_done_since + loop.linger,
             math.inf if loop.on_progress is None else loop.last_progress + loop.progress_every,
         )
+
+    def _wait_for_fleet(self) -> None:
+        """Wait for the fleet in real time: :meth:`fleet_wait_turn` until it is over, sleeping between turns."""
+        self.begin_fleet_wait(self.clock())
+        while not self.stop_requested.is_set():
+            wake = self.fleet_wait_turn(self.clock())
+            if wake is None:
+                return
+            self._sleep(wake, timers=False)  # no brain timers run before the start
 
     def begin_fleet_wait(self, now: float) -> None:
         """Start waiting for the fleet at ``now`` (:meth:`fleet_wait_turn`)."""
