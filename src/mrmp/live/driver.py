@@ -740,6 +740,7 @@ class LiveDriver:
         return "running"
 
     def fill_report(self, now: float) -> None:
+        """Bring :attr:`report` up to ``now``: end time, arrival, turns, rejections, faults and the safety counts."""
         report, robot = self.report, self.robot
         report.ended_at = now
         report.arrived = self._arrived()
