@@ -134,8 +134,7 @@ def run_live(
     files = _write_run_files(scenario, options, ids)
     session = random.SystemRandom().randrange(1, 2**31)
     layout = FleetLayout.on_loopback(ids, fleet=f"mrmp/{session}")
-    timeout = options.timeout or max(30.0, 10.0 * ideal_makespan(scenario, options.time_scale) + 3.0 * len(ids))
-    timeout = min(timeout, MAX_RUN_SECONDS)  # what mrmp agent --timeout accepts
+    timeout = options.timeout or run_timeout(scenario, options.time_scale)
     fleet = _start_fleet(options, files, layout, session, timeout)
     say(f"live: {len(ids)} robot processes and a referee over {options.transport} on loopback; results in {files.results}")
     note = policy_entry(scenario.policy.name).live_note if options.plan is None else ""
@@ -146,6 +145,18 @@ def run_live(
     reports = [_read_if_there(files.results / f"agent-{index}.json") for index in range(len(ids))]
     verdict = _read_if_there(files.results / "referee.json")
     return _judge(scenario, options, reports, verdict, _overall_stop_reason(stop_reason, reports), wall_time)
+
+
+def run_timeout(scenario: Scenario, time_scale: float) -> float:
+    """Seconds a live run of ``scenario`` may last unless told otherwise: ten times its ideal makespan plus three
+    seconds per robot, at least 30 s, at most what ``mrmp agent --timeout`` accepts.
+
+    >>> from mrmp.core import Grid, RobotSpec
+    >>> run_timeout(Scenario(Grid(1, 3), (RobotSpec("A", (0, 0), (0, 2)),)), time_scale=1.0)
+    30.0
+    """
+    timeout = max(30.0, 10.0 * ideal_makespan(scenario, time_scale) + 3.0 * len(scenario.robots))
+    return min(timeout, MAX_RUN_SECONDS)
 
 
 def _check(options: LiveOptions, ids: list[str]) -> None:

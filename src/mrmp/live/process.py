@@ -277,18 +277,8 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
             driver = Ros2Driver(spec.id, spec.start, spec.heading, domain=options.drive_domain, wheel_base=1.0)
             body = _ros2_body(driver, scenario, index, options, OccupancyRecorder(sink))
         else:
-            body = SimulatedBody(
-                spec.start,
-                spec.heading,
-                scenario.grid,
-                scenario.timing,
-                time_scale=options.time_scale,
-                jitter=options.jitter,
-                miss_line=options.miss_line,
-                rng=stream_random(options.seed, Stream.BODY, index),
-                recorder=OccupancyRecorder(sink, heading_sink=trace.write_heading),
-                model=body_model(scenario.policy.body),
-            )
+            recorder = OccupancyRecorder(sink, heading_sink=trace.write_heading)
+            body = simulated_body(scenario, index, recorder, options.time_scale, options.jitter, options.miss_line, options.seed)
         sealer = Sealer(options.key, options.session)
         opener = Opener(options.key, options.session, fleet_size=len(scenario.robots))
         agent = LIVE_DRIVERS[driver_kind(scenario, following_plan=policy is not None)](
@@ -315,6 +305,31 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
             driver.close()
     write_json(report_path, report.as_dict())
     return report
+
+
+def simulated_body(
+    scenario: Scenario,
+    index: int,
+    recorder: OccupancyRecorder,
+    time_scale: float,
+    jitter: float = 0.0,
+    miss_line: float = 0.0,
+    seed: int = 0,
+) -> SimulatedBody:
+    """Robot ``index``'s simulated body on its start cell, in the scenario's body model, its randomness from ``seed``."""
+    spec = scenario.robots[index]
+    return SimulatedBody(
+        spec.start,
+        spec.heading,
+        scenario.grid,
+        scenario.timing,
+        time_scale=time_scale,
+        jitter=jitter,
+        miss_line=miss_line,
+        rng=stream_random(seed, Stream.BODY, index),
+        recorder=recorder,
+        model=body_model(scenario.policy.body),
+    )
 
 
 CELL_SIZE = 1.0

@@ -58,17 +58,16 @@ from collections.abc import Iterator
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
-from mrmp.core.body import body_model
 from mrmp.core.errors import InputError, Problem
-from mrmp.core.limits import MAX_RUN_SECONDS
 from mrmp.core.result import RunResult
 from mrmp.core.scenario import Scenario
-from mrmp.core.seeds import Stream, derive_seed, stream_random
+from mrmp.core.seeds import Stream, derive_seed
 from mrmp.io.live_files import TraceWriter, read_json, write_json
-from mrmp.live.body import OccupancyRecorder, SimulatedBody
+from mrmp.live.body import OccupancyRecorder
 from mrmp.live.driver import AgentTiming, LiveDriver
-from mrmp.live.process import LIVE_DRIVERS, DriverOptions, driver_kind, fleet_timing, run_referee
-from mrmp.live.results import ideal_makespan, live_result
+from mrmp.live.launcher import run_timeout
+from mrmp.live.process import LIVE_DRIVERS, DriverOptions, driver_kind, fleet_timing, run_referee, simulated_body
+from mrmp.live.results import live_result
 from mrmp.live.transport import FaultCounts, LiveFaults
 from mrmp.protocol.auth import Opener, Sealer
 from mrmp.sim.policy_table import body_problem
@@ -215,23 +214,13 @@ class _VirtualFleet:
         self.network = VirtualNetwork(robots, options.faults, options.latency, derive_seed(options.seed, Stream.LIVE_FAULTS, 0))
         key, session = os.urandom(32), random.Random(options.seed).randrange(1, 2**31)
         timing = fleet_timing(options.timing, robots)
-        timeout = options.timeout or max(30.0, 10.0 * ideal_makespan(scenario, options.time_scale) + 3.0 * robots)
-        self.timing = replace(timing, timeout=min(timeout, MAX_RUN_SECONDS))
+        self.timing = replace(timing, timeout=options.timeout or run_timeout(scenario, options.time_scale))
         kind = LIVE_DRIVERS[driver_kind(scenario, following_plan=False)]
         self.robots: list[_Robot] = []
-        for index, spec in enumerate(scenario.robots):
+        for index in range(robots):
             trace = TraceWriter(options.results / f"trace-{index}.jsonl", index)
-            body = SimulatedBody(
-                spec.start,
-                spec.heading,
-                scenario.grid,
-                scenario.timing,
-                time_scale=options.time_scale,
-                jitter=options.jitter,
-                rng=stream_random(options.seed, Stream.BODY, index),
-                recorder=OccupancyRecorder(trace.write, heading_sink=trace.write_heading),
-                model=body_model(scenario.policy.body),
-            )
+            recorder = OccupancyRecorder(trace.write, heading_sink=trace.write_heading)
+            body = simulated_body(scenario, index, recorder, options.time_scale, options.jitter, seed=options.seed)
             sealer, opener = Sealer(key, session), Opener(key, session, fleet_size=robots)
             driver = kind(scenario, index, _NoSockets(), body, sealer, opener, DriverOptions(self.timing, options.seed), None)
             driver.clock = self.clock
