@@ -237,6 +237,8 @@ class PibtBrain:
         self.moves: list[tuple[int, Cell]] = []
         """Every step's decided cell, as ``(step, cell)`` (the brain's path)."""
         self.heard: dict[int, tuple[float, bool]] = {}
+        self._silence_check_at = -math.inf
+        """No peer can have been silent for ``crash_after`` seconds before this time (:meth:`_crash_silent`)."""
         """Per peer: when it was last heard, and whether it said it stood on its goal."""
         self.t0: float | None = None
         self.step = 0
@@ -326,11 +328,25 @@ class PibtBrain:
         self._act = True
 
     def _crash_silent(self, now: float) -> None:
-        """Take every peer silent for ``crash_after`` seconds for crashed."""
+        """Take every peer silent for ``crash_after`` seconds for crashed.
+
+        The peers are looked at only once the one heard from least recently
+        can have been silent that long (:attr:`_silence_check_at`): news only
+        gets fresher, and a peer heard of for the first time, or again, is
+        heard now; so a turn costs no look at every peer of a large fleet.
+        """
+        if now < self._silence_check_at:
+            return
         robot = self.robot
+        least_recent = math.inf
         for peer, (heard_at, _) in self.heard.items():
-            if now - heard_at > self.crash_after and peer not in robot.crashed:
+            if peer in robot.crashed:
+                continue
+            if now - heard_at > self.crash_after:
                 robot.crash(peer)
+            else:
+                least_recent = min(least_recent, heard_at)
+        self._silence_check_at = least_recent + self.crash_after
 
     def _move_queued(self) -> bool:
         """Whether a move (not a turn) waits in the queue: the robot is held until its claim is granted."""
