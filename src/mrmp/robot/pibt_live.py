@@ -69,6 +69,8 @@ from __future__ import annotations
 import random
 from collections.abc import Iterable, Sequence
 
+import numpy as np
+
 from mrmp.core.heading import Heading
 from mrmp.protocol.messages import AnswerMessage, BeaconMessage, PibtMessage, PullMessage
 from mrmp.protocol.pibt_local import MAX_NEWS, CallInheritMessage, News, NewsBeaconMessage
@@ -77,7 +79,44 @@ from mrmp.robot.pibt_reliable import ReliablePibtRobot
 from mrmp.robot.pibt_robot import MIN_RADIUS, RESERVE_RADIUS
 from mrmp.search.flat_map import FlatMap
 
-__all__ = ["LivePibtRobot"]
+__all__ = ["KnownCells", "LivePibtRobot"]
+
+
+class KnownCells:
+    """Where each peer was last known to stand, and at the start of which step, as arrays indexed by peer.
+
+    :meth:`within` answers :meth:`LivePibtRobot.possibly_within`'s question for
+    every peer at once: a peer last known at ``(px, py)`` at the start of step
+    ``heard`` can stand within ``radius`` cells of ``(x, y)`` at the start of
+    step ``step`` only if ``|px - x| + |py - y| <= radius + max(0, step - heard)``.
+
+    >>> known = KnownCells()
+    >>> known.set(3, (0, 6), 1); known.set(1, (0, 1), 4)
+    >>> known.within((0, 0), 2, 4), known.within((0, 0), 2, 7)   # peer 3 can have come 6 cells closer by step 7
+    ([1], [1, 3])
+    """
+
+    def __init__(self) -> None:
+        self._x = np.zeros(0, dtype=np.int64)
+        self._y = np.zeros(0, dtype=np.int64)
+        self._heard = np.zeros(0, dtype=np.int64)
+        self._known = np.zeros(0, dtype=bool)
+
+    def set(self, peer: int, cell: tuple[int, int], step: int) -> None:
+        """``peer`` stood on ``cell`` at the start of ``step``."""
+        if peer >= len(self._known):
+            size = max(peer + 1, 2 * len(self._known))
+            self._x, self._y, self._heard = (np.resize(array, size) for array in (self._x, self._y, self._heard))
+            known = np.zeros(size, dtype=bool)
+            known[: len(self._known)] = self._known
+            self._known = known
+        self._x[peer], self._y[peer], self._heard[peer], self._known[peer] = cell[0], cell[1], step, True
+
+    def within(self, here: tuple[int, int], radius: int, step: int) -> list[int]:
+        """The peers that can stand within ``radius`` cells of ``here`` at the start of ``step``, in index order."""
+        distance = np.abs(self._x - here[0]) + np.abs(self._y - here[1])
+        reach = radius + np.maximum(0, step - self._heard)
+        return [int(peer) for peer in np.flatnonzero(self._known & (distance <= reach))]
 
 
 class LivePibtRobot(ReliablePibtRobot):
@@ -123,6 +162,8 @@ class LivePibtRobot(ReliablePibtRobot):
         )  # fmt: skip
         self.known: dict[int, tuple[int, int]] = {}
         """Per peer: the cell it was last heard of, and the step at whose start it stood there."""
+        self._known_cells = KnownCells()
+        """:attr:`known` as arrays, for :meth:`possibly_within` over a large fleet in one pass."""
         self.held = False
         """Whether the robot may not leave its cell in this step (its body does not own it yet)."""
         self.lookout = lookout
@@ -153,6 +194,7 @@ class LivePibtRobot(ReliablePibtRobot):
         old = self.known.get(peer)
         if old is None or step >= old[1]:
             self.known[peer] = (cell, step)
+            self._known_cells.set(peer, self.flat.cells[cell], step)
         if peer in self._unknown and not self._may_be_within(peer, max(self.radius, RESERVE_RADIUS)):
             self._unknown.discard(peer)
             self.wake = True
@@ -189,16 +231,9 @@ class LivePibtRobot(ReliablePibtRobot):
 
     def possibly_within(self, radius: int) -> list[int]:
         """The peers that can stand within ``radius`` cells at the start of this step (module docstring)."""
-        cells, step = self.flat.cells, self.step
-        x, y = cells[self.present]
-        near = []
-        for peer, (cell, heard) in self.known.items():
-            if peer in self.crashed:
-                continue
-            px, py = cells[cell]
-            if abs(px - x) + abs(py - y) <= radius + max(0, step - heard):
-                near.append(peer)
-        return sorted(near)
+        near = self._known_cells.within(self.flat.cells[self.present], radius, self.step)
+        crashed = self.crashed
+        return [peer for peer in near if peer not in crashed] if crashed else near
 
     @property
     def complete(self) -> bool:
