@@ -238,27 +238,32 @@ class _VirtualFleet:
         return self.now
 
     def run(self) -> None:
-        """Run every robot until each has stopped (or the virtual timeout passes)."""
+        """Run every robot until each has stopped, the virtual timeout passes, or Ctrl-C (what was done is kept)."""
         for robot in self.robots:
             robot.driver.begin_fleet_wait(0.0)
         end = self.timing.timeout + self.timing.start_wait + 1.0
         network = self.network
-        while self._wakes or network.next_arrival() < math.inf:
-            next_robot = self._wakes[0][0] if self._wakes else math.inf
-            self.now = min(next_robot, network.next_arrival())
-            if self.now > end:
-                break
-            if network.next_arrival() <= next_robot:
-                for arrival, recipient, data in network.take_due(self.now):
-                    self._deliver(recipient, data, arrival)
-                continue
-            _, index, version = heapq.heappop(self._wakes)
-            robot = self.robots[index]
-            if version == robot.version and not robot.done:
-                self._turn(index, robot)
+        unfinished = "timeout"
+        try:
+            while self._wakes or network.next_arrival() < math.inf:
+                next_robot = self._wakes[0][0] if self._wakes else math.inf
+                self.now = min(next_robot, network.next_arrival())
+                if self.now > end:
+                    break
+                if network.next_arrival() <= next_robot:
+                    for arrival, recipient, data in network.take_due(self.now):
+                        self._deliver(recipient, data, arrival)
+                    continue
+                _, index, version = heapq.heappop(self._wakes)
+                robot = self.robots[index]
+                if version == robot.version and not robot.done:
+                    self._turn(index, robot)
+        except KeyboardInterrupt:
+            unfinished = "interrupted"
         for robot in self.robots:
             if not robot.done:
-                robot.driver.report.stop_reason = robot.driver.report.stop_reason or "timeout"
+                robot.driver.report.stop_reason = unfinished
+                robot.driver.fill_report(self.now)
                 robot.done = True
 
     def _deliver(self, recipient: int, data: bytes, arrival: float) -> None:

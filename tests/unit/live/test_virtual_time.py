@@ -99,3 +99,22 @@ def test_the_network_loses_and_duplicates_as_seeded():
     arrived = len(list(network.take_due(0.0)))
     counts = network.counts[0]
     assert counts.sent == 1000 and 400 < counts.lost < 600 and arrived == 1000 - counts.lost + counts.duplicated
+
+
+def test_ctrl_c_keeps_what_was_done(tmp_path, monkeypatch):
+    """Interrupted, the run still writes every robot's report, the referee's verdict and its result."""
+    from mrmp.live import virtual_time
+
+    turn = virtual_time._VirtualFleet._turn
+    turns = iter(range(10**9))
+
+    def interrupted_later(self, index, robot):
+        if next(turns) == 100:
+            raise KeyboardInterrupt
+        turn(self, index, robot)
+
+    monkeypatch.setattr(virtual_time._VirtualFleet, "_turn", interrupted_later)
+    result = run_virtual(crossing(), VirtualOptions(results=tmp_path, time_scale=10))
+    assert result.stop_reason == "interrupted" and not result.success and result.collisions == []
+    reports = [json.loads((tmp_path / f"agent-{index}.json").read_text()) for index in range(len(CROSS))]
+    assert {report["stop_reason"] for report in reports} == {"interrupted"} and (tmp_path / "referee.json").exists()
