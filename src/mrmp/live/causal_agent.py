@@ -47,6 +47,7 @@ from mrmp.live.transport import Transport
 from mrmp.protocol.auth import Opener, Sealer
 from mrmp.robot.causal_pibt import LOCK_RADIUS, CausalRobot
 from mrmp.robot.robot import Outgoing
+from mrmp.search.flat_map import FlatMap
 
 
 class CausalAgent(LiveDriver):
@@ -73,6 +74,7 @@ class CausalAgent(LiveDriver):
         timing: AgentTiming = AgentTiming(),
         seed: int = 0,
         clock: Callable[[], float] = time.monotonic,
+        flat: FlatMap | None = None,
     ) -> None:
         super().__init__(scenario, index, transport, body, sealer, opener, timing, seed, clock)
         spec = scenario.robots[index]
@@ -89,6 +91,7 @@ class CausalAgent(LiveDriver):
             heading=spec.heading,
             state_radius=live_state_radius(LOCK_RADIUS),
             body=body_model(scenario.policy.body),
+            flat=flat,
         )
         self._next_activation = 0.0
         self._extended_at: float | None = None

@@ -194,10 +194,16 @@ class PibtBrain:
     """
 
     def __init__(
-        self, scenario: Scenario, index: int, timing: PibtTiming, claim_retry: float = 0.05, crash_after: float = 6.0
+        self,
+        scenario: Scenario,
+        index: int,
+        timing: PibtTiming,
+        claim_retry: float = 0.05,
+        crash_after: float = 6.0,
+        flat: FlatMap | None = None,
     ) -> None:
         spec = scenario.robots[index]
-        flat = self.flat = FlatMap(scenario.grid)
+        flat = self.flat = flat if flat is not None else FlatMap(scenario.grid)
         goal, start = flat.index(spec.goal), flat.index(spec.start)
         distance = flat.distances(goal)[start]
         options = scenario.policy
@@ -511,6 +517,7 @@ class PibtAgent(LiveDriver):
         seed: int = 0,
         clock: Callable[[], float] = time.monotonic,
         pibt: PibtTiming | None = None,
+        flat: FlatMap | None = None,
     ) -> None:
         timing = dataclasses.replace(timing, poll=max(timing.poll, POLL))
         super().__init__(scenario, index, transport, body, sealer, opener, timing, seed, clock)
@@ -519,7 +526,7 @@ class PibtAgent(LiveDriver):
         self.pibt_timing = pibt if pibt is not None else PibtTiming.for_body(self.cell_seconds, turn_seconds)
         self.robot = PibtBrain(
             scenario, index, self.pibt_timing, claim_retry=min(timing.claim_retry, 0.05),
-            crash_after=2 * timing.give_up_after,
+            crash_after=2 * timing.give_up_after, flat=flat,
         )  # fmt: skip
 
     # -- what the driver reads of the brain --------------------------------------------------

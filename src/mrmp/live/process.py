@@ -40,6 +40,7 @@ from mrmp.live.transport import ConnectedTransport, LiveFaults, Transport, is_lo
 from mrmp.live.transport_table import FAULTS, TransportSpec
 from mrmp.policies.plan_following import PlanFollowingPolicy
 from mrmp.protocol.auth import Opener, Sealer
+from mrmp.search.flat_map import FlatMap
 from mrmp.sim.policy_table import policy_entry
 
 
@@ -147,6 +148,9 @@ class DriverOptions:
     timing: AgentTiming
     seed: int = 0
     guarded: bool = True
+    flat: FlatMap | None = None
+    """The map's distance tables, shared by the robots one process runs (None: each driver makes its own). They
+    are a cache of what every robot computes alike from the public map, not any robot's state."""
 
 
 @dataclass(frozen=True)
@@ -206,7 +210,9 @@ def _causal_agent(
     policy: PlanFollowingPolicy | None,
 ) -> CausalAgent:
     """The live driver of Causal-PIBT (always through the safety layer)."""
-    return CausalAgent(scenario, index, transport, body, sealer, opener, timing=options.timing, seed=options.seed)
+    return CausalAgent(
+        scenario, index, transport, body, sealer, opener, timing=options.timing, seed=options.seed, flat=options.flat
+    )
 
 
 def _pibt_agent(
@@ -220,7 +226,9 @@ def _pibt_agent(
     policy: PlanFollowingPolicy | None,
 ) -> PibtAgent:
     """The live driver of ``pibt``: locally sequenced, in steps on a common clock, always through the safety layer."""
-    return PibtAgent(scenario, index, transport, body, sealer, opener, timing=options.timing, seed=options.seed)
+    return PibtAgent(
+        scenario, index, transport, body, sealer, opener, timing=options.timing, seed=options.seed, flat=options.flat
+    )
 
 
 LiveDriver = Callable[

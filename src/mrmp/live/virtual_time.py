@@ -70,6 +70,7 @@ from mrmp.live.process import LIVE_DRIVERS, DriverOptions, driver_kind, fleet_ti
 from mrmp.live.results import live_result
 from mrmp.live.transport import FaultCounts, LiveFaults
 from mrmp.protocol.auth import Opener, Sealer
+from mrmp.search.flat_map import FlatMap
 from mrmp.sim.policy_table import body_problem
 
 __all__ = ["ProcessingCosts", "VirtualNetwork", "VirtualOptions", "run_virtual"]
@@ -216,13 +217,14 @@ class _VirtualFleet:
         timing = fleet_timing(options.timing, robots)
         self.timing = replace(timing, timeout=options.timeout or run_timeout(scenario, options.time_scale))
         kind = LIVE_DRIVERS[driver_kind(scenario, following_plan=False)]
+        shared = DriverOptions(self.timing, options.seed, flat=FlatMap(scenario.grid))  # one copy of the map's tables
         self.robots: list[_Robot] = []
         for index in range(robots):
             trace = TraceWriter(options.results / f"trace-{index}.jsonl", index)
             recorder = OccupancyRecorder(trace.write, heading_sink=trace.write_heading)
             body = simulated_body(scenario, index, recorder, options.time_scale, options.jitter, seed=options.seed)
             sealer, opener = Sealer(key, session), Opener(key, session, fleet_size=robots)
-            driver = kind(scenario, index, _NoSockets(), body, sealer, opener, DriverOptions(self.timing, options.seed), None)
+            driver = kind(scenario, index, _NoSockets(), body, sealer, opener, shared, None)
             driver.clock = self.clock
             outbox = _Outbox()
             driver.send_through(outbox)
