@@ -48,7 +48,7 @@ from __future__ import annotations
 
 from dataclasses import dataclass
 
-from mrmp.core.heading import Heading, right_turns
+from mrmp.core.heading import Heading, quarter_turns, right_turns
 
 __all__ = ["BODY_NAMES", "BODY_TABLE", "DEFAULT_BODY", "BodyModel", "body_model"]
 
@@ -97,8 +97,7 @@ class BodyModel:
         """
         if not self.headed:
             return 0
-        clockwise = right_turns(facing, wanted)
-        return clockwise if self.clockwise_only else min(clockwise, 4 - clockwise)
+        return right_turns(facing, wanted) if self.clockwise_only else quarter_turns(facing, wanted)
 
     def turn_ticks(self, turn_time: float, cell_time: float) -> float:
         """How long one quarter turn lasts, in ticks (cell times): 1 in place, else the timing's share, 0 without heading.

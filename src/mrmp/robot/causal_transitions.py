@@ -54,7 +54,7 @@ from collections.abc import Mapping
 from mrmp.core.body import BodyModel
 from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
-from mrmp.core.heading import Heading
+from mrmp.core.heading import Heading, quarter_turns
 from mrmp.protocol.messages import ADD_CHILD, CLEAR_PARENT, CONTRACT, REMOVE_CHILD, SET_VISITED, LockReleaseMessage
 from mrmp.robot.causal_views import CausalState, Mode, PeerView
 from mrmp.search.flat_map import FlatMap
@@ -268,13 +268,11 @@ class CausalTransitions:
         return self._distances[self.flat.index(cell)]
 
     def _turning_cost(self, tail: Cell, cell: Cell) -> float:
-        facing = int(self.heading)
         if cell == tail:
-            return round(1.0 + self._distances[4 * self.flat.index(tail) + facing - 1], 9)
-        direction = int(Heading.between(tail, cell))
-        quarters = (direction - facing) % 4
-        entry = self.grid.cost(cell)
-        return round(min(quarters, 4 - quarters) + entry + self._distances[4 * self.flat.index(cell) + direction - 1], 9)
+            return round(1.0 + self._distances[4 * self.flat.index(tail) + int(self.heading) - 1], 9)
+        direction = Heading.between(tail, cell)
+        onward = self._distances[4 * self.flat.index(cell) + int(direction) - 1]
+        return round(quarter_turns(self.heading, direction) + self.grid.cost(cell) + onward, 9)
 
     def _backtrack(self, state: CausalState, peers: PeerViews) -> None:
         """No candidate left: write S into the parent requesting this tail, and make it contract."""

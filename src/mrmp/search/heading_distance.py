@@ -48,13 +48,13 @@ import heapq
 
 from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
-from mrmp.core.heading import HEADINGS, right_turns
+from mrmp.core.heading import HEADINGS, quarter_turns, right_turns
 
 __all__ = ["heading_distances"]
 
 _TURNS = [[right_turns(facing, moving) for moving in HEADINGS] for facing in HEADINGS]
 """``_TURNS[h - 1][d - 1]``: right turns from facing ``h`` to facing ``d``."""
-_QUARTERS = [[min(turns, 4 - turns) for turns in row] for row in _TURNS]
+_QUARTERS = [[quarter_turns(facing, moving) for moving in HEADINGS] for facing in HEADINGS]
 """``_QUARTERS[h - 1][d - 1]``: quarter turns either way from facing ``h`` to facing ``d``."""
 
 
