@@ -600,6 +600,8 @@ class LiveDriver:
         report = self.report
         report.started_at = now
         report.believed_path.append((now, self._present()))
+        if self._present() == self.scenario.robots[self.index].goal:
+            report.arrival_time = 0.0  # there from the start: it arrives at once, unless it moves away
         if on_progress is not None:  # the launcher learns at once when this robot's run began
             self.fill_report(now)
             on_progress(report)

@@ -580,8 +580,8 @@ class PibtAgent(LiveDriver):
                 if self._ended_a_turn():
                     brain.turned()
                 else:
-                    brain.arrived_at(body.cell)
-                    self._record_move(now, started, brain.settled)
+                    brain.arrived_at(body.cell)  # the brain may have decided the steps beyond already: the body's cell says
+                    self._record_move(now, started, body.cell == self.scenario.robots[self.index].goal)
         else:
             action, out = brain.motion(now)
             self._send(out)

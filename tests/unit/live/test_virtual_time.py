@@ -118,3 +118,20 @@ def test_ctrl_c_keeps_what_was_done(tmp_path, monkeypatch):
     assert result.stop_reason == "interrupted" and not result.success and result.collisions == []
     reports = [json.loads((tmp_path / f"agent-{index}.json").read_text()) for index in range(len(CROSS))]
     assert {report["stop_reason"] for report in reports} == {"interrupted"} and (tmp_path / "referee.json").exists()
+
+
+def test_a_robot_arrives_when_its_body_enters_its_goal_for_the_last_time(tmp_path):
+    """A live ``pibt`` brain decides a step before its body ends the move of the last one: the robot's arrival
+    time is when its body entered its goal for good (its trace), whatever the brain had decided by then; a robot
+    that starts on its goal and stays there arrives at once."""
+    scenario = load(ROOT / "examples" / "causal-32.yaml")
+    robots = (*scenario.robots[:23], RobotSpec("still", (15, 0), (15, 0)))
+    scenario = scenario.with_changes(robots=robots, policy=replace(scenario.policy, name="pibt"))
+    result = run_virtual(scenario, VirtualOptions(results=tmp_path, time_scale=5, faults=LiveFaults(loss=0.1), seed=1))
+    assert result.success, result.stop_reason
+    reports = [json.loads((tmp_path / f"agent-{index}.json").read_text()) for index in range(len(robots))]
+    fleet_start = min(report["started_at"] for report in reports)
+    for index, robot in enumerate(result.robots):
+        lines = (tmp_path / f"trace-{index}.jsonl").read_text().splitlines()
+        left = [event["t"] for event in map(json.loads, lines) if event.get("event") == "leave"]  # a move's end
+        assert robot.time_s == pytest.approx(left[-1] - fleet_start if left else 0.0, abs=0.02), index
