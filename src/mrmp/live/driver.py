@@ -400,6 +400,11 @@ class LiveDriver:
         """The state to send every heartbeat while waiting for the fleet."""
         raise NotImplementedError
 
+    def _farewell_messages(self, now: float) -> list[Outgoing]:
+        """What to send every peer as the run ends: by default the state, so that every peer's last news of this
+        robot is fresh."""
+        return fleet_wide(self._state_messages(now))
+
     def _believed_within(self, radius: int) -> list[int]:
         """The peers the brain believes within ``radius`` cells of itself (where a radius broadcast goes)."""
         raise NotImplementedError
@@ -636,7 +641,7 @@ class LiveDriver:
                 loop.everyone_done_since = now
             if now - loop.everyone_done_since >= loop.linger:
                 report.stop_reason = "all arrived" if not report.silent_peers else "arrived; peers silent"
-                self._send(fleet_wide(self._state_messages(now)))  # every peer's last news of it is fresh
+                self._send(self._farewell_messages(now))
                 return None
         else:
             loop.everyone_done_since = None

@@ -83,6 +83,7 @@ from mrmp.protocol.codec import DecodeError, decode
 from mrmp.protocol.messages import (
     BeaconMessage,
     ClaimMessage,
+    FarewellMessage,
     Message,
     PibtMessage,
     ReleaseAckMessage,
@@ -447,6 +448,9 @@ class PibtBrain:
         if sender == self.index or not 0 <= sender < self.safety.fleet_size:
             self.dropped["own" if sender == self.index else "unknown_sender"] += 1
             return []
+        if sender in self.robot.departed:
+            self.dropped["departed"] += 1  # a late copy: its run is over
+            return []
         safety = self.safety
         if sender in self.robot.crashed:
             self.robot.revive(sender)
@@ -479,8 +483,25 @@ class PibtBrain:
         if isinstance(message, ReleaseAckMessage):
             safety.handle_release_ack(message)
             return []
+        if isinstance(message, FarewellMessage):
+            self._take_farewell(message)
+            return []
         self.dropped["other_type"] += 1
         return []
+
+    def _take_farewell(self, message: FarewellMessage) -> None:
+        """A peer's run is over: an obstacle on its cell for good, and done for the end of the run (it is heard
+        of for good: never silent)."""
+        cell = self.flat.index_on_grid(message.cell)
+        if cell is None:
+            self.dropped["off_map"] += 1
+            return
+        self.robot.depart(message.sender, cell)
+        self.heard[message.sender] = (math.inf, True)
+
+    def farewell(self) -> FarewellMessage:
+        """What this robot tells every peer as its run ends: the cell it stays on for good."""
+        return self._stamp(FarewellMessage(self.index, 0, self.flat.cells[self.robot.present]))
 
     def next_seq(self) -> int:
         """The next number of the robot's sequence (every message it sends has a fresh one)."""
@@ -548,6 +569,9 @@ class PibtAgent(LiveDriver):
 
     def _fleet_wait_messages(self) -> list[Outgoing]:
         return fleet_wide([Outgoing(self.robot.state())])
+
+    def _farewell_messages(self, now: float) -> list[Outgoing]:
+        return fleet_wide([Outgoing(self.robot.farewell())])
 
     def _believed_within(self, radius: int) -> list[int]:
         return self.robot.robot.possibly_within(radius)

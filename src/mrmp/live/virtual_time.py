@@ -29,7 +29,8 @@ The run writes what a live run writes (``agent-<i>.json``, ``trace-<i>.jsonl``,
 (:func:`mrmp.live.process.run_referee`, :func:`mrmp.live.results.live_result`),
 its times in virtual seconds; its ``wall_time_s`` is the CPU time the
 harness spent, and its ``network`` counts the turns run (``virtual_turns``)
-and the datagrams taken in or sent (``virtual_datagrams``). It is
+and the datagrams taken in or sent (``virtual_datagrams``), and those that
+reached a robot whose process had ended (``virtual_to_ended``). It is
 deterministic for a seed: one thread, one seeded network, seeded bodies and
 drivers (the fleet key and session only change the bytes, not their fate).
 
@@ -234,6 +235,8 @@ class _VirtualFleet:
         """Turns of the robots' main loops run."""
         self.datagrams = 0
         """Datagrams the robots took in or sent."""
+        self.to_ended = 0
+        """Datagrams that reached a robot whose process had ended (lost on it)."""
 
     def clock(self) -> float:
         """The virtual time: what every driver's clock reads."""
@@ -271,6 +274,7 @@ class _VirtualFleet:
     def _deliver(self, recipient: int, data: bytes, arrival: float) -> None:
         robot = self.robots[recipient]
         if robot.done:
+            self.to_ended += 1
             return  # its process has ended
         robot.driver.take_datagram(data)
         if robot.woken_by_messages and robot.wake_at > arrival:
@@ -371,6 +375,6 @@ def run_virtual(scenario: Scenario, options: VirtualOptions) -> RunResult:
         tick_seconds=scenario.timing.cell_time / options.time_scale / 4,
         time_scale=options.time_scale,
     )
-    harness = {"virtual_turns": fleet.turns, "virtual_datagrams": fleet.datagrams}
+    harness = {"virtual_turns": fleet.turns, "virtual_datagrams": fleet.datagrams, "virtual_to_ended": fleet.to_ended}
     return replace(result, network={**result.network, **harness})
 

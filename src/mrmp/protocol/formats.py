@@ -46,6 +46,7 @@ from mrmp.protocol.messages import (
     AnswerMessage,
     BeaconMessage,
     ClaimMessage,
+    FarewellMessage,
     HandoffMessage,
     HelloMessage,
     InheritMessage,
@@ -67,6 +68,7 @@ __all__ = [
     "ANSWER",
     "BEACON",
     "CLAIM",
+    "FAREWELL",
     "INHERIT",
     "LOCK_ACK",
     "LOCK_GRANT",
@@ -257,3 +259,11 @@ def _unpack_handoff(sender: int, seq: int, fields: Fields, _: tuple[Cell, ...]) 
 
 HANDOFF = register(WireFormat(15, HandoffMessage, "!Iii", lambda m: (m.claim, *m.cell), _unpack_handoff))
 HELLO = register(WireFormat(17, HelloMessage, "!", lambda m: (), lambda sender, seq, fields, _: HelloMessage(sender, seq)))
+
+
+def _unpack_farewell(sender: int, seq: int, fields: Fields, _: tuple[Cell, ...]) -> FarewellMessage:
+    cx, cy = fields
+    return FarewellMessage(sender, seq, (cx, cy))
+
+
+FAREWELL = register(WireFormat(18, FarewellMessage, "!ii", lambda m: m.cell, _unpack_farewell))

@@ -13,7 +13,8 @@ current claim; see ``docs/protocol.md``).
 request for a cell and its answer, :class:`ReleaseMessage` and
 :class:`ReleaseAckMessage` its release of a cell and the acknowledgement, :class:`HandoffMessage`
 a robot's commitment to leave its cell in the current tick (the lockstep model's following).
-:class:`HelloMessage` asks a peer for its state while a live robot waits for its fleet to start. :class:`BeaconMessage`,
+:class:`HelloMessage` asks a peer for its state while a live robot waits for its fleet to start, and
+:class:`FarewellMessage` tells the fleet that a live robot's run is over. :class:`BeaconMessage`,
 :class:`InheritMessage`, :class:`AnswerMessage`, :class:`ReserveMessage` and
 :class:`PullMessage` carry decentralized PIBT (:mod:`mrmp.robot.pibt_robot`), and
 :class:`StayMessage` too for bodies that turn in place.
@@ -180,6 +181,21 @@ class HelloMessage(Message):
 
     sender: int
     seq: int
+
+
+@dataclass(frozen=True, slots=True)
+class FarewellMessage(Message):
+    """A live robot's run is over: it stands on ``cell`` for good, and hears and answers nothing more.
+
+    Sent to every peer as the robot's process ends (:mod:`mrmp.live.driver`);
+    a peer takes it for an obstacle on ``cell`` at once, instead of sending it
+    what it will never acknowledge until it has been silent long enough to be
+    taken for crashed.
+    """
+
+    sender: int
+    seq: int
+    cell: Cell
 
 
 @dataclass(frozen=True, slots=True)

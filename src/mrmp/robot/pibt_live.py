@@ -175,6 +175,8 @@ class LivePibtRobot(ReliablePibtRobot):
         self._news: tuple[News, ...] = ()
         self.crashed: dict[int, int] = {}
         """Peers taken for crashed (:meth:`crash`), by the cell each was last known on."""
+        self.departed: set[int] = set()
+        """Peers whose run is over (:meth:`depart`): taken for crashed for good."""
         self.meet(starts)
 
     def meet(self, starts: Sequence[int], step: int = 1) -> None:
@@ -281,8 +283,26 @@ class LivePibtRobot(ReliablePibtRobot):
         self.wake = True
 
     def revive(self, peer: int) -> None:
-        """``peer``, taken for crashed, was heard again: from the next step on it is a robot like the others."""
+        """``peer``, taken for crashed, was heard again: from the next step on it is a robot like the others
+        (unless it said farewell: :meth:`depart`; what is heard of it after that is a late copy)."""
+        if peer not in self.departed:
+            self.crashed.pop(peer, None)
+
+    def depart(self, peer: int, cell: int) -> None:
+        """``peer``'s run is over, on ``cell``: an obstacle there for good, waited for and addressed no more.
+
+        >>> from mrmp.core.grid import Grid
+        >>> from mrmp.search.flat_map import FlatMap
+        >>> flat = FlatMap(Grid(4, 1))
+        >>> a = LivePibtRobot(0, 0, 3, flat, starts=[0, 2])
+        >>> a.depart(1, 2); a.revive(1)
+        >>> a.crashed, a.possibly_within(4)
+        ({1: 2}, [])
+        """
+        self.departed.add(peer)
         self.crashed.pop(peer, None)
+        self.learn(peer, cell, self.step)
+        self.crash(peer)
 
     def _obstacle(self, peer: int, cell: int) -> None:
         """``peer`` stands on ``cell`` for good this step: occupied, reserved by it, decided, settled there."""
@@ -303,12 +323,20 @@ class LivePibtRobot(ReliablePibtRobot):
             self.wake = True
 
     def on_tick(self, now: int) -> list[Outgoing]:
-        """:meth:`ReliablePibtRobot.on_tick`, its broadcasts addressed to the peers that can be near."""
+        """:meth:`ReliablePibtRobot.on_tick`, its broadcasts addressed to the peers that can be near; the beacon
+        sent again only to those of them that have not acknowledged it, and to the peers whose beacon it waits for.
+
+        A peer that acknowledged the beacon has it; a peer whose beacon has not
+        come answers a second copy with its own (:meth:`_take_step_beacon`).
+        """
         out = self._address(super().on_tick(now))
-        for item in out:
+        for index, item in enumerate(out):
             if isinstance(item.message, BeaconMessage):
-                self._beacon_to.update(item.recipients or ())
-        return out
+                acked = self._beacon_acks
+                recipients = {peer for peer in item.recipients or () if peer not in acked} | self._unknown
+                out[index] = Outgoing(item.message, tuple(sorted(recipients)))
+                self._beacon_to.update(recipients)
+        return [item for item in out if item.recipients != ()]
 
     def _address(self, out: list[Outgoing]) -> list[Outgoing]:
         """Turn every radius broadcast into a message to the peers that can be within the radius."""

@@ -9,7 +9,7 @@ from hypothesis import strategies as st
 
 from mrmp.core.heading import Heading
 from mrmp.protocol.codec import MAX_MESSAGE_BYTES, PROTOCOL_VERSION, DecodeError, decode, encode
-from mrmp.protocol.messages import ClaimMessage, ReplyMessage, StateMessage
+from mrmp.protocol.messages import ClaimMessage, FarewellMessage, ReplyMessage, StateMessage
 
 coordinates = st.integers(min_value=-(2**31), max_value=2**31 - 1)
 cells = st.tuples(coordinates, coordinates)
@@ -39,6 +39,7 @@ messages = (
     states()
     | st.builds(ClaimMessage, sender=u32, seq=u32, claim=claims, cell=cells)
     | st.builds(ReplyMessage, sender=u32, seq=u32, claimant=u32, claim=claims, cell=cells, granted=st.booleans())
+    | st.builds(FarewellMessage, sender=u32, seq=u32, cell=cells)
 )
 
 
@@ -94,6 +95,7 @@ def test_sizes_stay_small():
     assert len(_valid()) == 52
     assert len(encode(ClaimMessage(1, 2, 3, (4, 5)))) == 22
     assert len(encode(ReplyMessage(1, 2, 3, 4, (5, 6), False))) == 27
+    assert len(encode(FarewellMessage(1, 2, (3, 4)))) == 18
 
 
 def test_fields_that_do_not_fit_are_refused_at_encoding():

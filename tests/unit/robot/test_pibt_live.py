@@ -12,7 +12,7 @@ from mrmp.core import Grid, NetworkFaults, PolicyOptions, RobotSpec, Scenario, T
 from mrmp.core.heading import Heading
 from mrmp.live.body import OccupancyRecorder, SimulatedBody
 from mrmp.live.pibt_agent import PibtBrain, PibtTiming
-from mrmp.protocol.messages import BeaconMessage
+from mrmp.protocol.messages import BeaconMessage, FarewellMessage, StateMessage
 from mrmp.protocol.pibt_local import CallInheritMessage, CallReserveMessage, NewsBeaconMessage
 from mrmp.robot.messaging import Outgoing
 from mrmp.robot.pibt_live import LivePibtRobot
@@ -277,6 +277,40 @@ class BrainFleet:
             [spec.start, *(cell for _, cell in brain.moves)]
             for spec, brain in zip(self.scenario.robots, self.brains, strict=True)
         ]
+
+
+def test_a_beacon_goes_again_only_to_the_peers_that_have_not_acknowledged_it_or_whose_beacon_is_missing():
+    flat, cells = line(8)
+    starts = [cells[2], cells[0], cells[4]]  # b and c both within the radio radius of a
+    a, b, c = (LivePibtRobot(index, starts[index], cells[7], flat, starts=starts) for index in range(3))
+    sent = a.begin_step(1)
+    assert [item.recipients for item in sent] == [(1, 2)]
+    b.begin_step(1)
+    b.receive(sent[0].message)  # b acknowledges a's beacon; c's copy was lost
+    a.receive(next(item.message for item in b.act() if item.recipients == (0,) and not isinstance(item.message, BeaconMessage)))
+    resent = [item for item in a.on_tick(a.retry) if isinstance(item.message, BeaconMessage)]
+    assert [item.recipients for item in resent] == [(1, 2)]  # b's own beacon has not come: a's second copy pulls it
+    a.receive(b.begin_step(1)[0].message)
+    resent = [item for item in a.on_tick(2 * a.retry) if isinstance(item.message, BeaconMessage)]
+    assert [item.recipients for item in resent] == [(2,)] and c.index == 2  # b has a's beacon and a has b's
+
+
+def test_a_peer_that_says_farewell_is_an_obstacle_for_good_and_done():
+    scenario = corridor(robots=2, length=6)
+    brain = PibtBrain(scenario, 0, PibtTiming.for_body(0.5, 0.25))
+    brain.start(0.0)
+    sent = brain.expire(0.0)
+    assert any(1 in (item.recipients or ()) for item in sent)
+    brain.receive(FarewellMessage(1, 7, (1, 0)), 0.01)
+    assert brain.heard[1] == (math.inf, True) and brain.robot.crashed == {1: brain.flat.index((1, 0))}
+    late = StateMessage(1, 6, (1, 0), (1, 0), progress=1)  # a copy sent before the farewell, arriving after it
+    assert brain.receive(late, 0.02) == [] and brain.dropped["departed"] == 1 and 1 in brain.robot.crashed
+    later = [item for now in (0.05, 0.1, 0.2, 0.8, 1.6) for item in brain.expire(now)]
+    assert later and all(1 not in (item.recipients or ()) for item in later)
+    assert brain.receive(FarewellMessage(1, 8, (40, 0)), 0.3) == []  # off the map: dropped, counted
+    off_map = PibtBrain(scenario, 0, PibtTiming.for_body(0.5, 0.25))
+    off_map.receive(FarewellMessage(1, 8, (40, 0)), 0.0)
+    assert off_map.dropped["off_map"] == 1 and not off_map.robot.departed
 
 
 def corridor(robots=3, length=9):
