@@ -579,13 +579,14 @@ def run(
     kill: Annotated[list[str] | None, typer.Option(help="Kill robot ID's process S wall-clock seconds after the fleet's start (repeatable).", metavar="ID@S", show_default=False, rich_help_panel=LIVE)] = None,
     ros2: Annotated[bool, typer.Option("--ros2", help="Every robot process publishes its pose and state on ROS 2 topics (DDS, domain ROS_DOMAIN_ID; the ros2 extra; docs/ros2.md).", rich_help_panel=LIVE)] = False,
     virtual_clock: Annotated[bool, typer.Option("--virtual-clock", help="With --live: run every robot's live driver, brain and body in this process on a virtual clock, over a simulated network with a processor per robot (fleets larger than the machine; times in virtual seconds).", rich_help_panel=LIVE)] = False,
+    robots_per_process: Annotated[int, typer.Option(help="With --live: robots each mrmp agent process hosts, each with its own socket, brain and body (udp, multicast).", rich_help_panel=LIVE)] = 1,
 ) -> None:
     """Run a scenario (lockstep simulator, or --live processes) and report what happened."""
     # --resolve, --heading-aware, --radius, --swap and --search come from PolicyOptions' fields (with_policy_flags)
     request = RunRequest(
         None if json_path is None else str(json_path), animate, show_messages, watch, watch_fps, planner, time_limit, live, transport, time_scale,
         delay_ms, jitter, miss_line, results, kill or [], unsafe, goal_lines=goal_lines, colour_by=colour_by, speed=speed,
-        record=record, ros2=ros2, lorr_output=lorr_output, virtual_clock=virtual_clock,
+        record=record, ros2=ros2, lorr_output=lorr_output, virtual_clock=virtual_clock, robots_per_process=robots_per_process,
     )
     console = Console(stderr=request.json_path == "-", highlight=False)
     try:
@@ -642,6 +643,7 @@ class RunRequest:
     ros2: bool = False
     lorr_output: Path | None = None
     virtual_clock: bool = False
+    robots_per_process: int = 1
 
 
 def _validate_run(scenario: Scenario, request: RunRequest) -> None:
@@ -686,6 +688,8 @@ def _validate_run(scenario: Scenario, request: RunRequest) -> None:
         raise InputError(Problem("--lorr-output", f"LoRR's actions are those of turning bodies, not {scenario.policy.body}"))
     if request.virtual_clock and not request.live:
         raise InputError(Problem("--virtual-clock", "runs a live fleet on a virtual clock: add --live"))
+    if request.robots_per_process != 1 and (not request.live or request.virtual_clock):
+        raise InputError(Problem("--robots-per-process", "hosts the robots of a live run in processes: add --live (not --virtual-clock)"))
     if request.ros2 and not request.live:
         raise InputError(Problem("--ros2", "publishes the robots of a live run: add --live"))
     if request.ros2:
@@ -705,6 +709,9 @@ def _validate_live(scenario: Scenario, request: RunRequest) -> None:
         raise InputError(Problem("--live", reason))
     live_faults(scenario, request.time_scale, request.delay_ms)
     parse_kills(request.kill)
+    if not 1 <= request.robots_per_process <= MAX_LIVE_ROBOTS:
+        reason = f"must be 1 to {MAX_LIVE_ROBOTS}, got {request.robots_per_process}"
+        raise InputError(Problem("--robots-per-process", reason))
     _fraction(request.jitter, "--jitter")
     _fraction(request.miss_line, "--miss-line")
     if request.results is not None:
@@ -787,6 +794,7 @@ def _live_run(scenario: Scenario, request: RunRequest, plan: PlanningResult | No
         seed=scenario.seed,
         plan=plan,
         ros2=request.ros2,
+        robots_per_process=request.robots_per_process,
     )
     from mrmp.viz.progress import LiveProgressLine
 
@@ -1077,7 +1085,7 @@ def validate(
 @command()
 def agent(
     scenario_path: Annotated[Path | None, typer.Argument(metavar="SCENARIO", help="The fleet's scenario (the same file on every robot).", show_default=False)] = None,
-    robot: Annotated[str | None, typer.Option(help="Which robot of the scenario this process is (required).", metavar="ID")] = None,
+    robot: Annotated[list[str] | None, typer.Option(help="Which robot of the scenario this process is (required); repeat to host several, each with its own socket (udp, multicast).", metavar="ID", show_default=False)] = None,
     policy: Annotated[str | None, typer.Option(help="The decision rule (the same on every robot of the fleet).", metavar=choices(policy_names()), show_default=SCENARIO_DEFAULT, autocompletion=policy_names)] = None,
     transport: Annotated[str, typer.Option(help="How the robots talk.", metavar=choices(TRANSPORTS.names), autocompletion=lambda: list(TRANSPORTS.names))] = "udp",
     bind: Annotated[str, typer.Option(help="UDP: address to receive on.", metavar="HOST:PORT")] = "127.0.0.1:9001",
@@ -1107,19 +1115,20 @@ def agent(
     drive_wait: Annotated[float, typer.Option(help="With --drive ros2: seconds to wait for the driver's first odometry.")] = 30.0,
     scenario_option: Annotated[Path | None, typer.Option("--scenario", hidden=True, help="SCENARIO, as an option.")] = None,
 ) -> None:
-    """Run one robot of a fleet as this process (one command per robot, on its own computer)."""
+    """Run one robot of a fleet as this process (one command per robot, on its own computer), or several."""
+    import dataclasses
     import os
 
     from mrmp.io.lifetime import die_with_parent
     from mrmp.io.live_files import key_from_environment, read_key_file
     from mrmp.live.agent import AgentTiming
-    from mrmp.live.process import AgentOptions, check_key_policy, run_agent, warn
+    from mrmp.live.process import AgentOptions, check_key_policy, run_agents, warn
     from mrmp.live.transport import LiveFaults
 
     die_with_parent()
     try:
         scenario_path = _scenario_argument(scenario_path, scenario_option)
-        if robot is None:
+        if not robot:
             raise InputError(Problem("--robot", "give the id of the robot this process is"))
         scenario = apply_run_options(load_scenario(scenario_path, known_policies=policy_names()), policy, names=FLAG_NAMES)
         entry = policy_entry(scenario.policy.name)
@@ -1136,22 +1145,27 @@ def agent(
             raise InputError(Problem("--drive", reason))
         drive_domain = _ros2_domain("--drive") if drive == "ros2" else 0
         ids = [spec.id for spec in scenario.robots]
-        if robot not in ids:
-            raise InputError(Problem("--robot", f"no robot has the id {robot!r} in {scenario_path}"))
-        index = ids.index(robot)
+        for robot_id in robot:
+            if robot_id not in ids:
+                raise InputError(Problem("--robot", f"no robot has the id {robot_id!r} in {scenario_path}"))
+        if len(set(robot)) < len(robot):
+            raise InputError(Problem("--robot", "names a robot twice"))
+        if len(robot) > 1 and (plan is not None or ros2 or drive != "simulated"):
+            raise InputError(Problem("--robot", "one robot per process with --plan, --ros2 or --drive ros2"))
         transport_values = {
             "bind": bind, "peer": peer, "group": group, "interface": interface, "listen": listen, "connect": connect, "fleet": fleet,
         }
-        spec = TRANSPORTS.parse(transport, transport_values, ids, index)
-        missing = spec.entry.unavailable()
+        specs = TRANSPORTS.hosted(transport, transport_values, ids, robot)
+        missing = specs[0].entry.unavailable()
         if missing is not None:
             raise InputError(Problem("--transport", missing))
         key = read_key_file(key_file) if key_file is not None else key_from_environment(os.environ.get("MRMP_FLEET_KEY"))
-        key = check_key_policy(key, spec, warn)
+        for spec in specs:
+            key = check_key_policy(key, spec, warn)
         low, high = parse_range_ms(delay_ms, "--delay-ms")
-        options = AgentOptions(
-            index=index,
-            transport=spec,
+        common = AgentOptions(
+            index=0,
+            transport=specs[0],
             key=key,
             session=session,
             results=results,
@@ -1174,11 +1188,16 @@ def agent(
         if plan is not None:
             from mrmp.io.plans import read_share
 
-            read_share(plan, robot)  # a bad share is bad input: report it before any socket opens
-        report = run_agent(scenario, options)  # an address that cannot be used is bad input too
+            read_share(plan, robot[0])  # a bad share is bad input: report it before any socket opens
+        hosted = [
+            dataclasses.replace(common, index=ids.index(robot_id), transport=spec)
+            for robot_id, spec in zip(robot, specs, strict=True)
+        ]
+        reports = run_agents(scenario, hosted)  # an address that cannot be used is bad input too
     except InputError as error:
         raise _fail(error.problems) from None
-    raise typer.Exit(0 if report.arrived else 1)
+    raise typer.Exit(0 if all(report.arrived for report in reports) else 1)
+
 
 
 def _ros2_domain(option: str = "--ros2") -> int:

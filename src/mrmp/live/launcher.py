@@ -71,6 +71,8 @@ class LiveOptions:
     plan: PlanningResult | None = None
     ros2: bool = False
     """Every robot publishes its pose and state on ROS 2 topics (``mrmp agent --ros2``; domain ``ROS_DOMAIN_ID``)."""
+    robots_per_process: int = 1
+    """How many robots each ``mrmp agent`` process hosts (each with its own socket, brain and body)."""
 
 
 @dataclass(frozen=True)
@@ -91,6 +93,9 @@ class _Fleet:
 
     ids: list[str]
     agents: list[subprocess.Popen[bytes]]
+    """The robot processes, each hosting one robot or more."""
+    process_of: list[int]
+    """Per robot (by index): which of :attr:`agents` hosts it."""
     referee: subprocess.Popen[bytes]
     started: float
     timeout: float
@@ -136,7 +141,11 @@ def run_live(
     layout = FleetLayout.on_loopback(ids, fleet=f"mrmp/{session}")
     timeout = options.timeout or run_timeout(scenario, options.time_scale)
     fleet = _start_fleet(options, files, layout, session, timeout)
-    say(f"live: {len(ids)} robot processes and a referee over {options.transport} on loopback; results in {files.results}")
+    hosting = "" if options.robots_per_process == 1 else f" ({options.robots_per_process} robots per process)"
+    say(
+        f"live: {len(ids)} robots in {len(fleet.agents)} processes{hosting} and a referee over {options.transport} on loopback; "
+        f"results in {files.results}"
+    )
     note = policy_entry(scenario.policy.name).live_note if options.plan is None else ""
     if note:
         say(f"live: {note}")
@@ -166,6 +175,12 @@ def _check(options: LiveOptions, ids: list[str]) -> None:
     for robot_id in options.kill:
         if robot_id not in ids:
             raise InputError(Problem("--kill", f"no robot has the id {robot_id!r}"))
+    if options.robots_per_process > 1:
+        if options.kill or options.plan is not None or options.ros2:
+            reason = "hosts one robot per process with --kill (a kill ends a process), --planner or --ros2"
+            raise InputError(Problem("--robots-per-process", reason))
+        if not TRANSPORTS.entry(options.transport).hosts_several:
+            raise InputError(Problem("--robots-per-process", f"one robot per process over {options.transport}"))
 
 
 def _write_run_files(scenario: Scenario, options: LiveOptions, ids: list[str]) -> _RunFiles:
@@ -208,14 +223,20 @@ def _start_fleet(options: LiveOptions, files: _RunFiles, layout: FleetLayout, se
         ],
     )
     common = _agent_arguments(options, files, session, timeout)
-    agents = []
-    for index, robot_id in enumerate(layout.ids):
-        transport = TRANSPORTS.fleet_spec(options.transport, layout, index)
-        plan = [f"--plan={files.shares[index]}"] if files.shares else []
-        robot = [str(files.scenario), f"--robot={robot_id}"]
-        command = [*_PYTHON, "agent", *robot, *common, *plan, *transport.arguments(layout.ids)]
-        agents.append(_start(command))
-    return _Fleet(list(layout.ids), agents, referee, started, timeout, files.done, files.results)
+    agents: list[subprocess.Popen[bytes]] = []
+    process_of: list[int] = []
+    per_process = options.robots_per_process
+    for first in range(0, len(layout.ids), per_process):
+        indices = list(range(first, min(first + per_process, len(layout.ids))))
+        robots = [str(files.scenario), *(f"--robot={layout.ids[index]}" for index in indices)]
+        if len(indices) == 1:
+            transport = TRANSPORTS.fleet_spec(options.transport, layout, first).arguments(layout.ids)
+        else:
+            transport = TRANSPORTS.entry(options.transport).hosting_arguments(layout, indices)
+        plan = [f"--plan={files.shares[first]}"] if files.shares else []
+        agents.append(_start([*_PYTHON, "agent", *robots, *common, *plan, *transport]))
+        process_of.extend(len(agents) - 1 for _ in indices)
+    return _Fleet(list(layout.ids), agents, process_of, referee, started, timeout, files.done, files.results)
 
 
 def _agent_arguments(options: LiveOptions, files: _RunFiles, session: int, timeout: float) -> list[str]:
@@ -261,8 +282,9 @@ def _watch(
             if pending_kills and fleet_start is None:
                 fleet_start = _fleet_start(fleet)
             for index, seconds in list(pending_kills.items()):
-                if fleet_start is not None and now >= fleet_start + seconds and fleet.agents[index].poll() is None:
-                    fleet.agents[index].kill()
+                process = fleet.agents[fleet.process_of[index]]
+                if fleet_start is not None and now >= fleet_start + seconds and process.poll() is None:
+                    process.kill()
                     say(f"live: killed robot {fleet.ids[index]} at {now - fleet_start:.1f} s after the fleet's start")
                     del pending_kills[index]
             if now - fleet.started > fleet.timeout + 10.0:
@@ -305,11 +327,11 @@ def fleet_progress(results: Path, robots: int, elapsed_s: float) -> LiveProgress
 def _fleet_start(fleet: _Fleet) -> float | None:
     """When the last robot began its run (its report's ``started_at``), or None while one still waits to begin."""
     starts = []
-    for index, agent in enumerate(fleet.agents):
+    for index, process in enumerate(fleet.process_of):
         report = _read_if_there(fleet.results / f"agent-{index}.json")
         if report is not None and report.get("started_at"):
             starts.append(float(report["started_at"]))
-        elif agent.poll() is None:
+        elif fleet.agents[process].poll() is None:
             return None
     return max(starts, default=time.monotonic())
 

@@ -15,7 +15,7 @@ import signal
 import sys
 import threading
 import time
-from collections.abc import Callable, Iterator, Mapping
+from collections.abc import Callable, Iterator, Mapping, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -258,31 +258,87 @@ def driver_kind(scenario: Scenario, following_plan: bool) -> str:
 
 def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
     """Run one robot until it is done, writing ``agent-<i>.json`` and ``trace-<i>.jsonl`` in ``options.results``."""
-    options = replace(options, timing=fleet_timing(options.timing, len(scenario.robots)))
-    index = options.index
-    options.results.mkdir(parents=True, exist_ok=True)
-    policy = None
-    if options.plan is not None:
-        moves, dependencies = read_share(options.plan, scenario.robots[index].id)
-        dependents = read_share_dependents(options.plan, scenario.robots[index].id)
-        crash_silence = CRASH_SILENCES * options.timing.silence_timeout
-        policy = PlanFollowingPolicy(moves, dependencies, dependents, answer_all_pulls=True, crash_silence=crash_silence)
-    spec = scenario.robots[index]
-    report_path = options.results / f"agent-{index}.json"
-    trace = TraceWriter(options.results / f"trace-{index}.jsonl", index)
-    transport: Transport | None = None
-    ros2: Ros2Publisher | None = None
-    driver: Ros2Driver | None = None
-    try:
+    return run_agents(scenario, [options])[0]
+
+
+def run_agents(scenario: Scenario, robots: Sequence[AgentOptions]) -> list[AgentReport]:
+    """Run the robots of ``robots`` in this process until each is done; each writes its report and trace as
+    :func:`run_agent` does.
+
+    Each hosted robot has what a robot process has: its own transport (its own
+    socket), envelope, body, driver and threads; none reads another's state,
+    and they talk only through the network, as robots in processes of their
+    own do. One robot runs in this thread; several run one thread each. A stop
+    signal, or the end of the process that started this one, stops them all.
+    """
+    with contextlib.ExitStack() as resources:
+        hosted = [_HostedRobot.open(scenario, options, resources) for options in robots]
+
+        def stop_all() -> None:
+            for robot in hosted:
+                robot.agent.request_stop()
+
+        _on_stop_signals(stop_all)
+        watch_parent(stop_all)
+        for robot in hosted:
+            if isinstance(robot.opened, ConnectedTransport):
+                _wait_for_peers(robot.opened, len(scenario.robots) - 1, robot.agent.stop_requested)
+        if len(hosted) == 1:
+            with profiled(hosted[0].options.results / f"profile-{hosted[0].options.index}.prof"):
+                hosted[0].run()
+        else:
+            threads = [threading.Thread(target=robot.run_catching, name=f"robot-{robot.options.index}") for robot in hosted]
+            for thread in threads:
+                thread.start()
+            for thread in threads:
+                thread.join()
+            for robot in hosted:
+                if robot.failure is not None:
+                    raise robot.failure
+    reports = []
+    for robot in hosted:
+        write_json(robot.report_path, robot.agent.report.as_dict())
+        reports.append(robot.agent.report)
+    return reports
+
+
+@dataclass
+class _HostedRobot:
+    """One robot run by this process: its options, transport, driver and report file (:func:`run_agents`)."""
+
+    options: AgentOptions
+    opened: Transport
+    """Its transport as opened (before faults are injected)."""
+    agent: Agent | CausalAgent | PibtAgent
+    report_path: Path
+    failure: Exception | None = None
+
+    @classmethod
+    def open(cls, scenario: Scenario, options: AgentOptions, resources: contextlib.ExitStack) -> _HostedRobot:
+        """Open the robot's trace, transport and body and make its driver; ``resources`` closes them."""
+        options = replace(options, timing=fleet_timing(options.timing, len(scenario.robots)))
+        index = options.index
+        options.results.mkdir(parents=True, exist_ok=True)
+        policy = None
+        if options.plan is not None:
+            moves, dependencies = read_share(options.plan, scenario.robots[index].id)
+            dependents = read_share_dependents(options.plan, scenario.robots[index].id)
+            crash_silence = CRASH_SILENCES * options.timing.silence_timeout
+            policy = PlanFollowingPolicy(moves, dependencies, dependents, answer_all_pulls=True, crash_silence=crash_silence)
+        spec = scenario.robots[index]
+        trace = resources.enter_context(contextlib.closing(TraceWriter(options.results / f"trace-{index}.jsonl", index)))
         sink: OccupancySink = trace.write
         if options.ros2_domain is not None:
             ros2 = Ros2Publisher(spec.id, spec.start, spec.heading, domain=options.ros2_domain)
+            resources.callback(ros2.close)
             sink = _both(trace.write, ros2.occupancy)
-        transport = opened = options.transport.open(index, len(scenario.robots))
+        opened = options.transport.open(index, len(scenario.robots))
+        resources.callback(opened.close)
         transport = FAULTS.wrap(opened, options.faults, seed=derive_seed(options.seed, Stream.LIVE_FAULTS, index))
         body: Body
         if options.drive == "ros2":
             driver = Ros2Driver(spec.id, spec.start, spec.heading, domain=options.drive_domain, wheel_base=1.0)
+            resources.callback(driver.close)
             body = _ros2_body(driver, scenario, index, options, OccupancyRecorder(sink))
         else:
             recorder = OccupancyRecorder(sink, heading_sink=trace.write_heading)
@@ -292,27 +348,24 @@ def run_agent(scenario: Scenario, options: AgentOptions) -> AgentReport:
         agent = LIVE_DRIVERS[driver_kind(scenario, following_plan=policy is not None)](
             scenario, index, transport, body, sealer, opener, DriverOptions(options.timing, options.seed, options.guarded), policy
         )
-        _on_stop_signals(agent.request_stop)
-        watch_parent(agent.request_stop)
-        if isinstance(opened, ConnectedTransport):
-            _wait_for_peers(opened, len(scenario.robots) - 1, agent.stop_requested)
-        with profiled(options.results / f"profile-{index}.prof"):
-            try:
-                report = agent.run(on_progress=lambda report: write_json(report_path, report.as_dict()))
-            except Exception as error:  # what the robot gathered is kept, saying why it stopped
-                agent.report.stop_reason = f"crashed: {type(error).__name__}: {error}"
-                write_json(report_path, agent.report.as_dict())
-                raise
-    finally:
-        if transport is not None:
-            transport.close()
-        trace.close()
-        if ros2 is not None:
-            ros2.close()
-        if driver is not None:
-            driver.close()
-    write_json(report_path, report.as_dict())
-    return report
+        return cls(options, opened, agent, options.results / f"agent-{index}.json")
+
+    def run(self) -> None:
+        """Run the robot until it is done; what it gathered is kept, saying why it stopped, if it fails."""
+        path = self.report_path
+        try:
+            self.agent.run(on_progress=lambda report: write_json(path, report.as_dict()))
+        except Exception as error:
+            self.agent.report.stop_reason = f"crashed: {type(error).__name__}: {error}"
+            write_json(path, self.agent.report.as_dict())
+            raise
+
+    def run_catching(self) -> None:
+        """:meth:`run`, in a thread of its own: a failure is kept for the main thread to raise."""
+        try:
+            self.run()
+        except Exception as error:
+            self.failure = error
 
 
 def simulated_body(

@@ -31,6 +31,7 @@ from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from typing import Any, ClassVar, Generic, TypeVar
 
+from mrmp.core.errors import InputError, Problem
 from mrmp.live.transport import Transport
 
 LOOPBACK = "127.0.0.1"
@@ -156,6 +157,8 @@ class TransportEntry(ABC, Generic[OptionsT]):
     """
 
     name: ClassVar[str]
+    hosts_several: ClassVar[bool] = False
+    """Whether one ``mrmp agent`` can host several robots over it, each with a transport of its own (:meth:`hosting`)."""
     """The ``--transport`` value that selects this transport."""
 
     summary: ClassVar[str]
@@ -193,6 +196,22 @@ class TransportEntry(ABC, Generic[OptionsT]):
     def unavailable(self) -> str | None:
         """Why this transport cannot be used here and how to fix it, or None when it can."""
         return None
+
+    def hosting(self, values: Mapping[str, Any], robots: Sequence[str]) -> list[Mapping[str, Any]]:
+        """The option values (as :meth:`parse` reads them) of each of several ``robots`` one ``mrmp agent``
+        hosts, each with a transport of its own, from the values its command line gave.
+
+        Raises
+        ------
+        InputError
+            By default: this transport carries one robot per process.
+        """
+        raise InputError(Problem("--robot", f"one robot per process over {self.name}"))
+
+    def hosting_arguments(self, layout: FleetLayout, indices: Sequence[int]) -> list[str]:
+        """The ``mrmp agent`` arguments of one process hosting robots ``indices`` of a laid-out fleet (:meth:`hosting`
+        reads them back)."""
+        raise InputError(Problem("--robots-per-process", f"one robot per process over {self.name}"))
 
 
 class TransportLayer(ABC, Generic[OptionsT]):

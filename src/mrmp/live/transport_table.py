@@ -113,6 +113,33 @@ class UdpEntry(TransportEntry[UdpOptions]):
         peers = [f"--peer={ids[other]}={_text(address)}" for other, address in options.peers.items()]
         return [f"--bind={_text(options.bind)}", *peers]
 
+    hosts_several = True
+
+    def hosting(self, values: Mapping[str, Any], robots: Sequence[str]) -> list[Mapping[str, Any]]:
+        """Each hosted robot binds the address its own ``--peer`` gives and sends to the others'.
+
+        >>> UdpEntry().hosting({"peer": ["A=127.0.0.1:9001", "B=127.0.0.1:9002"]}, ["B", "A"])
+        [{'peer': ['A=127.0.0.1:9001'], 'bind': '127.0.0.1:9002'}, {'peer': ['B=127.0.0.1:9002'], 'bind': '127.0.0.1:9001'}]
+        """
+        entries = [str(item) for item in values.get("peer") or ()]
+        addresses = {name: address for name, _, address in (item.partition("=") for item in entries)}
+        hosted: list[Mapping[str, Any]] = []
+        for robot in robots:
+            if robot not in addresses:
+                reason = f"no address for {robot}: each robot of a process that hosts several binds its own --peer address"
+                raise InputError(Problem("--peer", reason))
+            others = [item for item in entries if item.partition("=")[0] != robot]
+            hosted.append({**values, "peer": others, "bind": addresses[robot]})
+        return hosted
+
+    def hosting_arguments(self, layout: FleetLayout, indices: Sequence[int]) -> list[str]:
+        """Every robot's address as a ``--peer``, the hosted ones' included.
+
+        >>> UdpEntry().hosting_arguments(FleetLayout(("A", "B"), (9001, 9002), 9003, "mrmp/7"), [1])
+        ['--peer=A=127.0.0.1:9001', '--peer=B=127.0.0.1:9002']
+        """
+        return [f"--peer={robot}={layout.host}:{port}" for robot, port in zip(layout.ids, layout.ports, strict=True)]
+
 
 # -- UDP multicast ------------------------------------------------------------------------------
 
@@ -160,6 +187,15 @@ class MulticastEntry(TransportEntry[MulticastOptions]):
 
     def arguments(self, options: MulticastOptions, ids: Sequence[str]) -> list[str]:
         return [f"--group={_text(options.group)}", f"--interface={options.interface}"]
+
+    hosts_several = True
+
+    def hosting(self, values: Mapping[str, Any], robots: Sequence[str]) -> list[Mapping[str, Any]]:
+        """Every hosted robot joins the group with a socket of its own."""
+        return [values for _ in robots]
+
+    def hosting_arguments(self, layout: FleetLayout, indices: Sequence[int]) -> list[str]:
+        return self.arguments(self.fleet_options(layout, indices[0]), layout.ids)
 
 
 # -- Zenoh --------------------------------------------------------------------------------------
@@ -384,6 +420,18 @@ class TransportTable:
             For an unknown transport, or option values its entry cannot use.
         """
         return TransportSpec(name, self.entry(name).parse(values, ids, index))
+
+    def hosted(self, name: str, values: Mapping[str, Any], ids: Sequence[str], robots: Sequence[str]) -> list[TransportSpec]:
+        """The transport ``name`` of each of several ``robots`` one ``mrmp agent`` hosts (one: as :meth:`parse`).
+
+        Raises
+        ------
+        InputError
+            For a transport that carries one robot per process, or option values its entry cannot use.
+        """
+        entry = self.entry(name)
+        hosted = [values] if len(robots) == 1 else entry.hosting(values, robots)
+        return [TransportSpec(name, entry.parse(own, ids, ids.index(robot))) for robot, own in zip(robots, hosted, strict=True)]
 
     def fleet_spec(self, name: str, layout: FleetLayout, index: int) -> TransportSpec:
         """The transport ``name`` as robot ``index`` of a laid-out fleet uses it."""

@@ -190,3 +190,35 @@ def test_a_key_file_shorter_than_16_bytes_is_refused(tmp_path):
     completed = mrmp("agent", "--scenario", EXAMPLES / "thesis-swap.yaml", "--robot", "A", "--bind", "0.0.0.0:17452",
                      "--peer", "B=127.0.0.1:17453", "--key-file", key, environment=without_key())  # fmt: skip
     assert_refused(completed, str(key), "a fleet key needs at least 16 bytes, this one has 3")
+
+
+def test_an_agent_hosting_several_robots_needs_a_transport_that_gives_each_its_own_socket():
+    completed = mrmp("agent", "--scenario", EXAMPLES / "thesis-swap.yaml", "--robot", "A", "--robot", "B", "--transport",
+                     "zenoh", "--listen=tcp/127.0.0.1:7447", environment=without_key())  # fmt: skip
+    assert_refused(completed, "--robot", "one robot per process over zenoh")
+
+
+def test_an_agent_hosting_several_robots_over_udp_needs_each_ones_address():
+    completed = mrmp("agent", "--scenario", EXAMPLES / "thesis-swap.yaml", "--robot", "A", "--robot", "B",
+                     "--peer", "B=127.0.0.1:17460", environment=without_key())  # fmt: skip
+    assert_refused(completed, "--peer", "no address for A")
+
+
+def test_an_agent_names_each_robot_once():
+    completed = mrmp("agent", "--scenario", EXAMPLES / "thesis-swap.yaml", "--robot", "A", "--robot", "A",
+                     environment=without_key())  # fmt: skip
+    assert_refused(completed, "--robot", "names a robot twice")
+
+
+@pytest.mark.parametrize(
+    ("arguments", "reason"),
+    [
+        (["--robots-per-process", "2"], "add --live"),
+        (["--live", "--robots-per-process", "0"], "must be 1 to 256, got 0"),
+        (["--live", "--robots-per-process", "2", "--virtual-clock"], "add --live (not --virtual-clock)"),
+        (["--live", "--robots-per-process", "2", "--transport", "zenoh"], "one robot per process over zenoh"),
+        (["--live", "--robots-per-process", "2", "--kill", "A@1"], "with --kill"),
+    ],
+)
+def test_robots_per_process_is_refused_where_it_cannot_be_honoured(arguments, reason):
+    assert_refused(mrmp("run", EXAMPLES / "thesis-swap.yaml", *arguments), "--robots-per-process", reason)
