@@ -705,7 +705,7 @@ def _validate_live(scenario: Scenario, request: RunRequest) -> None:
     if request.virtual_clock:
         _validate_virtual_clock(scenario, request)
     elif len(scenario.robots) > MAX_LIVE_ROBOTS:
-        reason = f"a live run starts one process per robot, at most {MAX_LIVE_ROBOTS}; this scenario has {len(scenario.robots)}"
+        reason = f"a live run runs at most {MAX_LIVE_ROBOTS} robots on this machine; this scenario has {len(scenario.robots)}"
         raise InputError(Problem("--live", reason))
     live_faults(scenario, request.time_scale, request.delay_ms)
     parse_kills(request.kill)

@@ -15,7 +15,7 @@ bound                        value           what it bounds
 ``MAX_YAML_DEPTH``           32              nesting of lists and mappings in a YAML file
 ``MAX_GRID_CELLS``           4,194,304       cells of a map (width x height; 2048 x 2048)
 ``MAX_ROBOTS``               10,000          robots of a scenario (and of a benchmark run)
-``MAX_LIVE_ROBOTS``          256             robots of a ``--live`` run (one process each, on one machine)
+``MAX_LIVE_ROBOTS``          256             robots of a ``--live`` run (one process each, or K each, on one machine)
 ``MAX_VIRTUAL_ROBOTS``       2,000           robots of a ``--live --virtual-clock`` run (one process, about 6 MB each)
 ``MAX_RADIUS``               64              ``policy.radius`` (cells)
 ``MAX_DELAY_TICKS``          1,000           a simulated message delay (``network.delay``, ``--delay``)

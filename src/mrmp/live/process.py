@@ -32,6 +32,7 @@ from mrmp.live.agent import Agent, AgentReport, AgentTiming
 from mrmp.live.body import Body, OccupancyRecorder, OdometryLineBody, SimulatedBody
 from mrmp.live.causal_agent import CausalAgent
 from mrmp.live.diff_drive import body_geometry
+from mrmp.live.host_loop import Hosted, Selectable, run_hosted
 from mrmp.live.pibt_agent import PibtAgent
 from mrmp.live.referee import IntervalReferee
 from mrmp.live.ros2_driver import Ros2Driver, odometry_topic
@@ -266,10 +267,12 @@ def run_agents(scenario: Scenario, robots: Sequence[AgentOptions]) -> list[Agent
     :func:`run_agent` does.
 
     Each hosted robot has what a robot process has: its own transport (its own
-    socket), envelope, body, driver and threads; none reads another's state,
-    and they talk only through the network, as robots in processes of their
-    own do. One robot runs in this thread; several run one thread each. A stop
-    signal, or the end of the process that started this one, stops them all.
+    socket), envelope, body and driver; none reads another's state, and they
+    talk only through the network, as robots in processes of their own do. One
+    robot runs as a robot process does (its receiving and client threads beside
+    its main loop); several run in this thread, their main loops interleaved
+    on the real clock (:func:`~mrmp.live.host_loop.run_hosted`). A stop signal,
+    or the end of the process that started this one, stops them all.
     """
     with contextlib.ExitStack() as resources:
         hosted = [_HostedRobot.open(scenario, options, resources) for options in robots]
@@ -283,23 +286,16 @@ def run_agents(scenario: Scenario, robots: Sequence[AgentOptions]) -> list[Agent
         for robot in hosted:
             if isinstance(robot.opened, ConnectedTransport):
                 _wait_for_peers(robot.opened, len(scenario.robots) - 1, robot.agent.stop_requested)
-        if len(hosted) == 1:
-            with profiled(hosted[0].options.results / f"profile-{hosted[0].options.index}.prof"):
-                hosted[0].run()
-        else:
-            threads = [threading.Thread(target=robot.run_catching, name=f"robot-{robot.options.index}") for robot in hosted]
-            for thread in threads:
-                thread.start()
-            for thread in threads:
-                thread.join()
-            for robot in hosted:
-                if robot.failure is not None:
-                    raise robot.failure
-    reports = []
-    for robot in hosted:
-        write_json(robot.report_path, robot.agent.report.as_dict())
-        reports.append(robot.agent.report)
-    return reports
+        try:
+            with profiled(robots[0].results / f"profile-{robots[0].index}.prof"):
+                if len(hosted) == 1:
+                    hosted[0].run()
+                else:
+                    run_hosted([robot.in_host_loop() for robot in hosted])
+        finally:
+            for robot in hosted:  # every report on disk, whatever ended the run
+                write_json(robot.report_path, robot.agent.report.as_dict())
+    return [robot.agent.report for robot in hosted]
 
 
 @dataclass
@@ -311,7 +307,6 @@ class _HostedRobot:
     """Its transport as opened (before faults are injected)."""
     agent: Agent | CausalAgent | PibtAgent
     report_path: Path
-    failure: Exception | None = None
 
     @classmethod
     def open(cls, scenario: Scenario, options: AgentOptions, resources: contextlib.ExitStack) -> _HostedRobot:
@@ -360,12 +355,13 @@ class _HostedRobot:
             write_json(path, self.agent.report.as_dict())
             raise
 
-    def run_catching(self) -> None:
-        """:meth:`run`, in a thread of its own: a failure is kept for the main thread to raise."""
-        try:
-            self.run()
-        except Exception as error:
-            self.failure = error
+    def in_host_loop(self) -> Hosted:
+        """The robot as :func:`~mrmp.live.host_loop.run_hosted` runs it: its socket watched, its report written as
+        it goes."""
+        if not isinstance(self.opened, Selectable):
+            raise InputError(Problem("--robot", "several robots to a process need transports with a socket each"))
+        path = self.report_path
+        return Hosted(self.agent, self.opened, on_progress=lambda report: write_json(path, report.as_dict()))
 
 
 def simulated_body(

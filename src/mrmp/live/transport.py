@@ -168,6 +168,10 @@ class _UdpSocket:
             return None
         return None if self._closed else data
 
+    def fileno(self) -> int:
+        """The socket's file descriptor (a selector can watch it: :mod:`mrmp.live.host_loop`)."""
+        return self._socket.fileno()
+
     def close(self) -> None:
         """Close the socket, waking a ``receive`` blocked in another thread; ``receive`` returns None from now on."""
         self._closed = True
