@@ -267,10 +267,14 @@ class AgentReport:
     turns: int = 0
     steps: int = 0
     messages_sent: int = 0
+    """Messages sent, counted per recipient (a message to every peer counts once per peer): the datagrams a
+    unicast transport (UDP, Zenoh) puts on the wire, and the figure of "messages per move"."""
     sent_by_kind: dict[str, int] = field(default_factory=dict)
     """Messages sent (per recipient) by message type (``StateMessage``, ``ClaimMessage``...)."""
     bytes_sent: int = 0
     datagrams_sent: int = 0
+    """Sends handed to the transport: a message to every peer counts once (one datagram on the wire over
+    multicast, one per peer over unicast), a message to named peers once per peer."""
     messages_received: int = 0
     rejected: dict[str, int] = field(default_factory=dict)
     faults: dict[str, int] = field(default_factory=dict)
