@@ -25,7 +25,7 @@ import os
 import tempfile
 from pathlib import Path
 
-from live_virtual import case_scenario, simulated_seconds
+from live_virtual import case_scenario, fleet_parser, simulated_seconds
 from mrmp.core.result import RunResult
 from mrmp.live.launcher import LiveOptions, run_live
 from mrmp.live.transport import LiveFaults
@@ -77,14 +77,8 @@ def row(case: str, arguments: argparse.Namespace) -> None:
 
 
 def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--cases", default="random-64-64-10:100")
+    parser = fleet_parser(__doc__.splitlines()[0], "random-64-64-10:100")
     parser.add_argument("--robots-per-process", type=int, default=25)
-    parser.add_argument("--loss", type=float, default=0.1)
-    parser.add_argument("--time-scale", type=float, default=5.0)
-    parser.add_argument("--synchronizer", choices=("clock", "local"), default="clock")
-    parser.add_argument("--body", choices=("omni", "turning"), default="omni")
-    parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--no-virtual", dest="virtual", action="store_false", help="only the live run")
     arguments = parser.parse_args()
     for case in arguments.cases.split(","):

@@ -104,16 +104,22 @@ def row(case: str, arguments: argparse.Namespace) -> None:
     )
 
 
-def main() -> int:
-    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
-    parser.add_argument("--cases", default="random-64-64-10:200,random-64-64-10:1000")
+def fleet_parser(description: str, cases: str) -> argparse.ArgumentParser:
+    """The options of a live ``pibt`` fleet's bench: its cases, loss, time scale, synchronizer, body and seed."""
+    parser = argparse.ArgumentParser(description=description)
+    parser.add_argument("--cases", default=cases)
     parser.add_argument("--loss", type=float, default=0.1)
     parser.add_argument("--time-scale", type=float, default=5.0)
     parser.add_argument("--synchronizer", choices=("clock", "local"), default="clock")
     parser.add_argument("--body", choices=("omni", "turning"), default="omni")
+    parser.add_argument("--seed", type=int, default=0)
+    return parser
+
+
+def main() -> int:
+    parser = fleet_parser(__doc__.splitlines()[0], "random-64-64-10:200,random-64-64-10:1000")
     parser.add_argument("--turn-us", type=float, default=ProcessingCosts().turn * 1e6, help="processor time per turn")
     parser.add_argument("--datagram-us", type=float, default=ProcessingCosts().datagram * 1e6, help="per datagram")
-    parser.add_argument("--seed", type=int, default=0)
     arguments = parser.parse_args()
     for case in arguments.cases.split(","):
         row(case, arguments)
