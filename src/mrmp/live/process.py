@@ -328,8 +328,10 @@ class _HostedRobot:
             resources.callback(ros2.close)
             sink = _both(trace.write, ros2.occupancy)
         opened = options.transport.open(index, len(scenario.robots))
-        resources.callback(opened.close)
+        resources.callback(opened.close)  # closing is idempotent: the fault injector closes it too
         transport = FAULTS.wrap(opened, options.faults, seed=derive_seed(options.seed, Stream.LIVE_FAULTS, index))
+        if transport is not opened:
+            resources.callback(transport.close)  # its thread of late datagrams ends, then the socket closes
         body: Body
         if options.drive == "ros2":
             driver = Ros2Driver(spec.id, spec.start, spec.heading, domain=options.drive_domain, wheel_base=1.0)
