@@ -712,6 +712,9 @@ def _validate_live(scenario: Scenario, request: RunRequest) -> None:
     if not 1 <= request.robots_per_process <= MAX_LIVE_ROBOTS:
         reason = f"must be 1 to {MAX_LIVE_ROBOTS}, got {request.robots_per_process}"
         raise InputError(Problem("--robots-per-process", reason))
+    if request.robots_per_process > 1 and (request.kill or request.planner or request.ros2):
+        reason = "hosts one robot per process with --kill (a kill ends a process), --planner or --ros2"
+        raise InputError(Problem("--robots-per-process", reason))  # before any plan is made
     _fraction(request.jitter, "--jitter")
     _fraction(request.miss_line, "--miss-line")
     if request.results is not None:

@@ -222,3 +222,8 @@ def test_an_agent_names_each_robot_once():
 )
 def test_robots_per_process_is_refused_where_it_cannot_be_honoured(arguments, reason):
     assert_refused(mrmp("run", EXAMPLES / "thesis-swap.yaml", *arguments), "--robots-per-process", reason)
+
+
+def test_robots_per_process_with_a_planner_is_refused_before_any_plan_is_made():
+    completed = mrmp("run", EXAMPLES / "causal-32.yaml", "--live", "--robots-per-process", "4", "--planner", "lacam")
+    assert_refused(completed, "--robots-per-process", "--planner")
