@@ -40,7 +40,8 @@ holds up every robot that waits for it). The run
 ends when this robot and every peer have arrived (and a short linger has
 passed so that late requests are still answered, at least a fleet heartbeat,
 so that a far peer that has left its goal again is heard of; the robot then
-sends its state to every peer), when every peer that has not arrived has been
+sends every peer its state, or what its policy's driver sends instead: a live
+``pibt`` robot its farewell), when every peer that has not arrived has been
 silent for ``give_up_after`` seconds, on timeout, or on a stop request.
 """
 
