@@ -362,6 +362,8 @@ class LiveDriver:
         self.random = stream_random(seed, Stream.SCHEDULE, index)
         self.report = AgentReport(spec.id, index, spec.start, spec.goal)
         self.stop_requested = threading.Event()
+        self.running = False
+        """Whether the wait for the fleet is over and the run begun (:meth:`main_turn`)."""
         self._inbox = Mailbox()
         self._receiving = threading.Event()
         self._lock = threading.Lock()
@@ -671,6 +673,19 @@ class LiveDriver:
             if wake is None:
                 return
             self._sleep(wake, timers=False)  # no brain timers run before the start
+
+    def main_turn(self, now: float, on_progress: Callable[[AgentReport], None] | None = None) -> float | None:
+        """One turn of the main loop of a driver run by a loop of someone else's (a virtual clock, a process hosting
+        several robots): a turn of the wait for the fleet (:meth:`begin_fleet_wait` first) and, once it is over,
+        the run begun and its first turn, then a turn of the run. When to wake next (:meth:`wake_rule`, with timers
+        once :attr:`running`), or None: the run is over."""
+        if not self.running:
+            wake = self.fleet_wait_turn(now)
+            if wake is not None:
+                return wake
+            self.running = True
+            self.begin_run(now, on_progress)
+        return self.turn(now)
 
     def begin_fleet_wait(self, now: float) -> None:
         """Start waiting for the fleet at ``now`` (:meth:`fleet_wait_turn`)."""

@@ -1,9 +1,7 @@
 """Several live robots in one thread: each with its own socket, driver, brain and body, on the real clock.
 
 :func:`run_hosted` runs the main loops of the drivers it is given as their
-robot processes would (:meth:`~mrmp.live.driver.LiveDriver.fleet_wait_turn`,
-:meth:`~mrmp.live.driver.LiveDriver.begin_run`,
-:meth:`~mrmp.live.driver.LiveDriver.turn`, and each driver's own
+robot processes would (:meth:`~mrmp.live.driver.LiveDriver.main_turn`, and each driver's own
 :meth:`~mrmp.live.driver.LiveDriver.wake_rule` for when its next turn comes),
 interleaved in one thread: a driver's turn runs when its wake time comes or,
 when its rule says a message wakes it, as soon as a datagram reaches its
@@ -55,8 +53,6 @@ class Hosted:
     driver: LiveDriver
     socket: Selectable
     on_progress: Callable[[AgentReport], None] | None = None
-    running: bool = False
-    """Past its wait for the fleet."""
     done: bool = False
     wake_at: float = 0.0
     woken_by_messages: bool = True
@@ -119,14 +115,8 @@ def _turn(robot: Hosted, now: float) -> None:
         if driver.stop_requested.is_set():
             driver.report.stop_reason = "interrupted"
             wake = None
-        elif not robot.running:
-            wake = driver.fleet_wait_turn(now)
-            if wake is None:
-                robot.running = True
-                driver.begin_run(now, robot.on_progress)
-                wake = driver.turn(now)
         else:
-            wake = driver.turn(now)
+            wake = driver.main_turn(now, robot.on_progress)
     except Exception as error:  # the robot stops, saying why; the others run on
         driver.report.stop_reason = f"crashed: {type(error).__name__}: {error}"
         robot.failure, wake = error, None
@@ -134,7 +124,7 @@ def _turn(robot: Hosted, now: float) -> None:
         robot.done = True
         driver.fill_report(now)
         return
-    robot.wake_at, robot.woken_by_messages = driver.wake_rule(now, wake, timers=robot.running)
+    robot.wake_at, robot.woken_by_messages = driver.wake_rule(now, wake, timers=driver.running)
 
 
 def _take_datagrams(robot: Hosted, now: float) -> None:

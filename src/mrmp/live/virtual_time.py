@@ -195,8 +195,6 @@ class _Robot:
     driver: LiveDriver
     outbox: _Outbox
     trace: TraceWriter
-    running: bool = False
-    """Past its wait for the fleet."""
     done: bool = False
     wake_at: float = 0.0
     woken_by_messages: bool = True
@@ -284,15 +282,7 @@ class _VirtualFleet:
         """One turn of the robot's main loop at the current time; its datagrams leave when its processing ends."""
         driver, report, now = robot.driver, robot.driver.report, self.now
         taken_in, sent = report.messages_received, report.datagrams_sent
-        if not robot.running:
-            wake = driver.fleet_wait_turn(now)
-            timers = False
-            if wake is None:
-                robot.running = True
-                driver.begin_run(now)
-                wake, timers = driver.turn(now), True
-        else:
-            wake, timers = driver.turn(now), True
+        wake = driver.main_turn(now)
         datagrams = report.messages_received - taken_in + report.datagrams_sent - sent
         self.turns += 1
         self.datagrams += datagrams
@@ -305,7 +295,7 @@ class _VirtualFleet:
             robot.done = True
             driver.fill_report(now)
             return
-        at, woken_by_messages = driver.wake_rule(now, wake, timers)
+        at, woken_by_messages = driver.wake_rule(now, wake, timers=driver.running)
         self._schedule(index, robot, max(at, robot.busy_until), woken_by_messages)
 
     def _schedule(self, index: int, robot: _Robot, at: float, woken_by_messages: bool) -> None:

@@ -43,6 +43,7 @@ class CountingDriver:
         self.turns, self.expect, self.fail_at = turns, expect, fail_at
         self.sent = self.taken = self.turned = 0
         self.stop_requested = threading.Event()
+        self.running = False
         self.report = AgentReport(robot="r", index=0, start=(0, 0), goal=(0, 0))
         self.client = None
 
@@ -52,11 +53,11 @@ class CountingDriver:
     def begin_fleet_wait(self, now: float) -> None:
         pass
 
-    def fleet_wait_turn(self, now: float) -> float | None:
-        return None
-
-    def begin_run(self, now: float, on_progress=None) -> None:
-        self.report.started_at = now
+    def main_turn(self, now: float, on_progress=None) -> float | None:
+        if not self.running:  # its fleet is there at once
+            self.running = True
+            self.report.started_at = now
+        return self.turn(now)
 
     def turn(self, now: float) -> float | None:
         self.turned += 1
