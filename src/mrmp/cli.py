@@ -712,9 +712,10 @@ def _validate_live(scenario: Scenario, request: RunRequest) -> None:
     if not 1 <= request.robots_per_process <= MAX_LIVE_ROBOTS:
         reason = f"must be 1 to {MAX_LIVE_ROBOTS}, got {request.robots_per_process}"
         raise InputError(Problem("--robots-per-process", reason))
-    if request.robots_per_process > 1 and (request.kill or request.planner or request.ros2):
-        reason = "hosts one robot per process with --kill (a kill ends a process), --planner or --ros2"
-        raise InputError(Problem("--robots-per-process", reason))  # before any plan is made
+    from mrmp.live.launcher import check_hosting
+
+    planned = request.planner is not None
+    check_hosting(request.robots_per_process, request.transport, bool(request.kill), planned, request.ros2)  # before any plan
     _fraction(request.jitter, "--jitter")
     _fraction(request.miss_line, "--miss-line")
     if request.results is not None:

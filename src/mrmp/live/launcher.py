@@ -175,12 +175,26 @@ def _check(options: LiveOptions, ids: list[str]) -> None:
     for robot_id in options.kill:
         if robot_id not in ids:
             raise InputError(Problem("--kill", f"no robot has the id {robot_id!r}"))
-    if options.robots_per_process > 1:
-        if options.kill or options.plan is not None or options.ros2:
-            reason = "hosts one robot per process with --kill (a kill ends a process), --planner or --ros2"
-            raise InputError(Problem("--robots-per-process", reason))
-        if not TRANSPORTS.entry(options.transport).hosts_several:
-            raise InputError(Problem("--robots-per-process", f"one robot per process over {options.transport}"))
+    check_hosting(options.robots_per_process, options.transport, bool(options.kill), options.plan is not None, options.ros2)
+
+
+def check_hosting(robots_per_process: int, transport: str, kill: bool, planned: bool, ros2: bool) -> None:
+    """Refuse several robots to a process where it cannot be honoured: with robots to kill (a kill ends a
+    process), a plan or ROS 2, or over a transport that carries one robot per process.
+
+    >>> check_hosting(4, "udp", kill=False, planned=False, ros2=False)
+    >>> check_hosting(4, "udp", kill=True, planned=False, ros2=False)  # doctest: +ELLIPSIS
+    Traceback (most recent call last):
+    ...
+    mrmp.core.errors.InputError: --robots-per-process: hosts one robot per process with --kill (a kill ends a ...
+    """
+    if robots_per_process == 1:
+        return
+    if kill or planned or ros2:
+        reason = "hosts one robot per process with --kill (a kill ends a process), --planner or --ros2"
+        raise InputError(Problem("--robots-per-process", reason))
+    if not TRANSPORTS.entry(transport).hosts_several:
+        raise InputError(Problem("--robots-per-process", f"one robot per process over {transport}"))
 
 
 def _write_run_files(scenario: Scenario, options: LiveOptions, ids: list[str]) -> _RunFiles:
