@@ -112,6 +112,18 @@ class KnownCells:
             self._known = known
         self._x[peer], self._y[peer], self._heard[peer], self._known[peer] = cell[0], cell[1], step, True
 
+    def can_be_within(self, peer: int, here: tuple[int, int], radius: int, step: int) -> bool:
+        """Whether ``peer`` (known) can stand within ``radius`` cells of ``here`` at the start of ``step``: the bound
+        of :meth:`within`, for one peer.
+
+        >>> known = KnownCells()
+        >>> known.set(3, (0, 6), 1)
+        >>> known.can_be_within(3, (0, 0), 2, 4), known.can_be_within(3, (0, 0), 2, 5)
+        (False, True)
+        """
+        distance = abs(int(self._x[peer]) - here[0]) + abs(int(self._y[peer]) - here[1])
+        return distance <= radius + max(0, step - int(self._heard[peer]))
+
     def within(self, here: tuple[int, int], radius: int, step: int) -> list[int]:
         """The peers that can stand within ``radius`` cells of ``here`` at the start of ``step``, in index order."""
         distance = np.abs(self._x - here[0]) + np.abs(self._y - here[1])
@@ -203,9 +215,7 @@ class LivePibtRobot(ReliablePibtRobot):
 
     def _may_be_within(self, peer: int, radius: int) -> bool:
         """Whether ``peer`` can stand within ``radius`` cells at the start of this step (as :meth:`possibly_within`)."""
-        cell, heard = self.known[peer]
-        (x, y), (px, py) = self.flat.cells[self.present], self.flat.cells[cell]
-        return abs(px - x) + abs(py - y) <= radius + max(0, self.step - heard)
+        return self._known_cells.can_be_within(peer, self.flat.cells[self.present], radius, self.step)
 
     def _fresh_news(self) -> tuple[News, ...]:
         """What this step's beacon tells of others: where the peers heard of since the last step's start stood.
