@@ -268,7 +268,7 @@ class _Search:
     """One LaCAM (or LaCAM*) search: the high-level stack of configurations and its lazy low-level queues."""
 
     def __init__(
-        self, instance: MapfProblem, distances: list[list[float]], seed: int | None, swap: bool, anytime: bool
+        self, instance: MapfProblem, distances: Sequence[Sequence[float]], seed: int | None, swap: bool, anytime: bool
     ) -> None:
         self.flat = flat_grid(instance.grid)
         self.count = len(instance)
@@ -290,7 +290,7 @@ class _Search:
 
     # -- what a configuration is (a cell per robot; :class:`_TurningSearch`: a state) ---------
 
-    def _generator(self, neighbours: Sequence[tuple[int, ...]], distances: list[list[float]], swap: bool) -> PIBT:
+    def _generator(self, neighbours: Sequence[tuple[int, ...]], distances: Sequence[Sequence[float]], swap: bool) -> PIBT:
         return PIBT(neighbours, distances, list(self.goal_config), swap=swap, rng=self.rng, rotations=False)
 
     def _candidates(self, flat: FlatGrid) -> list[tuple[int, ...]]:
@@ -456,7 +456,7 @@ class _Search:
 class _TurningSearch(_Search):
     """LaCAM for ``turning`` bodies: a configuration holds every robot's state ``4 * cell + heading - 1``."""
 
-    def _generator(self, neighbours: Sequence[tuple[int, ...]], distances: list[list[float]], swap: bool) -> PIBT:
+    def _generator(self, neighbours: Sequence[tuple[int, ...]], distances: Sequence[Sequence[float]], swap: bool) -> PIBT:
         return PIBT(
             neighbours, distances, list(self.goal_config), rng=self.rng, rotations=False, turning_y_size=self.flat.y_size
         )

@@ -112,6 +112,7 @@ def pibt_plan(
     count = len(instance)
     cells = [flat.index(cell) for cell in instance.starts]
     goal_cells = [flat.index(cell) for cell in instance.goals]
+    distances: list[Sequence[float]]
     if turning:
         distances = [heading_distances(grid, goal, 1.0, both_ways=True) for goal in instance.goals]
         headings = [int(heading) for heading in instance.headings]

@@ -49,7 +49,7 @@ from __future__ import annotations
 
 import random
 from collections import Counter
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 
 from mrmp.core.body import BodyModel
 from mrmp.core.cell import Cell
@@ -107,7 +107,7 @@ class CausalTransitions:
         self.goal = goal
         self._distances = self._table(goal)
 
-    def _table(self, goal: Cell) -> list[float]:
+    def _table(self, goal: Cell) -> Sequence[float]:
         """The distances to ``goal`` that rank the candidates: by cell, or by (cell, heading) for a turning body."""
         if self.turns_in_place:
             return self.flat.heading_distances(self.flat.index(goal), 1.0, both_ways=True)

@@ -89,6 +89,7 @@ from __future__ import annotations
 
 import random
 from collections import Counter
+from collections.abc import Sequence
 
 from mrmp.core.heading import Heading
 from mrmp.policies.pibt_rules import (
@@ -446,7 +447,6 @@ class PibtRobot:
 
     def _begin_call(self, out: list[Outgoing]) -> None:
         flat = self.flat
-        distances = flat.distances(self.goal)
         if self.turning:
             candidates = turning_candidates(
                 flat.neighbours,
@@ -470,13 +470,17 @@ class PibtRobot:
             )
         else:
             candidates = sorted_candidates(
-                flat.neighbours, self.present, distances, self._noise, self._settled if self.tie_penalties else None
+                flat.neighbours,
+                self.present,
+                flat.distances(self.goal),
+                self._noise,
+                self._settled if self.tie_penalties else None,
             )
         if self.turning:
             self._ahead_cell = ahead_cell(flat.neighbours, self.present, int(self.heading), flat.y_size)
         self._pulled = None
         if self.swap:
-            self._pulled = self._swap_partner(candidates, distances)
+            self._pulled = self._swap_partner(candidates, flat.distances(self.goal))
             if self._pulled is not None:
                 candidates.reverse()
         self._candidates = candidates
@@ -582,7 +586,7 @@ class PibtRobot:
         if taker is not None and taker != self.index and self._targets.get(taker) == self.present:
             out.append(Outgoing(StayMessage(self.index, self._seq(), self.step), (taker,)))
 
-    def _swap_partner(self, candidates: list[int], distances: list[float]) -> int | None:
+    def _swap_partner(self, candidates: list[int], distances: Sequence[float]) -> int | None:
         """``is_swap_required_and_possible`` on what the robot heard: the robot to pull, or None."""
         flat = self.flat
         neighbours, occupants, targets, goals = flat.neighbours, self._occupants, self._targets, self._goals

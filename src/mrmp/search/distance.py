@@ -330,6 +330,15 @@ class DistanceTable:
         """
         return self._dist[: self._flat.size].tolist()
 
+    def as_array(self) -> array[float]:
+        """The distances as an ``array('d')`` indexed by flat cell: :meth:`as_list` in 8 bytes a cell.
+
+        >>> from mrmp.core.grid import Grid
+        >>> distance_table(Grid.from_rows([".#."]), (0, 0)).as_array()
+        array('d', [0.0, inf, inf])
+        """
+        return self._dist[: self._flat.size]
+
     def path(self, cell: Cell) -> tuple[Cell, ...]:
         """A cheapest path from ``cell`` to the goal, following :meth:`next_cells`.
 

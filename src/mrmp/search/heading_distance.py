@@ -7,10 +7,20 @@ from every state ``(cell, heading)`` — the heading being the direction the rob
 faces on that cell — to the goal cell in any heading, where a move from ``c`` in
 direction ``d`` while facing ``h`` costs ``right_turns(h, d) * turn_cost`` plus the
 entry cost of the cell entered (the same model as heading-aware A*,
-:mod:`mrmp.search.best_first_engine`). It is Dijkstra's algorithm (Dijkstra, 1959)
-run backwards from the goal's four states over the state graph.
+:mod:`mrmp.search.best_first_engine`).
 
-The table is a flat list: the state of flat cell ``i`` (``x * y_size + y``) facing
+The search runs backwards from the goal's four states over the state graph,
+wavefront by wavefront, as a label-correcting shortest-path search (Bellman 1958,
+"On a routing problem"; Moore 1959, "The shortest path through a maze"): the states
+improved in one wave offer their cost to their predecessors in the next, until no
+state improves. With non-negative costs this gives Dijkstra's distances (Dijkstra
+1959, "A note on two problems in connexion with graphs"), each candidate cost summed
+in the same order. As in :mod:`mrmp.search.distance`, a small wave is expanded in a
+plain Python loop and a large one with a few numpy operations over the whole wave:
+the 280,000 states of a 500 x 140 warehouse map take tens of milliseconds, where a
+heap-based search in Python took a third of a second.
+
+The table is a flat ``array('d')``: the state of flat cell ``i`` (``x * y_size + y``) facing
 heading ``h`` (1-4) is entry ``4 * i + h - 1``; blocked and unreachable states are
 ``inf``. Policy ``pibt`` with ``heading_aware`` ranks its candidate cells with it
 (:func:`mrmp.policies.pibt_rules.heading_candidates`).
@@ -44,7 +54,12 @@ Turning either way, facing WEST costs two quarter turns, facing NORTH one:
 
 from __future__ import annotations
 
-import heapq
+import threading
+from array import array
+from collections import OrderedDict
+
+import numpy as np
+import numpy.typing as npt
 
 from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
@@ -56,10 +71,69 @@ _TURNS = [[right_turns(facing, moving) for moving in HEADINGS] for facing in HEA
 """``_TURNS[h - 1][d - 1]``: right turns from facing ``h`` to facing ``d``."""
 _QUARTERS = [[quarter_turns(facing, moving) for moving in HEADINGS] for facing in HEADINGS]
 """``_QUARTERS[h - 1][d - 1]``: quarter turns either way from facing ``h`` to facing ``d``."""
+_VECTOR_THRESHOLD = 32
+"""Waves of more states than this are expanded with numpy; smaller ones in Python."""
+_GRID_CACHE_SIZE = 8
+"""How many grids keep their state graph cached."""
+
+IndexArray = npt.NDArray[np.intp]
 
 
-def heading_distances(grid: Grid, goal: Cell, turn_cost: float, both_ways: bool = False) -> list[float]:
+class _StateGraph:
+    """What every reverse search on one grid needs, built once (module docstring).
+
+    State ``s = 4 * i + d`` is flat cell ``i`` entered moving in direction ``d``
+    (0 to 3: NORTH, EAST, SOUTH, WEST). Its predecessors are the four states of the
+    cell behind it, ``behind[s]``, or none when that cell is blocked or off the
+    grid (``behind[s] == size``, the padding cell). ``costs[i]`` is the entry cost
+    of cell ``i``.
+    """
+
+    def __init__(self, grid: Grid) -> None:
+        x_size, y_size = grid.x_size, grid.y_size
+        size = x_size * y_size
+        self.size = size
+        self.costs = [float(grid.cost((x, y))) for x in range(x_size) for y in range(y_size)] + [0.0]
+        behind = [size] * (4 * size + 4)
+        for x in range(x_size):
+            for y in range(y_size):
+                if not grid.is_free((x, y)):
+                    continue
+                state = 4 * (x * y_size + y)
+                for direction, heading in enumerate(HEADINGS):
+                    dx, dy = heading.delta
+                    before = (x - dx, y - dy)
+                    if grid.is_free(before):
+                        behind[state + direction] = before[0] * y_size + before[1]
+        self.behind = behind
+        self.behind_array: IndexArray = np.array(behind, dtype=np.intp)
+        self.cost_array = np.array(self.costs)
+        self.ranks: IndexArray = np.arange(16 * size + 16, dtype=np.intp)
+
+
+_GRAPHS: OrderedDict[Grid, _StateGraph] = OrderedDict()
+_GRAPHS_LOCK = threading.Lock()
+
+
+def _state_graph(grid: Grid) -> _StateGraph:
+    """The state graph of ``grid``, kept for the last few grids (grids are immutable)."""
+    with _GRAPHS_LOCK:
+        graph = _GRAPHS.get(grid)
+        if graph is not None:
+            _GRAPHS.move_to_end(grid)
+            return graph
+    graph = _StateGraph(grid)
+    with _GRAPHS_LOCK:
+        _GRAPHS[grid] = graph
+        while len(_GRAPHS) > _GRID_CACHE_SIZE:
+            _GRAPHS.popitem(last=False)
+    return graph
+
+
+def heading_distances(grid: Grid, goal: Cell, turn_cost: float, both_ways: bool = False) -> array[float]:
     """The least cost from every ``(cell, heading)`` state of ``grid`` to ``goal`` (module docstring).
+
+    The table is an ``array('d')``: 8 bytes a state, indexed as a list.
 
     Parameters
     ----------
@@ -81,33 +155,72 @@ def heading_distances(grid: Grid, goal: Cell, turn_cost: float, both_ways: bool 
         raise ValueError(f"goal {goal} is not a free cell of the grid")
     if turn_cost < 0:
         raise ValueError(f"turn_cost must not be negative, got {turn_cost}")
-    y_size = grid.y_size
-    inf = float("inf")
-    table = [inf] * (4 * grid.x_size * y_size)
-    goal_index = goal[0] * y_size + goal[1]
-    queue: list[tuple[float, int]] = []
-    for heading in range(4):
-        table[4 * goal_index + heading] = 0.0
-        queue.append((0.0, 4 * goal_index + heading))
-    deltas = [heading.delta for heading in HEADINGS]
+    graph = _state_graph(grid)
     counts = _QUARTERS if both_ways else _TURNS
     turns = [[counts[facing][moving] * turn_cost for moving in range(4)] for facing in range(4)]
-    while queue:
-        cost, state = heapq.heappop(queue)
-        if cost > table[state]:
-            continue
-        cell_index, moving = divmod(state, 4)
-        x, y = divmod(cell_index, y_size)
-        # the robot entered (x, y) moving in direction `moving`, from the cell behind it
-        dx, dy = deltas[moving]
-        before = (x - dx, y - dy)
-        if not grid.is_free(before):
-            continue
-        entered = cost + grid.cost((x, y))
-        before_index = 4 * (before[0] * y_size + before[1])
-        for facing in range(4):
-            candidate = entered + turns[facing][moving]
-            if candidate < table[before_index + facing]:
-                table[before_index + facing] = candidate
-                heapq.heappush(queue, (candidate, before_index + facing))
-    return table
+    table = _search(graph, goal[0] * grid.y_size + goal[1], turns)
+    return table[: 4 * graph.size]
+
+
+def _search(graph: _StateGraph, goal: int, turns: list[list[float]]) -> array[float]:
+    """The wavefront label-correcting search of the module docstring, from flat cell ``goal``.
+
+    ``turns[facing][moving]`` is the cost of the turns before a move. The padding
+    cell's states hold ``-inf``, so no offer improves them and they are never queued.
+    """
+    size, behind, costs = graph.size, graph.behind, graph.costs
+    table = array("d", [float("inf")]) * (4 * size) + array("d", [float("-inf")]) * 4
+    view = np.frombuffer(table, dtype=np.float64)
+    by_moving = [[turns[facing][moving] for facing in range(4)] for moving in range(4)]
+    by_moving_array = np.array(by_moving)
+    facings = np.arange(4, dtype=np.intp)
+    queued = bytearray(4 * size + 4)  # 1 for a state already in the wave being built
+    owner: IndexArray | None = None
+    frontier: list[int] | IndexArray = [4 * goal + heading for heading in range(4)]
+    for state in frontier:
+        table[state] = 0.0
+    while True:
+        if isinstance(frontier, list):
+            wave: list[int] = []
+            append = wave.append
+            for state in frontier:
+                before = 4 * behind[state]
+                entered = table[state] + costs[state >> 2]
+                for facing, turn in enumerate(by_moving[state & 3]):
+                    offer = entered + turn
+                    if offer < table[before + facing]:
+                        table[before + facing] = offer
+                        if not queued[before + facing]:
+                            queued[before + facing] = 1
+                            append(before + facing)
+            for state in wave:
+                queued[state] = 0
+            if not wave:
+                return table
+            frontier = wave if len(wave) <= _VECTOR_THRESHOLD else np.array(wave, dtype=np.intp)
+        else:
+            entered = view[frontier] + graph.cost_array[frontier >> 2]
+            candidates = (4 * graph.behind_array[frontier])[:, None] + facings
+            offers = entered[:, None] + by_moving_array[frontier & 3]
+            candidates, offers = candidates.ravel(), offers.ravel()
+            better = offers < view[candidates]
+            candidates, offers = candidates[better], offers[better]
+            if not candidates.size:
+                return table
+            np.minimum.at(view, candidates, offers)
+            if owner is None:
+                owner = np.empty(4 * size + 4, dtype=np.intp)
+            candidates = _dedupe(candidates, owner, graph.ranks)
+            frontier = candidates if candidates.size > _VECTOR_THRESHOLD else candidates.tolist()
+
+
+def _dedupe(states: IndexArray, owner: IndexArray, ranks: IndexArray) -> IndexArray:
+    """One copy of each value of ``states``, via the ``owner`` scratch array (no sort).
+
+    Each position writes its rank into ``owner[state]``; exactly one write per
+    state survives (NumPy does not say which), and only that position matches.
+    """
+    order = ranks[: states.size]
+    owner[states] = order
+    unique: IndexArray = states[owner[states] == order]
+    return unique

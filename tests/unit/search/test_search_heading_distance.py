@@ -11,6 +11,7 @@ from mrmp.core.heading import HEADINGS, Heading
 from mrmp.core.scenario import Timing
 from mrmp.search import astar
 from mrmp.search.graph import path_cost
+from mrmp.search import heading_distance
 from mrmp.search.heading_distance import heading_distances
 
 
@@ -78,8 +79,56 @@ def test_blocked_cells_are_unreachable_and_bad_arguments_are_refused():
     grid = Grid.from_rows([".@.", "..."])
     table = heading_distances(grid, (0, 0), 0.5)
     blocked = 4 * (1 * 3 + 1)  # (1, 1) is the '@' (rows are drawn north up)
-    assert table[blocked : blocked + 4] == [float("inf")] * 4
+    assert list(table[blocked : blocked + 4]) == [float("inf")] * 4
     with pytest.raises(ValueError, match="not a free cell"):
         heading_distances(grid, (1, 1), 0.5)
     with pytest.raises(ValueError, match="must not be negative"):
         heading_distances(grid, (0, 0), -1.0)
+
+
+def dijkstra_table(grid: Grid, goal, turn_cost: float, both_ways: bool) -> list[float]:
+    """Dijkstra over the states, forwards from each state's moves, written apart from the module's search."""
+    import heapq
+
+    from mrmp.core.heading import quarter_turns, right_turns
+
+    count = right_turns if not both_ways else quarter_turns
+    states = [(cell, heading) for cell in grid.free_cells() for heading in HEADINGS]
+    cost = {goal_state: 0.0 for goal_state in states if goal_state[0] == goal}
+    queue = [(0.0, state) for state in cost]
+    incoming: dict = {}
+    for cell, facing in states:  # the moves out of (cell, facing), indexed by the state they reach
+        for moving in HEADINGS:
+            dx, dy = moving.delta
+            ahead = (cell[0] + dx, cell[1] + dy)
+            if grid.is_free(ahead):
+                step = count(facing, moving) * turn_cost + grid.cost(ahead)
+                incoming.setdefault((ahead, moving), []).append(((cell, facing), step))
+    while queue:
+        value, state = heapq.heappop(queue)
+        if value > cost[state]:
+            continue
+        for before, step in incoming.get(state, ()):
+            if value + step < cost.get(before, float("inf")):
+                cost[before] = value + step
+                heapq.heappush(queue, (value + step, before))
+    table = [float("inf")] * (4 * grid.x_size * grid.y_size)
+    for (cell, heading), value in cost.items():
+        table[4 * (cell[0] * grid.y_size + cell[1]) + int(heading) - 1] = value
+    return table
+
+
+@pytest.mark.parametrize("threshold", [0, 64, 10**9])
+@pytest.mark.parametrize("seed", range(4))
+def test_large_maps_give_dijkstras_table_whether_waves_run_in_python_or_numpy(monkeypatch, seed, threshold):
+    """Waves above the threshold are expanded with numpy, the others in Python: every split gives Dijkstra's table."""
+    monkeypatch.setattr(heading_distance, "_VECTOR_THRESHOLD", threshold)
+    rng = random.Random(seed)
+    rows = ["".join("@" if rng.random() < 0.2 else "." for _ in range(40)) for _ in range(30)]
+    plain = Grid.from_rows(rows)
+    costs = {cell: rng.choice((1.0, 1.0, 2.0, 0.5)) for cell in plain.free_cells()} if seed % 2 else {}
+    grid = Grid(plain.x_size, plain.y_size, plain.blocked_cells(), costs)
+    goal = rng.choice(grid.free_cells())
+    for turn_cost, both_ways in ((1.0, True), (0.5, False)):
+        expected = dijkstra_table(grid, goal, turn_cost, both_ways)
+        assert list(heading_distances(grid, goal, turn_cost, both_ways)) == pytest.approx(expected)
