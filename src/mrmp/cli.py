@@ -1052,7 +1052,8 @@ def bench(
     table = Table(title=f"{config.name}: {len(outcome.records)} of {outcome.total} runs recorded")
     rows = summary_rows(outcome.records)
     table.add_column("map", min_width=max((len(row.map) for row in rows), default=3))
-    for column in ("policy", "N", "runs", "success", "SoC/LB", "wall s", "timeouts", "errors"):
+    tasks = any(row.mean_tasks_finished is not None for row in rows)  # runs of LoRR problems: their score
+    for column in ("policy", "N", "runs", "success", "SoC/LB", "wall s", "timeouts", "errors", *(("tasks",) if tasks else ())):
         table.add_column(column, justify="left" if column == "policy" else "right")
     for row in rows:
         table.add_row(
@@ -1060,6 +1061,7 @@ def bench(
             f"{row.mean_soc_over_lb:.3f}" if row.mean_soc_over_lb is not None else "-",
             f"{row.mean_wall_time_s:.2f}" if row.mean_wall_time_s is not None else "-",
             str(row.timeouts), str(row.errors),
+            *((f"{row.mean_tasks_finished:.1f}" if row.mean_tasks_finished is not None else "-",) if tasks else ()),
         )  # fmt: skip
     console.print(table)
     console.print(f"results: {out / 'results.jsonl'} and {out / 'results.csv'}", markup=False)

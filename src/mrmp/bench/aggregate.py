@@ -12,6 +12,8 @@ For each group (:class:`GroupSummary`):
 * ``mean_wall_time_per_step_s`` and ``mean_messages_per_robot_move``: means
   over the finished runs (status ``done``);
 * ``mean_throughput``: goals reached per tick, mean over finished lifelong runs;
+* ``mean_tasks_finished``: tasks finished (the League of Robot Runners' score), mean over the finished runs
+  of LoRR problems;
 * ``timeouts``, ``errors`` and ``runs_with_collisions`` (referee findings).
 
 A mean over no run is None. :func:`headline_table` formats the groups as
@@ -71,6 +73,7 @@ class GroupSummary:
     mean_wall_time_per_step_s: float | None
     mean_messages_per_robot_move: float | None
     mean_throughput: float | None
+    mean_tasks_finished: float | None = None
 
     @property
     def success_rate(self) -> float:
@@ -177,6 +180,7 @@ def _summary(key: GroupKey, runs: Sequence[BenchRecord]) -> GroupSummary:
         mean_wall_time_per_step_s=mean(run.wall_time_per_step_s for run in done),
         mean_messages_per_robot_move=mean(run.messages_per_robot_move for run in done),
         mean_throughput=mean(run.throughput for run in done if run.lifelong),
+        mean_tasks_finished=mean(run.tasks_finished for run in done if run.tasks_finished is not None),
     )
 
 
@@ -283,10 +287,12 @@ _HEADLINE: tuple[tuple[str, bool, Callable[[GroupSummary], str]], ...] = (
     ("msgs/move", True, lambda summary: _number(summary.mean_messages_per_robot_move, 2)),
 )
 _THROUGHPUT = ("throughput", True, lambda summary: _number(summary.mean_throughput, 3))
+_TASKS = ("tasks", True, lambda summary: _number(summary.mean_tasks_finished, 1))
 
 
 def headline_table(summaries: Sequence[GroupSummary]) -> TextTable:
-    """The headline table: one row per configuration, a ``lifelong`` and ``throughput`` column when lifelong runs exist.
+    """The headline table: one row per configuration, a ``lifelong`` and ``throughput`` column when lifelong runs exist,
+    and a ``tasks`` column (tasks finished) when runs of LoRR problems do.
 
     Success counts every run; SoC/LB and makespan are means over the
     successful runs; ms/step (wall time per step) and msgs/move (messages per
@@ -296,6 +302,8 @@ def headline_table(summaries: Sequence[GroupSummary]) -> TextTable:
     if any(summary.key.lifelong for summary in summaries):
         columns.insert(3, ("lifelong", False, lambda summary: "yes" if summary.key.lifelong else "no"))
         columns.append(_THROUGHPUT)
+    if any(summary.mean_tasks_finished is not None for summary in summaries):
+        columns.append(_TASKS)
     return TextTable(
         columns=tuple(name for name, _, _ in columns),
         numeric=tuple(numeric for _, numeric, _ in columns),

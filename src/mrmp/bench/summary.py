@@ -26,7 +26,8 @@ class SummaryRow:
     ``success_rate`` counts every run (a timeout or an error is a failure);
     ``mean_soc_over_lb`` averages the sum of costs over the lower bound of the
     successful runs (None when none succeeded); ``mean_wall_time_s`` averages
-    the finished runs' wall time.
+    the finished runs' wall time; ``mean_tasks_finished`` the tasks finished by
+    runs of League of Robot Runners problems (None for other runs).
     """
 
     map: str
@@ -38,6 +39,7 @@ class SummaryRow:
     mean_wall_time_s: float | None
     timeouts: int
     errors: int
+    mean_tasks_finished: float | None = None
 
 
 def summary_rows(records: Iterable[Mapping[str, Any]]) -> list[SummaryRow]:
@@ -49,6 +51,7 @@ def summary_rows(records: Iterable[Mapping[str, Any]]) -> list[SummaryRow]:
     for (map_name, policy, agents), group in groups.items():
         ratios = [r["soc_over_lb"] for r in group if r.get("success") and r.get("soc_over_lb") is not None]
         walls = [r["wall_time_s"] for r in group if r.get("wall_time_s") is not None]
+        tasks = [r["tasks_finished"] for r in group if r.get("tasks_finished") is not None]
         rows.append(
             SummaryRow(
                 map=map_name,
@@ -60,6 +63,7 @@ def summary_rows(records: Iterable[Mapping[str, Any]]) -> list[SummaryRow]:
                 mean_wall_time_s=mean(walls) if walls else None,
                 timeouts=sum(1 for r in group if r.get("status") == "timeout"),
                 errors=sum(1 for r in group if r.get("status") == "error"),
+                mean_tasks_finished=mean(tasks) if tasks else None,
             )
         )
     return rows

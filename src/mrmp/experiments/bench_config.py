@@ -1,6 +1,7 @@
 """The YAML benchmark configuration of ``mrmp bench``, read strictly and expanded into runs.
 
-A configuration looks like this (``maps``, ``agents`` and ``policies`` are required)::
+A configuration looks like this (``maps`` and ``policies`` are required, and ``agents`` where a map entry
+has none)::
 
     name: standard                     # default: the file's stem
     maps:                              # MovingAI files (paths relative to this file) ...
@@ -15,6 +16,8 @@ A configuration looks like this (``maps``, ``agents`` and ``policies`` are requi
         density: 0.2                   # the family's settings (mrmp.core.map_generators)
         seeds: [0, 1]                  # one map per seed (not for warehouse: it has none)
         instances: 2                   # seeded random starts and goals per map
+      - lorr: ../../examples/lorr/maze-example_40.json   # ... or a League of Robot Runners problem:
+        agents: [20, 40]               # its first N robots (default: its teamSize), lifelong, max_ticks steps
     agents: [10, 50]                   # numbers of robots
     policies: [thesis, astar, pibt, cbs, pp, lacam]   # decentralized policies and central planners
     seeds: [0, 1]                      # each run's seed (the simulated network's; LaCAM's)
@@ -22,7 +25,7 @@ A configuration looks like this (``maps``, ``agents`` and ``policies`` are requi
       - {loss: 0.0}
       - {loss: 0.1, delay: [0, 2], duplicate: 0.0, reorder: 0.0}
     time_limit: 30                     # wall-clock seconds per run (default 60)
-    max_ticks: 500                     # optional tick limit
+    max_ticks: 500                     # optional tick limit (a LoRR problem's steps; default 5000)
     lifelong: false                    # true: new goals on arrival (decentralized policies only)
 
 The file is read with the node reader of :mod:`mrmp.io.scenario_file`, so
@@ -66,6 +69,7 @@ from mrmp.core.map_generators import GENERATORS, complete_spec, generate, larges
 from mrmp.core.scenario import NetworkFaults, _fault_problems
 from mrmp.experiments.matrix import BenchRun
 from mrmp.io._files import PathLike, file_problem, read_text
+from mrmp.io.lorr import LorrProblem, read_lorr_problem
 from mrmp.io.movingai import read_map, read_scen_entries, scen_map_problems
 from mrmp.io.scenario_file import (
     _BAD,
@@ -86,6 +90,8 @@ FILE_MAP_KEYS = ("map", "scen", "instances", "agents")
 _GENERATOR_SETTINGS = tuple(dict.fromkeys(p.name for g in GENERATORS.values() for p in g.parameters))
 GENERATED_MAP_KEYS = ("generate", "width", "height", *_GENERATOR_SETTINGS, "seeds", "instances", "agents")
 """Keys allowed in a ``maps`` entry describing generated maps."""
+LORR_MAP_KEYS = ("lorr", "agents")
+"""Keys allowed in a ``maps`` entry naming a League of Robot Runners problem."""
 DEFAULT_TIME_LIMIT_S = 60.0
 """Wall-clock seconds a run may take when the configuration sets no ``time_limit``."""
 
@@ -132,6 +138,7 @@ class _Instance:
     scen: str | None = None
     generator: tuple[tuple[str, Any], ...] | None = None
     instance: int | None = None
+    lorr: LorrProblem | None = None
 
 
 class _BenchReader(_Reader):
@@ -201,10 +208,11 @@ class _BenchReader(_Reader):
 
     def map_entry(self, node: Node, path: str) -> list[_Instance]:
         """The instance families of one ``maps`` entry."""
-        if isinstance(node, MappingNode) and any(
-            isinstance(key, ScalarNode) and key.value == "generate" for key, _ in node.value
-        ):
+        keys = {key.value for key, _ in node.value if isinstance(key, ScalarNode)} if isinstance(node, MappingNode) else set()
+        if "generate" in keys:
             return self.generated_entry(node, path)
+        if "lorr" in keys:
+            return self.lorr_entry(node, path)
         entries = self.mapping(node, path, FILE_MAP_KEYS, required=("map",))
         if entries is None or "map" not in entries:
             return []
@@ -315,11 +323,36 @@ class _BenchReader(_Reader):
                 )  # fmt: skip
         return instances
 
+    def lorr_entry(self, node: Node, path: str) -> list[_Instance]:
+        """The one instance of a ``lorr:`` entry: the problem, its first N robots for each of ``agents`` (default:
+        its ``teamSize``)."""
+        entries = self.mapping(node, path, LORR_MAP_KEYS, required=("lorr",))
+        if entries is None or "lorr" not in entries:
+            return []
+        agents = self.positive_list(entries, "agents", f"{path}.agents", largest=MAX_ROBOTS)
+        problem_file = self.file(entries["lorr"].value, f"{path}.lorr", "LoRR problem file")
+        if problem_file is None:
+            return []
+        try:
+            problem = read_lorr_problem(problem_file)
+        except InputError as error:
+            self.problems.extend(error.problems)
+            return []
+        reason = f"its teamSize is {problem.team_size}"
+        counts = tuple(agents) if agents else (problem.team_size,)
+        return [_Instance(problem.name, problem.team_size, reason, counts, map_path=str(problem_file), lorr=problem)]
+
+    def lorr_policy_problems(self, policies: list[str], node: Node, path: str) -> None:
+        """Report each central planner among ``policies``: a LoRR problem is lifelong."""
+        for policy in policies:
+            if policy in PLANNER_NAMES:
+                self.report(_line(node), path, f"LoRR problems are lifelong: {policy} is a central planner")
+
     # -- whole file --------------------------------------------------------------------
 
     def read_config(self, root: Node, time_limit_override: float | None) -> BenchConfig | None:
         """Expand the configuration into runs; None if anything was wrong."""
-        top = self.mapping(root, "", TOP_KEYS, required=("maps", "agents", "policies"))
+        top = self.mapping(root, "", TOP_KEYS, required=("maps", "policies"))
         if top is None:
             return None
         name = self.optional(top, "name", "name", self.label)
@@ -329,19 +362,31 @@ class _BenchReader(_Reader):
         if len(map_nodes) > MAX_BENCH_MAPS:
             self.report(top["maps"].key_line, "maps", f"at most {MAX_BENCH_MAPS} maps, got {len(map_nodes)}")
             map_nodes = []
+        entry_of: dict[int, tuple[Node, str]] = {}
         for index, node in enumerate(map_nodes):
             self.lines[f"maps[{index}]"] = _line(node)
-            instances += self.map_entry(node, f"maps[{index}]")
+            found = self.map_entry(node, f"maps[{index}]")
+            entry_of.update((id(family), (node, f"maps[{index}]")) for family in found)
+            instances += found
             if len({instance.generator or instance.map_path for instance in instances}) > MAX_BENCH_MAPS:
                 self.report(_line(node), f"maps[{index}]", f"the configuration reaches more than {MAX_BENCH_MAPS} maps")
                 break
         agents = self.positive_list(top, "agents", "agents", largest=MAX_ROBOTS) or []
+        if "agents" not in top:
+            for family in instances:
+                if family.agents is None:
+                    node, path = entry_of[id(family)]
+                    self.report(_line(node), path, "give agents: [N, ...] here or at the top level")
+                    break
         policies = self.policies(top)
         seeds = self.positive_list(top, "seeds", "seeds", smallest=0) or [0]
         faults = self.fault_list(top)
         time_limit = self.bounded(top, "time_limit", "time_limit", self.number, 0.001, MAX_RUN_SECONDS)
         max_ticks = self.bounded(top, "max_ticks", "max_ticks", self.integer, 1, MAX_TICKS)
         lifelong = self.optional(top, "lifelong", "lifelong", self.boolean)
+        for family in instances:
+            if family.lorr is not None:
+                self.lorr_policy_problems(policies, *entry_of[id(family)])
         if lifelong is True:
             central = [policy for policy in policies if policy in PLANNER_NAMES]
             if central:
@@ -367,8 +412,10 @@ class _BenchReader(_Reader):
                             runs.append(
                                 BenchRun(
                                     map_name=family.map_name, agents=count, policy=policy, map_path=family.map_path,
-                                    scen=family.scen, generator=family.generator, instance=family.instance,
-                                    seed=seed, faults=network, lifelong=bool(lifelong), max_ticks=max_ticks,
+                                    scen=None if family.lorr else family.scen, generator=family.generator,
+                                    instance=family.instance, lorr=family.map_path if family.lorr else None,
+                                    seed=seed, faults=network, lifelong=bool(lifelong) or family.lorr is not None,
+                                    max_ticks=max_ticks,
                                     time_limit_s=float(limit), bench=name,
                                 )
                             )  # fmt: skip

@@ -81,6 +81,10 @@ class BenchRun:
         The run's seed (the simulated network's, and LaCAM's).
     faults:
         The simulated network's faults.
+    lorr:
+        A League of Robot Runners problem file (:mod:`mrmp.io.lorr`), whose map, robots (the first
+        ``agents``) and task stream the run takes, or None. Such a run is lifelong and lasts
+        ``max_ticks`` steps.
     lifelong, max_ticks:
         As in a scenario file.
     time_limit_s:
@@ -96,6 +100,7 @@ class BenchRun:
     scen: str | None = None
     generator: tuple[tuple[str, Any], ...] | None = None
     instance: int | None = None
+    lorr: str | None = None
     seed: int = 0
     faults: NetworkFaults = field(default_factory=NetworkFaults)
     lifelong: bool = False
@@ -114,8 +119,10 @@ class BenchRun:
         return dict(self.generator) if self.generator is not None else None
 
     def identity(self) -> dict[str, Any]:
-        """The parameters that make the run what it is (files by name only)."""
-        return {
+        """The parameters that make the run what it is (files by name only; ``lorr`` only when set, so
+        that the ids of the other runs do not change)."""
+        lorr = {"lorr": PurePath(self.lorr).name} if self.lorr is not None else {}
+        return lorr | {
             "map": self.map_name,
             "scen": PurePath(self.scen).name if self.scen is not None else None,
             "generator": self.generator_spec,

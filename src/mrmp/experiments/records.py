@@ -52,6 +52,8 @@ def build_scenario(run: BenchRun) -> Scenario:
     ValueError
         If a generator spec is wrong or the robots do not fit.
     """
+    if run.lorr is not None:
+        return _lorr_scenario(run)
     if run.generator is not None:
         grid = generate(run.generator_spec or {})
         base = random_instance(grid, run.agents, seed=run.instance or 0, name=f"{grid.name}-i{run.instance or 0}")
@@ -72,6 +74,18 @@ def build_scenario(run: BenchRun) -> Scenario:
     )
 
 
+def _lorr_scenario(run: BenchRun) -> Scenario:
+    """The scenario of a run on a LoRR problem: its first ``agents`` robots and its task stream, for ``max_ticks``
+    steps (the Start-Kit's 5,000 when unset), with the run's policy, faults and seed; the problem's bodies."""
+    from mrmp.experiments.run_options import apply_run_options
+    from mrmp.io.lorr import LORR_STEPS, lorr_scenario, read_lorr_problem
+
+    assert run.lorr is not None
+    problem = read_lorr_problem(run.lorr).with_team(run.agents)
+    scenario = lorr_scenario(problem, run.max_ticks or LORR_STEPS)
+    return apply_run_options(scenario.with_changes(network=run.faults), run.policy, seed=run.seed)
+
+
 def base_record(run: BenchRun, status: str, error: str | None = None) -> dict[str, Any]:
     """A record of ``run`` with its parameters and every result field null."""
     record: dict[str, Any] = {
@@ -85,6 +99,7 @@ def base_record(run: BenchRun, status: str, error: str | None = None) -> dict[st
         "scen": run.scen,
         "generator": run.generator_spec,
         "instance": run.instance,
+        "lorr": run.lorr,
         "agents": run.agents,
         "policy": run.policy,
         "kind": run.kind,
@@ -121,6 +136,7 @@ def result_fields(result: RunResult) -> dict[str, Any]:
             else None
         ),
         robots_arrived=sum(1 for robot in result.robots if robot.arrived),
+        tasks_finished=result.tasks.finished if result.tasks is not None else None,
         goals_reached=sum(robot.goals_reached for robot in result.robots),
         steps=steps,
         wall_time_per_step_s=result.wall_time_s / steps if steps else None,

@@ -46,12 +46,12 @@ RESULT_FIELDS: tuple[str, ...] = (
     "success", "stop_reason", "ticks", "makespan", "sum_of_costs", "lower_bound", "time_makespan_s",
     "time_sum_of_costs_s", "messages",
     "network", "wall_time_s", "planning_time_s", "plan_bytes", "throughput", "collisions", "soc_over_lb",
-    "robots_arrived", "goals_reached", "steps", "wall_time_per_step_s", "messages_per_robot_move",
+    "robots_arrived", "goals_reached", "steps", "wall_time_per_step_s", "messages_per_robot_move", "tasks_finished",
 )  # fmt: skip
 """The fields of a record that come from the run's result (null for a timeout or an error)."""
 
 CSV_COLUMNS: tuple[str, ...] = (
-    "run_id", "bench", "status", "error", "map", "map_path", "scen", "instance", "agents", "policy", "kind",
+    "run_id", "bench", "status", "error", "map", "map_path", "scen", "instance", "lorr", "agents", "policy", "kind",
     "seed", "loss", "delay_min", "delay_max", "duplicate", "reorder", "lifelong", "max_ticks", "time_limit_s",
     *(name for name in RESULT_FIELDS if name != "network"),
 )  # fmt: skip

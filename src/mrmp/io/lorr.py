@@ -34,7 +34,7 @@ from __future__ import annotations
 
 import json
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from pathlib import Path
 from typing import Any
 
@@ -102,6 +102,18 @@ class LorrProblem:
     agent_size: float = 1.0
     version: str | None = None
     source: str = ""
+
+    def with_team(self, team_size: int) -> LorrProblem:
+        """The same problem for its first ``team_size`` robots, as if its ``teamSize`` said so (tasks revealed
+        ``numTasksReveal x team_size`` at a time).
+
+        >>> problem = read_lorr_problem("examples/lorr/maze-example_40.json").with_team(10)
+        >>> problem.team_size, len(problem.starts)
+        (10, 10)
+        """
+        if not 1 <= team_size <= self.team_size:
+            raise ValueError(f"{self.name} has {self.team_size} robots; cannot keep {team_size}")
+        return replace(self, starts=self.starts[:team_size], team_size=team_size)
 
 
 def lorr_cell(location: int, grid: Grid) -> Cell:

@@ -101,9 +101,12 @@ _RESULT_FIELDS: dict[str, tuple[str, bool]] = {  # name -> (kind, required when 
     "wall_time_per_step_s": (_NUMBER, True),
     "messages_per_robot_move": (_NUMBER, False),
 }
-_OPTIONAL_FIELDS: dict[str, str] = {"bench": _TEXT, "instance": _INT, "time_sum_of_costs_s": _NUMBER}
+_OPTIONAL_FIELDS: dict[str, str] = {
+    "bench": _TEXT, "instance": _INT, "time_sum_of_costs_s": _NUMBER, "lorr": _TEXT, "tasks_finished": _INT,
+}  # fmt: skip
 """Fields a record may lack: the benchmark's name, a generated map's instance number, the sum of costs in seconds
-(recorded since bodies were named)."""
+(recorded since bodies were named), a LoRR problem file and the tasks finished (recorded since benchmarks took
+LoRR problems)."""
 _KINDS = ("decentralized", "centralized")
 
 
@@ -198,6 +201,8 @@ class BenchRecord:
     messages_per_robot_move: float | None = None
     bench: str | None = None
     instance: int | None = None
+    lorr: str | None = None
+    tasks_finished: int | None = None
     line: int = field(default=0, compare=False)
 
     @property

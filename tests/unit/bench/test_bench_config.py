@@ -129,7 +129,7 @@ def test_errors_are_one_line_each_with_file_and_line(folder, change, expected):
 
 def test_missing_required_keys_and_a_warehouse_with_seeds(folder):
     found = problems(folder, "maps:\n  - {generate: warehouse, width: 30, height: 12, seeds: [1]}\n")
-    assert any(line.endswith("bench.yaml:1: missing required key 'agents'") for line in found), found
+    assert any(line.endswith("bench.yaml:2: maps[0]: give agents: [N, ...] here or at the top level") for line in found), found
     assert any(line.endswith("bench.yaml:1: missing required key 'policies'") for line in found), found
     assert any("bench.yaml:2: maps[0].seeds: warehouse maps are not random" in line for line in found), found
 
@@ -145,7 +145,7 @@ def test_text_without_a_folder_reads_relative_to_the_given_base():
     assert config.runs[0].map_path == str((MAPS / "empty-32-32.map").resolve())
 
 
-@pytest.mark.parametrize("name", ["tiny", "standard", "generated"])
+@pytest.mark.parametrize("name", ["tiny", "standard", "generated", "lorr"])
 def test_the_example_configurations_read(name):
     config = load_bench_config(ROOT / "bench" / f"{name}.yaml")
     assert config.name == name and config.runs and config.notes == ()
