@@ -7,11 +7,13 @@ the same number of steps:
 * the Start-Kit's default entry (its greedy scheduler and its planner: PIBT
   with traffic-flow guide paths, C++, Release build), through the Start-Kit's
   own simulator (``build/lifelong -s STEPS -t PLAN_MS``);
-* mrmp: ``pibt`` computed by the robots' messages in the ``turning`` body, the
-  simulator starting their calls in priority order (``sequencing: driver``), the same greedy scheduler
+* mrmp, once per sequencing of ``--sequencings`` (default both): ``pibt``
+  computed by the robots' messages in the ``turning`` body, the robots ordering
+  their calls themselves (``local``, fully decentralized) or the simulator starting
+  them in priority order (``driver``), the same greedy scheduler
   (:mod:`mrmp.sim.task_book`), in the simulator (:func:`mrmp.io.lorr.lorr_scenario`);
 
-and prints the tasks each finished (LoRR's score, ``numTaskFinished``), their
+and prints, one row per sequencing, the tasks each finished (LoRR's score, ``numTaskFinished``), their
 ratio, the seconds per step (the Start-Kit's mean ``plannerTimes``; mrmp's
 wall time of the whole run over its steps, robots, messages and task book
 included) and their ratio, mrmp's collisions and its messages per robot-step.
@@ -28,6 +30,7 @@ The default planner spends what its time limit allows on the guide paths;
 it finished 899 tasks at its default 1000 ms and 902 at 100 ms).
 
 Usage: python bench/lorr.py --start-kit PATH [--cases random.domain/random_32_32_20_100.json,...] [--steps 500]
+       [--sequencings local,driver]
 """
 
 from __future__ import annotations
@@ -40,10 +43,11 @@ import subprocess
 import sys
 import tempfile
 import time
-from dataclasses import asdict, dataclass
+from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 from mrmp.core.errors import InputError
+from mrmp.core.options import SEQUENCINGS
 from mrmp.io.lifetime import preexec_dying_with
 from mrmp.io.lorr import load_lorr_scenario
 from mrmp.sim.simulator import simulate
@@ -66,6 +70,7 @@ class Row:
     problem: str
     robots: int
     steps: int
+    sequencing: str
     start_kit_tasks: int
     mrmp_tasks: int
     start_kit_step_s: float
@@ -148,20 +153,26 @@ def start_kit_run(program: Path, problem: Path, steps: int, plan_ms: int, scratc
     return int(result["numTaskFinished"]), sum(times) / len(times)
 
 
-def measure(program: Path, start_kit: Path, case: str, steps: int, plan_ms: int, scratch: Path) -> Row:
-    """One case, the Start-Kit first, then mrmp."""
+def measure(
+    program: Path, start_kit: Path, case: str, steps: int, plan_ms: int, sequencings: list[str], scratch: Path
+) -> list[Row]:
+    """One case, the Start-Kit first, then mrmp once per sequencing."""
     problem, name = case_problem(start_kit, case, scratch)
     start_kit_tasks, start_kit_step = start_kit_run(program, problem, steps, plan_ms, scratch)
-    scenario = load_lorr_scenario(problem, steps)
-    started = time.perf_counter()
-    result = simulate(scenario)
-    wall = time.perf_counter() - started
-    assert result.tasks is not None
-    robots = len(scenario.robots)
-    return Row(
-        name, robots, steps, start_kit_tasks, result.tasks.finished, start_kit_step, wall / max(1, result.ticks),
-        len(result.collisions), result.messages / max(1, result.ticks * robots),
-    )  # fmt: skip
+    rows = []
+    for sequencing in sequencings:
+        scenario = load_lorr_scenario(problem, steps)
+        scenario = scenario.with_changes(policy=replace(scenario.policy, sequencing=sequencing))
+        started = time.perf_counter()
+        result = simulate(scenario)
+        wall = time.perf_counter() - started
+        assert result.tasks is not None
+        robots = len(scenario.robots)
+        rows.append(Row(
+            name, robots, steps, sequencing, start_kit_tasks, result.tasks.finished, start_kit_step,
+            wall / max(1, result.ticks), len(result.collisions), result.messages / max(1, result.ticks * robots),
+        ))  # fmt: skip
+    return rows
 
 
 def main() -> int:
@@ -170,8 +181,13 @@ def main() -> int:
     parser.add_argument("--cases", default=CASES, help="DOMAIN/FILE.json[:N], comma-separated (in its example_problems)")
     parser.add_argument("--steps", type=int, default=500, help="steps of every run")
     parser.add_argument("--plan-ms", type=int, default=100, help="the Start-Kit planner's time limit per step (ms)")
+    parser.add_argument("--sequencings", default="local,driver", help="mrmp's orders of calls, comma-separated")
     parser.add_argument("--out", type=Path, default=Path("lorr-results.jsonl"), help="JSON lines, one per case")
     arguments = parser.parse_args()
+    sequencings = arguments.sequencings.split(",")
+    unknown = [name for name in sequencings if name not in SEQUENCINGS]
+    if unknown or not sequencings:
+        return fail(f"--sequencings: expected some of {', '.join(SEQUENCINGS)}, got {arguments.sequencings!r}")
     start_kit = arguments.start_kit.resolve()
     if not (start_kit / "CMakeLists.txt").is_file() or not (start_kit / "default_planner").is_dir():
         return fail(f"--start-kit: {start_kit} is not a Start-Kit source tree (no CMakeLists.txt and default_planner/)")
@@ -184,7 +200,7 @@ def main() -> int:
     except (OSError, subprocess.CalledProcessError) as error:
         return fail(f"--start-kit: building the Start-Kit failed ({error}); see {start_kit / 'build-mrmp.log'}")
     print(
-        f"{'problem':<26} {'N':>5} {'steps':>5} {'SK tasks':>8} {'mrmp tasks':>10} {'ratio':>6} "
+        f"{'problem':<26} {'N':>5} {'steps':>5} {'sequencing':>10} {'SK tasks':>8} {'mrmp tasks':>10} {'ratio':>6} "
         f"{'SK s/step':>9} {'mrmp s/step':>11} {'ratio':>6} {'coll':>4} {'msg/robot-step':>14}",
         flush=True,
     )
@@ -192,19 +208,20 @@ def main() -> int:
         scratch = Path(folder)
         for case in arguments.cases.split(","):
             try:
-                row = measure(program, start_kit, case, arguments.steps, arguments.plan_ms, scratch)
+                rows = measure(program, start_kit, case, arguments.steps, arguments.plan_ms, sequencings, scratch)
             except InputError as error:
                 return fail(str(error))
             except subprocess.CalledProcessError as error:
                 return fail(f"{case}: the Start-Kit failed with exit code {error.returncode}")
-            with arguments.out.open("a") as out:
-                out.write(json.dumps({**asdict(row), "task_ratio": row.task_ratio, "time_ratio": row.time_ratio}) + "\n")
-            print(
-                f"{row.problem:<26} {row.robots:>5} {row.steps:>5} {row.start_kit_tasks:>8} {row.mrmp_tasks:>10} "
-                f"{row.task_ratio:>6.3f} {row.start_kit_step_s:>9.4f} {row.mrmp_step_s:>11.4f} {row.time_ratio:>6.2f} "
-                f"{row.mrmp_collisions:>4} {row.mrmp_messages_per_robot_step:>14.2f}",
-                flush=True,
-            )
+            for row in rows:
+                with arguments.out.open("a") as out:
+                    out.write(json.dumps({**asdict(row), "task_ratio": row.task_ratio, "time_ratio": row.time_ratio}) + "\n")
+                print(
+                    f"{row.problem:<26} {row.robots:>5} {row.steps:>5} {row.sequencing:>10} {row.start_kit_tasks:>8} "
+                    f"{row.mrmp_tasks:>10} {row.task_ratio:>6.3f} {row.start_kit_step_s:>9.4f} {row.mrmp_step_s:>11.4f} "
+                    f"{row.time_ratio:>6.2f} {row.mrmp_collisions:>4} {row.mrmp_messages_per_robot_step:>14.2f}",
+                    flush=True,
+                )
     return 0
 
 

@@ -69,7 +69,7 @@ from mrmp.core.map_generators import GENERATORS, complete_spec, generate, larges
 from mrmp.core.scenario import NetworkFaults, _fault_problems
 from mrmp.experiments.matrix import BenchRun
 from mrmp.io._files import PathLike, file_problem, read_text
-from mrmp.io.lorr import LorrProblem, read_lorr_problem
+from mrmp.io.lorr import read_lorr_problem
 from mrmp.io.movingai import read_map, read_scen_entries, scen_map_problems
 from mrmp.io.scenario_file import (
     _BAD,
@@ -138,7 +138,8 @@ class _Instance:
     scen: str | None = None
     generator: tuple[tuple[str, Any], ...] | None = None
     instance: int | None = None
-    lorr: LorrProblem | None = None
+    lorr: str | None = None
+    """A League of Robot Runners problem file."""
 
 
 class _BenchReader(_Reader):
@@ -340,7 +341,7 @@ class _BenchReader(_Reader):
             return []
         reason = f"its teamSize is {problem.team_size}"
         counts = tuple(agents) if agents else (problem.team_size,)
-        return [_Instance(problem.name, problem.team_size, reason, counts, map_path=str(problem_file), lorr=problem)]
+        return [_Instance(problem.name, problem.team_size, reason, counts, lorr=str(problem_file))]
 
     def lorr_policy_problems(self, policies: list[str], node: Node, path: str) -> None:
         """Report each central planner among ``policies``: a LoRR problem is lifelong."""
@@ -368,7 +369,7 @@ class _BenchReader(_Reader):
             found = self.map_entry(node, f"maps[{index}]")
             entry_of.update((id(family), (node, f"maps[{index}]")) for family in found)
             instances += found
-            if len({instance.generator or instance.map_path for instance in instances}) > MAX_BENCH_MAPS:
+            if len({instance.generator or instance.map_path or instance.lorr for instance in instances}) > MAX_BENCH_MAPS:
                 self.report(_line(node), f"maps[{index}]", f"the configuration reaches more than {MAX_BENCH_MAPS} maps")
                 break
         agents = self.positive_list(top, "agents", "agents", largest=MAX_ROBOTS) or []
@@ -412,8 +413,8 @@ class _BenchReader(_Reader):
                             runs.append(
                                 BenchRun(
                                     map_name=family.map_name, agents=count, policy=policy, map_path=family.map_path,
-                                    scen=None if family.lorr else family.scen, generator=family.generator,
-                                    instance=family.instance, lorr=family.map_path if family.lorr else None,
+                                    scen=family.scen, generator=family.generator, instance=family.instance,
+                                    lorr=family.lorr,
                                     seed=seed, faults=network, lifelong=bool(lifelong) or family.lorr is not None,
                                     max_ticks=max_ticks,
                                     time_limit_s=float(limit), bench=name,

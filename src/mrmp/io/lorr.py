@@ -284,8 +284,8 @@ def lorr_scenario(problem: LorrProblem, steps: int = LORR_STEPS) -> Scenario:
     """A lifelong mrmp scenario of ``problem``: its robots on their starts facing east, its task stream, ``steps`` ticks.
 
     The robots compute ``pibt`` by messages in the ``turning`` body (LoRR's
-    ``MAPF_T``), the simulator starting their calls in priority order
-    (``sequencing: driver``); every
+    ``MAPF_T``), ordering their calls themselves (``sequencing: local``, the
+    default of ``pibt``); every
     robot's goal is its start until the scheduler gives it a task. One tick is
     one LoRR action (the 2024 rules; a 2026 problem's ``agentCounter``
     execution ticks per action are not simulated).
@@ -299,7 +299,7 @@ def lorr_scenario(problem: LorrProblem, steps: int = LORR_STEPS) -> Scenario:
     return Scenario(
         problem.grid,
         robots,
-        policy=PolicyOptions(name="pibt", body="turning", sequencing="driver"),
+        policy=PolicyOptions(name="pibt", body="turning", sequencing="local"),
         lifelong=True,
         tasks=stream,
         max_ticks=steps,

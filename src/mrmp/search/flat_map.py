@@ -92,7 +92,7 @@ class FlatMap(FlatGrid):
         if table is None:
             started = time.perf_counter()
             table = distance_table(self.grid, self.cell(goal)).as_array()
-            table = self._keep(goal, table, time.perf_counter() - started)
+            table = self._keep(goal, table, started)
         return table
 
     def heading_distances(self, goal: int, turn_cost: float, both_ways: bool = False) -> array[float]:
@@ -110,7 +110,7 @@ class FlatMap(FlatGrid):
         if table is None:
             started = time.perf_counter()
             table = heading_distances(self.grid, self.cell(goal), turn_cost, both_ways)
-            table = self._keep(key, table, time.perf_counter() - started)
+            table = self._keep(key, table, started)
         return table
 
     @property
@@ -125,11 +125,11 @@ class FlatMap(FlatGrid):
             self._tables.move_to_end(key)
         return table
 
-    def _keep(self, key: _TableKey, table: array[float], seconds: float) -> array[float]:
-        """Keep ``table`` (:func:`compact`), dropping the lists used least recently while the budget is
-        exceeded; the list kept."""
+    def _keep(self, key: _TableKey, table: array[float], started: float) -> array[float]:
+        """Keep ``table`` (:func:`compact`), whose computation began at ``started`` (``time.perf_counter``),
+        dropping the lists used least recently while the budget is exceeded; the list kept."""
         table = compact(table)
-        self.table_seconds += seconds
+        self.table_seconds += time.perf_counter() - started
         self.tables_computed += 1
         self._tables[key] = table
         self._kept_bytes += table.itemsize * len(table)

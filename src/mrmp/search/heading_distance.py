@@ -14,8 +14,9 @@ wavefront by wavefront, as a label-correcting shortest-path search (Bellman 1958
 "On a routing problem"; Moore 1959, "The shortest path through a maze"): the states
 improved in one wave offer their cost to their predecessors in the next, until no
 state improves. With non-negative costs this gives Dijkstra's distances (Dijkstra
-1959, "A note on two problems in connexion with graphs"), each candidate cost summed
-in the same order. As in :mod:`mrmp.search.distance`, a small wave is expanded in a
+1959, "A note on two problems in connexion with graphs"), to the last bit: every
+candidate cost is summed as a heap-based search sums it (the entry cost, then the
+turns). As in :mod:`mrmp.search.distance`, a small wave is expanded in a
 plain Python loop and a large one with a few numpy operations over the whole wave:
 the 280,000 states of a 500 x 140 warehouse map take tens of milliseconds, where a
 heap-based search in Python took a third of a second.
