@@ -7,13 +7,15 @@ the same number of steps:
 * the Start-Kit's default entry (its greedy scheduler and its planner: PIBT
   with traffic-flow guide paths, C++, Release build), through the Start-Kit's
   own simulator (``build/lifelong -s STEPS -t PLAN_MS``);
-* mrmp, once per sequencing of ``--sequencings`` (default both): ``pibt``
-  computed by the robots' messages in the ``turning`` body, the robots ordering
-  their calls themselves (``local``, fully decentralized) or the simulator starting
-  them in priority order (``driver``), the same greedy scheduler
-  (:mod:`mrmp.sim.task_book`), in the simulator (:func:`mrmp.io.lorr.lorr_scenario`);
+* mrmp, once per sequencing of ``--sequencings`` and guidance of ``--guidances``
+  (default: all four): ``pibt`` computed by the robots' messages in the ``turning``
+  body, the robots ordering their calls themselves (``local``, fully decentralized)
+  or the simulator starting them in priority order (``driver``), their tables
+  guided by lanes (``crisscross``, :mod:`mrmp.search.guidance`) or not (``none``),
+  the same greedy scheduler (:mod:`mrmp.sim.task_book`), in the simulator
+  (:func:`mrmp.io.lorr.lorr_scenario`);
 
-and prints, one row per sequencing, the tasks each finished (LoRR's score, ``numTaskFinished``), their
+and prints, one row per sequencing and guidance, the tasks each finished (LoRR's score, ``numTaskFinished``), their
 ratio, the seconds per step (the Start-Kit's mean ``plannerTimes``; mrmp's
 wall time of the whole run over its steps, robots, messages and task book
 included) and their ratio, mrmp's collisions and its messages per robot-step.
@@ -30,7 +32,7 @@ The default planner spends what its time limit allows on the guide paths;
 it finished 899 tasks at its default 1000 ms and 902 at 100 ms).
 
 Usage: python bench/lorr.py --start-kit PATH [--cases random.domain/random_32_32_20_100.json,...] [--steps 500]
-       [--sequencings local,driver]
+       [--sequencings local,driver] [--guidances crisscross,none]
 """
 
 from __future__ import annotations
@@ -47,7 +49,7 @@ from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
 from mrmp.core.errors import InputError
-from mrmp.core.options import SEQUENCINGS
+from mrmp.core.options import GUIDANCES, SEQUENCINGS
 from mrmp.io.lifetime import preexec_dying_with
 from mrmp.io.lorr import load_lorr_scenario
 from mrmp.sim.simulator import simulate
@@ -71,6 +73,7 @@ class Row:
     robots: int
     steps: int
     sequencing: str
+    guidance: str
     start_kit_tasks: int
     mrmp_tasks: int
     start_kit_step_s: float
@@ -154,22 +157,22 @@ def start_kit_run(program: Path, problem: Path, steps: int, plan_ms: int, scratc
 
 
 def measure(
-    program: Path, start_kit: Path, case: str, steps: int, plan_ms: int, sequencings: list[str], scratch: Path
+    program: Path, start_kit: Path, case: str, steps: int, plan_ms: int, fleets: list[tuple[str, str]], scratch: Path
 ) -> list[Row]:
-    """One case, the Start-Kit first, then mrmp once per sequencing."""
+    """One case, the Start-Kit first, then mrmp once per ``(sequencing, guidance)`` of ``fleets``."""
     problem, name = case_problem(start_kit, case, scratch)
     start_kit_tasks, start_kit_step = start_kit_run(program, problem, steps, plan_ms, scratch)
     rows = []
-    for sequencing in sequencings:
+    for sequencing, guidance in fleets:
         scenario = load_lorr_scenario(problem, steps)
-        scenario = scenario.with_changes(policy=replace(scenario.policy, sequencing=sequencing))
+        scenario = scenario.with_changes(policy=replace(scenario.policy, sequencing=sequencing, guidance=guidance))
         started = time.perf_counter()
         result = simulate(scenario)
         wall = time.perf_counter() - started
         assert result.tasks is not None
         robots = len(scenario.robots)
         rows.append(Row(
-            name, robots, steps, sequencing, start_kit_tasks, result.tasks.finished, start_kit_step,
+            name, robots, steps, sequencing, guidance, start_kit_tasks, result.tasks.finished, start_kit_step,
             wall / max(1, result.ticks), len(result.collisions), result.messages / max(1, result.ticks * robots),
         ))  # fmt: skip
     return rows
@@ -182,12 +185,17 @@ def main() -> int:
     parser.add_argument("--steps", type=int, default=500, help="steps of every run")
     parser.add_argument("--plan-ms", type=int, default=100, help="the Start-Kit planner's time limit per step (ms)")
     parser.add_argument("--sequencings", default="local,driver", help="mrmp's orders of calls, comma-separated")
+    parser.add_argument("--guidances", default="crisscross,none", help="mrmp's lanes, comma-separated")
     parser.add_argument("--out", type=Path, default=Path("lorr-results.jsonl"), help="JSON lines, one per case")
     arguments = parser.parse_args()
     sequencings = arguments.sequencings.split(",")
     unknown = [name for name in sequencings if name not in SEQUENCINGS]
-    if unknown or not sequencings:
+    if unknown:
         return fail(f"--sequencings: expected some of {', '.join(SEQUENCINGS)}, got {arguments.sequencings!r}")
+    guidances = arguments.guidances.split(",")
+    if any(name not in GUIDANCES for name in guidances):
+        return fail(f"--guidances: expected some of {', '.join(GUIDANCES)}, got {arguments.guidances!r}")
+    fleets = [(sequencing, guidance) for sequencing in sequencings for guidance in guidances]
     start_kit = arguments.start_kit.resolve()
     if not (start_kit / "CMakeLists.txt").is_file() or not (start_kit / "default_planner").is_dir():
         return fail(f"--start-kit: {start_kit} is not a Start-Kit source tree (no CMakeLists.txt and default_planner/)")
@@ -200,15 +208,15 @@ def main() -> int:
     except (OSError, subprocess.CalledProcessError) as error:
         return fail(f"--start-kit: building the Start-Kit failed ({error}); see {start_kit / 'build-mrmp.log'}")
     print(
-        f"{'problem':<26} {'N':>5} {'steps':>5} {'sequencing':>10} {'SK tasks':>8} {'mrmp tasks':>10} {'ratio':>6} "
-        f"{'SK s/step':>9} {'mrmp s/step':>11} {'ratio':>6} {'coll':>4} {'msg/robot-step':>14}",
+        f"{'problem':<26} {'N':>5} {'steps':>5} {'sequencing':>10} {'guidance':>10} {'SK tasks':>8} {'mrmp tasks':>10} "
+        f"{'ratio':>6} {'SK s/step':>9} {'mrmp s/step':>11} {'ratio':>6} {'coll':>4} {'msg/robot-step':>14}",
         flush=True,
     )
     with tempfile.TemporaryDirectory(prefix="mrmp-lorr-") as folder:
         scratch = Path(folder)
         for case in arguments.cases.split(","):
             try:
-                rows = measure(program, start_kit, case, arguments.steps, arguments.plan_ms, sequencings, scratch)
+                rows = measure(program, start_kit, case, arguments.steps, arguments.plan_ms, fleets, scratch)
             except InputError as error:
                 return fail(str(error))
             except subprocess.CalledProcessError as error:
@@ -217,9 +225,10 @@ def main() -> int:
                 with arguments.out.open("a") as out:
                     out.write(json.dumps({**asdict(row), "task_ratio": row.task_ratio, "time_ratio": row.time_ratio}) + "\n")
                 print(
-                    f"{row.problem:<26} {row.robots:>5} {row.steps:>5} {row.sequencing:>10} {row.start_kit_tasks:>8} "
-                    f"{row.mrmp_tasks:>10} {row.task_ratio:>6.3f} {row.start_kit_step_s:>9.4f} {row.mrmp_step_s:>11.4f} "
-                    f"{row.time_ratio:>6.2f} {row.mrmp_collisions:>4} {row.mrmp_messages_per_robot_step:>14.2f}",
+                    f"{row.problem:<26} {row.robots:>5} {row.steps:>5} {row.sequencing:>10} {row.guidance:>10} "
+                    f"{row.start_kit_tasks:>8} {row.mrmp_tasks:>10} {row.task_ratio:>6.3f} {row.start_kit_step_s:>9.4f} "
+                    f"{row.mrmp_step_s:>11.4f} {row.time_ratio:>6.2f} {row.mrmp_collisions:>4} "
+                    f"{row.mrmp_messages_per_robot_step:>14.2f}",
                     flush=True,
                 )
     return 0

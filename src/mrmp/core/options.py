@@ -50,6 +50,10 @@ SEQUENCINGS = ("driver", "local")
 """Who orders ``pibt``'s calls: the simulator, in priority order (:mod:`mrmp.sim.rounds`), or the robots
 themselves, by messages among neighbours (:mod:`mrmp.sim.local_rounds`)."""
 
+GUIDANCES = ("none", "crisscross")
+"""The lanes a ``pibt`` robot's tables may be guided by (:data:`mrmp.search.guidance.GUIDANCE_TABLE`): none, or the
+crisscross pattern (moves against a row's or column's lane cost one step more)."""
+
 SYNCHRONIZERS = ("clock", "local")
 """When a ``pibt`` robot (local sequencing) ends its step: at a time common to all (:mod:`mrmp.sim.local_rounds`),
 or once every robot within 2 cells has decided, by its own word (:mod:`mrmp.sim.synchronized_rounds`)."""
@@ -226,6 +230,20 @@ def synchronizer_setting() -> Any:
         help="pibt (local sequencing, simulated or live): when a robot ends its step: clock (a time common to all) or "
         "local (once every robot within 2 cells has decided; a local synchronizer).",
         yaml_key="synchronizer", flag="--synchronizer", check=_one_of_synchronizers, choices=SYNCHRONIZERS,
+    )  # fmt: skip
+
+
+def _one_of_guidances(value: object) -> str | None:
+    return None if value in GUIDANCES else f"must be one of {', '.join(GUIDANCES)}, got {value!r}"
+
+
+def guidance_setting() -> Any:
+    """``guidance``: the lanes that shape a ``pibt`` robot's distance tables (:data:`GUIDANCES`)."""
+    return setting(
+        "none",
+        help="pibt with turning bodies (others ignore it): the lanes that shape the robots' distance tables: none, "
+        "or crisscross (rows and columns alternate direction; a move against its lane counts one step more).",
+        yaml_key="guidance", flag="--guidance", check=_one_of_guidances, choices=GUIDANCES,
     )  # fmt: skip
 
 

@@ -31,6 +31,7 @@ from mrmp.core.options import (
     RESOLUTIONS,
     body_setting,
     check_settings,
+    guidance_setting,
     heading_aware_setting,
     radius_setting,
     resolve_setting,
@@ -134,6 +135,7 @@ class PolicyOptions:
     sequencing: str = sequencing_setting()
     synchronizer: str = synchronizer_setting()
     body: str = body_setting()
+    guidance: str = guidance_setting()
 
     def __post_init__(self) -> None:
         check_settings(self)

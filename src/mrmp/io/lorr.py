@@ -285,7 +285,8 @@ def lorr_scenario(problem: LorrProblem, steps: int = LORR_STEPS) -> Scenario:
 
     The robots compute ``pibt`` by messages in the ``turning`` body (LoRR's
     ``MAPF_T``), ordering their calls themselves (``sequencing: local``, the
-    default of ``pibt``); every
+    default of ``pibt``), their tables guided by the crisscross lanes
+    (``guidance: crisscross``, :mod:`mrmp.search.guidance`); every
     robot's goal is its start until the scheduler gives it a task. One tick is
     one LoRR action (the 2024 rules; a 2026 problem's ``agentCounter``
     execution ticks per action are not simulated).
@@ -299,7 +300,7 @@ def lorr_scenario(problem: LorrProblem, steps: int = LORR_STEPS) -> Scenario:
     return Scenario(
         problem.grid,
         robots,
-        policy=PolicyOptions(name="pibt", body="turning", sequencing="local"),
+        policy=PolicyOptions(name="pibt", body="turning", sequencing="local", guidance="crisscross"),
         lifelong=True,
         tasks=stream,
         max_ticks=steps,

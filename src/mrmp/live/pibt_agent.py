@@ -223,6 +223,7 @@ class PibtBrain:
             swap=options.swap and not self.turning,
             turning=self.turning,
             dead_end_bonus=DEAD_END_BONUS if self.turning else 0,
+            guidance=options.guidance,
             heading_aware=options.heading_aware,
             turn_cost=scenario.timing.turn_time / scenario.timing.cell_time,
             rng=stream_random(scenario.seed, Stream.TIES, index),

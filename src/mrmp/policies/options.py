@@ -24,6 +24,7 @@ from typing import TypeVar
 
 from mrmp.core.options import (
     check_settings,
+    guidance_setting,
     heading_aware_setting,
     radius_setting,
     resolve_setting,
@@ -69,6 +70,7 @@ class PibtOptions:
     swap: bool = swap_setting()
     sequencing: str = sequencing_setting()
     synchronizer: str = synchronizer_setting()
+    guidance: str = guidance_setting()
 
     def __post_init__(self) -> None:
         check_settings(self)

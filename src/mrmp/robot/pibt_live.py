@@ -163,6 +163,7 @@ class LivePibtRobot(ReliablePibtRobot):
         tie_penalties: bool | None = None,
         turning: bool = False,
         dead_end_bonus: int = 0,
+        guidance: str = "none",
         retry: int = 1,
         starts: Sequence[int] = (),
         lookout: int = 2,
@@ -170,7 +171,7 @@ class LivePibtRobot(ReliablePibtRobot):
         super().__init__(
             index, start, goal, flat, tie=tie, heading=heading, radius=radius, swap=swap,
             heading_aware=heading_aware, turn_cost=turn_cost, rng=rng, tie_penalties=tie_penalties,
-            turning=turning, dead_end_bonus=dead_end_bonus, retry=retry,
+            turning=turning, dead_end_bonus=dead_end_bonus, guidance=guidance, retry=retry,
         )  # fmt: skip
         self.known: dict[int, tuple[int, int]] = {}
         """Per peer: the cell it was last heard of, and the step at whose start it stood there."""

@@ -143,11 +143,12 @@ class LocalPibtRobot(PibtRobot):
         tie_penalties: bool | None = None,
         turning: bool = False,
         dead_end_bonus: int = 0,
+        guidance: str = "none",
     ) -> None:
         super().__init__(
             index, start, goal, flat, tie=tie, heading=heading, radius=radius, swap=swap,
             heading_aware=heading_aware, turn_cost=turn_cost, rng=rng, tie_penalties=tie_penalties,
-            turning=turning, dead_end_bonus=dead_end_bonus,
+            turning=turning, dead_end_bonus=dead_end_bonus, guidance=guidance,
         )  # fmt: skip
         self.stats: Counter[str] = Counter()
         self.wake = False

@@ -126,12 +126,13 @@ class ReliablePibtRobot(LocalPibtRobot):
         tie_penalties: bool | None = None,
         turning: bool = False,
         dead_end_bonus: int = 0,
+        guidance: str = "none",
         retry: int = 1,
     ) -> None:
         super().__init__(
             index, start, goal, flat, tie=tie, heading=heading, radius=radius, swap=swap,
             heading_aware=heading_aware, turn_cost=turn_cost, rng=rng, tie_penalties=tie_penalties,
-            turning=turning, dead_end_bonus=dead_end_bonus,
+            turning=turning, dead_end_bonus=dead_end_bonus, guidance=guidance,
         )  # fmt: skip
         if retry < 1:
             raise ValueError(f"retry {retry} is below 1 tick")

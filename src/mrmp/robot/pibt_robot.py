@@ -169,6 +169,10 @@ class PibtRobot:
         that a robot shut in a dead end outranks the robot that waits at its
         mouth. Without the swap technique (bodies that turn in place) the two
         would otherwise wait for each other for ever.
+    guidance:
+        With ``turning``: the lanes that shape its tables (a name of
+        :data:`~mrmp.search.guidance.GUIDANCE_TABLE`; ``none``, the default,
+        leaves them the (cell, heading) distances).
     """
 
     def __init__(
@@ -188,6 +192,7 @@ class PibtRobot:
         tie_penalties: bool | None = None,
         turning: bool = False,
         dead_end_bonus: int = 0,
+        guidance: str = "none",
     ) -> None:
         if radius < MIN_RADIUS:
             raise ValueError(f"radius {radius} is below {MIN_RADIUS}: robots two cells apart could take the same cell")
@@ -208,6 +213,7 @@ class PibtRobot:
         self.turning = turning
         self._ahead_or_stay = turning and self.turns_by_staying
         self.dead_end_bonus = dead_end_bonus
+        self.guidance = guidance
         self.elapsed = 0
         self.step = 0
         self.seq = 0
@@ -452,7 +458,7 @@ class PibtRobot:
                 flat.neighbours,
                 self.present,
                 int(self.heading),
-                flat.heading_distances(self.goal, 1.0, both_ways=True),
+                flat.heading_distances(self.goal, 1.0, True, self.guidance),
                 flat.y_size,
                 flat.entry_costs,
                 self._noise,
@@ -572,7 +578,7 @@ class PibtRobot:
         assert self.target is not None
         here, heading = self.present, int(self.heading)
         flat = self.flat
-        table = flat.heading_distances(self.goal, 1.0, both_ways=True)
+        table = flat.heading_distances(self.goal, 1.0, True, self.guidance)
         chosen = self._stay_toward if self.turns_by_staying and self.target == here else self.target
         facing = turning_action(flat.neighbours, here, heading, chosen, table, flat.y_size)
         self.next_heading = Heading(facing)

@@ -54,8 +54,8 @@ recently are dropped, to be computed again if asked for."""
 _EXACT_IN_SINGLE = 2.0**24
 """Whole numbers below this are exact in a single-precision float."""
 
-_TableKey = tuple[int, float, bool] | int
-"""A plain list's goal, or a heading-aware list's ``(goal, turn_cost, both_ways)``."""
+_TableKey = tuple[int, float, bool, str] | int
+"""A plain list's goal, or a heading-aware list's ``(goal, turn_cost, both_ways, guidance)``."""
 
 
 class FlatMap(FlatGrid):
@@ -95,21 +95,23 @@ class FlatMap(FlatGrid):
             table = self._keep(goal, table, started)
         return table
 
-    def heading_distances(self, goal: int, turn_cost: float, both_ways: bool = False) -> array[float]:
+    def heading_distances(
+        self, goal: int, turn_cost: float, both_ways: bool = False, guidance: str = "none"
+    ) -> array[float]:
         """For every state (flat cell ``i``, heading ``h``), at ``4 * i + h - 1``, the heading-aware
         cost to reach the flat cell ``goal`` when a right turn (a quarter turn either way, with
-        ``both_ways``) costs ``turn_cost``
+        ``both_ways``) costs ``turn_cost``, moves against the lanes of ``guidance`` more
         (:func:`~mrmp.search.heading_distance.heading_distances`), computed once per goal and kept.
 
         >>> flat = FlatMap(Grid(1, 3))
         >>> list(flat.heading_distances(2, 0.5)[:4])    # from (0, 0) facing NORTH, EAST, SOUTH, WEST
         [2.5, 2.0, 3.5, 3.0]
         """
-        key = (goal, turn_cost, both_ways)
+        key = (goal, turn_cost, both_ways, guidance)
         table = self._kept(key)
         if table is None:
             started = time.perf_counter()
-            table = heading_distances(self.grid, self.cell(goal), turn_cost, both_ways)
+            table = heading_distances(self.grid, self.cell(goal), turn_cost, both_ways, guidance)
             table = self._keep(key, table, started)
         return table
 

@@ -65,6 +65,7 @@ import numpy.typing as npt
 from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
 from mrmp.core.heading import HEADINGS, quarter_turns, right_turns
+from mrmp.search.guidance import guidance_costs
 
 __all__ = ["heading_distances"]
 
@@ -86,15 +87,20 @@ class _StateGraph:
     State ``s = 4 * i + d`` is flat cell ``i`` entered moving in direction ``d``
     (0 to 3: NORTH, EAST, SOUTH, WEST). Its predecessors are the four states of the
     cell behind it, ``behind[s]``, or none when that cell is blocked or off the
-    grid (``behind[s] == size``, the padding cell). ``costs[i]`` is the entry cost
-    of cell ``i``.
+    grid (``behind[s] == size``, the padding cell). ``costs[s]`` is the cost of
+    entering state ``s``: its cell's entry cost, plus the guidance's extra cost
+    (:mod:`mrmp.search.guidance`).
     """
 
-    def __init__(self, grid: Grid) -> None:
+    def __init__(self, grid: Grid, guidance: str) -> None:
         x_size, y_size = grid.x_size, grid.y_size
         size = x_size * y_size
         self.size = size
-        self.costs = [float(grid.cost((x, y))) for x in range(x_size) for y in range(y_size)] + [0.0]
+        cell_costs = [float(grid.cost((x, y))) for x in range(x_size) for y in range(y_size)]
+        extra = guidance_costs(guidance, grid)
+        self.costs = [cost for cost in cell_costs for _ in range(4)] + [0.0] * 4
+        if extra is not None:
+            self.costs = [cost + more for cost, more in zip(self.costs, extra)] + [0.0] * 4
         behind = [size] * (4 * size + 4)
         for x in range(x_size):
             for y in range(y_size):
@@ -112,26 +118,29 @@ class _StateGraph:
         self.ranks: IndexArray = np.arange(16 * size + 16, dtype=np.intp)
 
 
-_GRAPHS: OrderedDict[Grid, _StateGraph] = OrderedDict()
+_GRAPHS: OrderedDict[tuple[Grid, str], _StateGraph] = OrderedDict()
 _GRAPHS_LOCK = threading.Lock()
 
 
-def _state_graph(grid: Grid) -> _StateGraph:
-    """The state graph of ``grid``, kept for the last few grids (grids are immutable)."""
+def _state_graph(grid: Grid, guidance: str) -> _StateGraph:
+    """The state graph of ``grid`` under ``guidance``, kept for the last few (grids are immutable)."""
+    key = (grid, guidance)
     with _GRAPHS_LOCK:
-        graph = _GRAPHS.get(grid)
+        graph = _GRAPHS.get(key)
         if graph is not None:
-            _GRAPHS.move_to_end(grid)
+            _GRAPHS.move_to_end(key)
             return graph
-    graph = _StateGraph(grid)
+    graph = _StateGraph(grid, guidance)
     with _GRAPHS_LOCK:
-        _GRAPHS[grid] = graph
+        _GRAPHS[key] = graph
         while len(_GRAPHS) > _GRID_CACHE_SIZE:
             _GRAPHS.popitem(last=False)
     return graph
 
 
-def heading_distances(grid: Grid, goal: Cell, turn_cost: float, both_ways: bool = False) -> array[float]:
+def heading_distances(
+    grid: Grid, goal: Cell, turn_cost: float, both_ways: bool = False, guidance: str = "none"
+) -> array[float]:
     """The least cost from every ``(cell, heading)`` state of ``grid`` to ``goal`` (module docstring).
 
     The table is an ``array('d')``: 8 bytes a state, indexed as a list.
@@ -146,17 +155,26 @@ def heading_distances(grid: Grid, goal: Cell, turn_cost: float, both_ways: bool 
         The cost of one right turn, in the unit of entry costs (``turn_time / cell_time``).
     both_ways:
         The body turns a quarter either way at ``turn_cost`` each (module docstring).
+    guidance:
+        A name of :data:`~mrmp.search.guidance.GUIDANCE_TABLE`: moves against the
+        map's lanes cost that much more (``none``: nothing more).
 
     Raises
     ------
     ValueError
-        If ``goal`` is not a free cell of the grid, or ``turn_cost`` is negative.
+        If ``goal`` is not a free cell of the grid, ``turn_cost`` is negative, or ``guidance`` unknown.
+
+    >>> from mrmp.core.heading import Heading
+    >>> row = Grid(2, 3)   # from (1, 0) to (1, 2), facing EAST: row 1's lane runs WEST
+    >>> state = 4 * 3 + int(Heading.EAST) - 1
+    >>> heading_distances(row, (1, 2), 1.0, True)[state], heading_distances(row, (1, 2), 1.0, True, "crisscross")[state]
+    (2.0, 4.0)
     """
     if not grid.is_free(goal):
         raise ValueError(f"goal {goal} is not a free cell of the grid")
     if turn_cost < 0:
         raise ValueError(f"turn_cost must not be negative, got {turn_cost}")
-    graph = _state_graph(grid)
+    graph = _state_graph(grid, guidance)
     counts = _QUARTERS if both_ways else _TURNS
     turns = [[counts[facing][moving] * turn_cost for moving in range(4)] for facing in range(4)]
     table = _search(graph, goal[0] * grid.y_size + goal[1], turns)
@@ -186,7 +204,7 @@ def _search(graph: _StateGraph, goal: int, turns: list[list[float]]) -> array[fl
             append = wave.append
             for state in frontier:
                 before = 4 * behind[state]
-                entered = table[state] + costs[state >> 2]
+                entered = table[state] + costs[state]
                 for facing, turn in enumerate(by_moving[state & 3]):
                     offer = entered + turn
                     if offer < table[before + facing]:
@@ -200,7 +218,7 @@ def _search(graph: _StateGraph, goal: int, turns: list[list[float]]) -> array[fl
                 return table
             frontier = wave if len(wave) <= _VECTOR_THRESHOLD else np.array(wave, dtype=np.intp)
         else:
-            entered = view[frontier] + graph.cost_array[frontier >> 2]
+            entered = view[frontier] + graph.cost_array[frontier]
             candidates = (4 * graph.behind_array[frontier])[:, None] + facings
             offers = entered[:, None] + by_moving_array[frontier & 3]
             candidates, offers = candidates.ravel(), offers.ravel()

@@ -93,7 +93,9 @@ class LocalRoundsSimulator(RoundsSimulator):
     Parameters are those of :class:`~mrmp.sim.rounds.RoundsSimulator`.
 
     ``step_ticks`` (faulty networks only; None for the default) is the length
-    of a step in ticks.
+    of a step in ticks. A scenario with a task stream (a League of Robot
+    Runners problem) lasts ``max_ticks`` steps, that is ``max_ticks x
+    step_ticks`` ticks, since its limit counts the competition's steps.
 
     Raises
     ------
@@ -106,6 +108,8 @@ class LocalRoundsSimulator(RoundsSimulator):
     reliable_type: type[ReliablePibtRobot] = ReliablePibtRobot
     """The brain over a faulty network."""
     robots: list[LocalPibtRobot]  # type: ignore[assignment]
+    steps_take_step_ticks = True
+    """Whether every step lasts ``step_ticks`` ticks (a simulator whose robots end their own steps says no)."""
 
     def __init__(
         self,
@@ -126,6 +130,8 @@ class LocalRoundsSimulator(RoundsSimulator):
         if not self.perfect:
             self.robot_type = self.reliable_type
         super().__init__(scenario, random_ties, on_tick, tie_penalties)
+        if scenario.tasks is not None and scenario.max_ticks is not None and self.steps_take_step_ticks:
+            self.max_ticks = scenario.max_ticks * step_ticks  # a task stream's run (LoRR's) lasts its steps
         for robot in self.robots:
             if isinstance(robot, ReliablePibtRobot):
                 robot.retry = self.retry

@@ -135,7 +135,9 @@ class RoundsSimulator:
         self.body = body_model(options.body)
         turning = self.body.turns_in_place
         self.robots: list[PibtRobot] = []
-        turning_options: dict[str, Any] = {"turning": True, "dead_end_bonus": DEAD_END_BONUS} if turning else {}
+        turning_options: dict[str, Any] = (
+            {"turning": True, "dead_end_bonus": DEAD_END_BONUS, "guidance": options.guidance} if turning else {}
+        )
         for index, spec in enumerate(scenario.robots):
             goal = flat.index(spec.goal)
             start = flat.index(spec.start)

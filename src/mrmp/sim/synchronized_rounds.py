@@ -83,6 +83,7 @@ class SynchronizedRoundsSimulator(LiveRoundsSimulator):
     robot_type = SynchronizedPibtRobot
     reliable_type: type[ReliablePibtRobot] = SynchronizedPibtRobot
     robots: list[SynchronizedPibtRobot]  # type: ignore[assignment]
+    steps_take_step_ticks = False
 
     _ended: dict[int, dict[int, int]]
     """Per step, the cell each robot that ended it ended on -> the cell it began on (:meth:`_record_steps`)."""

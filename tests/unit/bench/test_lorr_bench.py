@@ -25,6 +25,7 @@ def fake_start_kit(folder: Path) -> Path:
         (["--start-kit", "{kit}", "--steps", "0"], "--steps: must be between 1 and"),
         (["--start-kit", "{kit}", "--plan-ms", "0"], "--plan-ms: must be between 1 and 60000"),
         (["--start-kit", "{kit}", "--sequencings", "local,chaos"], "--sequencings: expected some of driver, local"),
+        (["--start-kit", "{kit}", "--guidances", "lanes"], "--guidances: expected some of none, crisscross"),
     ],
 )
 def test_bad_input_is_one_line_with_exit_code_2(arguments: list[str], message: str, tmp_path: Path) -> None:

@@ -113,6 +113,7 @@ def test_mrmp_run_takes_a_lorr_problem_and_writes_its_output(tmp_path: Path) -> 
         (["--steps", "0"], "--steps: must be between 1 and"),
         (["--lorr-output", "x.json", "--body", "omni"], "--lorr-output: LoRR's actions are those of turning bodies"),
         (["--live"], "--lifelong: lifelong runs are simulated"),
+        (["--lorr-output", "x.json", "--loss", "0.1"], "--lorr-output: LoRR's output has one action a step"),
     ],
 )
 def test_bad_lorr_runs_get_one_line(arguments: list[str], message: str) -> None:

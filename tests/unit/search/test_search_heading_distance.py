@@ -86,8 +86,9 @@ def test_blocked_cells_are_unreachable_and_bad_arguments_are_refused():
         heading_distances(grid, (0, 0), -1.0)
 
 
-def dijkstra_table(grid: Grid, goal, turn_cost: float, both_ways: bool) -> list[float]:
-    """Dijkstra over the states, forwards from each state's moves, written apart from the module's search."""
+def dijkstra_table(grid: Grid, goal, turn_cost: float, both_ways: bool, lanes=None) -> list[float]:
+    """Dijkstra over the states, forwards from each state's moves, written apart from the module's search; ``lanes``
+    gives a move's extra cost from the cell it enters and its direction."""
     import heapq
 
     from mrmp.core.heading import quarter_turns, right_turns
@@ -102,7 +103,7 @@ def dijkstra_table(grid: Grid, goal, turn_cost: float, both_ways: bool) -> list[
             dx, dy = moving.delta
             ahead = (cell[0] + dx, cell[1] + dy)
             if grid.is_free(ahead):
-                step = count(facing, moving) * turn_cost + grid.cost(ahead)
+                step = count(facing, moving) * turn_cost + grid.cost(ahead) + (lanes(ahead, moving) if lanes else 0.0)
                 incoming.setdefault((ahead, moving), []).append(((cell, facing), step))
     while queue:
         value, state = heapq.heappop(queue)
@@ -132,3 +133,24 @@ def test_large_maps_give_dijkstras_table_whether_waves_run_in_python_or_numpy(mo
     for turn_cost, both_ways in ((1.0, True), (0.5, False)):
         expected = dijkstra_table(grid, goal, turn_cost, both_ways)
         assert list(heading_distances(grid, goal, turn_cost, both_ways)) == pytest.approx(expected)
+
+
+def against_crisscross(cell, moving: Heading) -> float:
+    """The crisscross lanes as the documentation states them: even rows EAST, odd WEST; even columns NORTH, odd SOUTH."""
+    x, y = cell
+    if moving in (Heading.EAST, Heading.WEST):
+        return 0.0 if moving == (Heading.EAST if x % 2 == 0 else Heading.WEST) else 1.0
+    return 0.0 if moving == (Heading.NORTH if y % 2 == 0 else Heading.SOUTH) else 1.0
+
+
+@pytest.mark.parametrize("seed", range(3))
+def test_crisscross_guidance_adds_one_step_to_every_move_against_its_lane(seed):
+    rng = random.Random(seed)
+    rows = ["".join("@" if rng.random() < 0.2 else "." for _ in range(30)) for _ in range(20)]
+    grid = Grid.from_rows(rows)
+    goal = rng.choice(grid.free_cells())
+    expected = dijkstra_table(grid, goal, 1.0, True, against_crisscross)
+    assert list(heading_distances(grid, goal, 1.0, True, "crisscross")) == pytest.approx(expected)
+    assert list(heading_distances(grid, goal, 1.0, True, "none")) == list(heading_distances(grid, goal, 1.0, True))
+    with pytest.raises(ValueError, match="unknown guidance 'lanes'"):
+        heading_distances(grid, goal, 1.0, True, "lanes")
