@@ -135,3 +135,19 @@ def test_a_robot_arrives_when_its_body_enters_its_goal_for_the_last_time(tmp_pat
         lines = (tmp_path / f"trace-{index}.jsonl").read_text().splitlines()
         left = [event["t"] for event in map(json.loads, lines) if event.get("event") == "leave"]  # a move's end
         assert robot.time_s == pytest.approx(left[-1] - fleet_start if left else 0.0, abs=0.02), index
+
+
+def test_a_live_robot_ranks_its_moves_by_its_guided_tables(tmp_path):
+    """The live brain reads ``policy.guidance`` as the simulated one does (``tests/unit/sim/test_guidance.py``): on two
+    rows whose lower one runs WEST, a turning robot going EAST along it leaves it only when guided."""
+    from mrmp.core.heading import Heading
+
+    robot = (RobotSpec("a", (1, 0), (1, 11), Heading.EAST),)
+    rows = {}
+    for guidance in ("none", "crisscross"):
+        policy = PolicyOptions(name="pibt", body="turning", guidance=guidance)
+        scenario = Scenario(Grid(2, 12), robot, timing=Timing(1.0, 0.5), policy=policy, name="lanes")
+        result = run_virtual(scenario, VirtualOptions(results=tmp_path / guidance, time_scale=10))
+        assert result.success and result.collisions == [], result.stop_reason
+        rows[guidance] = {cell[0] for cell in believed_paths(tmp_path / guidance, 1)[0]}
+    assert rows == {"none": {1}, "crisscross": {0, 1}}
