@@ -231,9 +231,9 @@ def with_policy_flags(command: Callable[..., None]) -> Callable[..., None]:
     >>> def show(policy_settings: dict[str, Any]) -> None:
     ...     print(policy_settings)
     >>> list(inspect.signature(with_policy_flags(show)).parameters)
-    ['resolve', 'heading_aware', 'radius', 'swap', 'search', 'sequencing', 'synchronizer', 'body']
+    ['resolve', 'heading_aware', 'radius', 'swap', 'search', 'sequencing', 'synchronizer', 'body', 'guidance']
     >>> with_policy_flags(show)(radius=3)
-    {'resolve': None, 'heading_aware': None, 'radius': 3, 'swap': None, 'search': None, 'sequencing': None, 'synchronizer': None, 'body': None}
+    {'resolve': None, 'heading_aware': None, 'radius': 3, 'swap': None, 'search': None, 'sequencing': None, 'synchronizer': None, 'body': None, 'guidance': None}
     """
     types = setting_types(PolicyOptions)
     flags = [

@@ -124,7 +124,7 @@ def setting_types(options_type: type) -> dict[str, type]:
     >>> from mrmp.core.scenario import PolicyOptions
     >>> {name: kind.__name__ for name, kind in setting_types(PolicyOptions).items()}  # doctest: +NORMALIZE_WHITESPACE
     {'resolve': 'str', 'heading_aware': 'bool', 'radius': 'int', 'swap': 'bool', 'search': 'str', 'sequencing': 'str',
-     'synchronizer': 'str', 'body': 'str'}
+     'synchronizer': 'str', 'body': 'str', 'guidance': 'str'}
     """
     hints = typing.get_type_hints(options_type)
     return {field.name: hints[field.name] for field, _ in settings(options_type)}

@@ -157,8 +157,8 @@ def csv_row(record: Mapping[str, Any]) -> dict[str, Any]:
 def records_to_csv(records: Iterable[Mapping[str, Any]]) -> str:
     """The CSV text of records (header first; null as an empty cell).
 
-    >>> records_to_csv([{"run_id": "a", "agents": 5}]).splitlines()[1].split(",")[:10]
-    ['a', '', '', '', '', '', '', '', '5', '']
+    >>> records_to_csv([{"run_id": "a", "agents": 5}]).splitlines()[1].split(",")[:11]
+    ['a', '', '', '', '', '', '', '', '', '5', '']
     """
     buffer = io.StringIO()
     writer = csv.DictWriter(buffer, fieldnames=CSV_COLUMNS, lineterminator="\n")

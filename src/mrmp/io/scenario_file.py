@@ -990,7 +990,7 @@ def _policy_text(policy: PolicyOptions) -> str:
 
     >>> _policy_text(PolicyOptions())  # doctest: +NORMALIZE_WHITESPACE
     'name: "thesis", resolve: "divert", heading_aware: false, radius: 2, swap: true, search: "default",
-     sequencing: "local", synchronizer: "clock", body: "omni"'
+     sequencing: "local", synchronizer: "clock", body: "omni", guidance: "none"'
     """
     items = [f"name: {_quote(policy.name)}"]
     items += [f"{setting.yaml_key}: {_setting_text(getattr(policy, option.name))}" for option, setting in POLICY_SETTINGS]
