@@ -58,6 +58,7 @@ from mrmp.core.errors import NoPathError
 from mrmp.core.grid import Grid
 from mrmp.search.flat_grid import UNREACHABLE, FlatGrid, flat_grid
 from mrmp.search.graph import SizedGridMap
+from mrmp.search.wavefront import IndexArray, dedupe
 
 __all__ = ["DistanceTable", "distance_table"]
 
@@ -68,7 +69,6 @@ _GRID_CACHE_SIZE = 8
 _TABLE_CACHE_CELLS = 1 << 21
 """How many table cells (8 bytes each) the per-grid table cache may hold in all."""
 
-IndexArray = npt.NDArray[np.intp]
 
 
 class _ReverseSearch:
@@ -106,18 +106,6 @@ class _ReverseSearch:
         self.lock = threading.Lock()
 
 
-def _dedupe(cells: IndexArray, owner: IndexArray, ranks: IndexArray) -> IndexArray:
-    """One copy of each value of ``cells``, via the ``owner`` scratch array (no sort).
-
-    Each position writes its rank into ``owner[cell]``; exactly one write per
-    cell survives (NumPy does not say which), and only that position matches.
-    """
-    order = ranks[: cells.size]
-    owner[cells] = order
-    unique: IndexArray = cells[owner[cells] == order]
-    return unique
-
-
 def _breadth_first(search: _ReverseSearch, goal: int, step: float) -> array[float]:
     """Distances to ``goal`` when entering any free cell costs ``step`` (hybrid wavefront BFS)."""
     reverse, reverse_array, ranks = search.reverse, search.reverse_array, search.ranks
@@ -151,7 +139,7 @@ def _breadth_first(search: _ReverseSearch, goal: int, step: float) -> array[floa
                 break
             if owner is None:
                 owner = np.empty(search.size + 1, dtype=np.intp)
-            candidates = _dedupe(candidates, owner, ranks)
+            candidates = dedupe(candidates, owner, ranks)
             unseen_view[candidates] = False
             view[candidates] = d
             frontier = candidates if candidates.size > _VECTOR_THRESHOLD else candidates.tolist()
@@ -197,7 +185,7 @@ def _label_correcting(search: _ReverseSearch, goal: int) -> array[float]:
             np.minimum.at(view, candidates, offers[better])
             if owner is None:
                 owner = np.empty(search.size + 1, dtype=np.intp)
-            candidates = _dedupe(candidates, owner, ranks)
+            candidates = dedupe(candidates, owner, ranks)
             frontier = candidates if candidates.size > _VECTOR_THRESHOLD else candidates.tolist()
     dist[search.size] = math.inf
     return dist

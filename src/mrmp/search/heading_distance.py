@@ -60,12 +60,12 @@ from array import array
 from collections import OrderedDict
 
 import numpy as np
-import numpy.typing as npt
 
 from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
 from mrmp.core.heading import HEADINGS, quarter_turns, right_turns
 from mrmp.search.guidance import guidance_costs
+from mrmp.search.wavefront import IndexArray, dedupe
 
 __all__ = ["heading_distances"]
 
@@ -78,7 +78,6 @@ _VECTOR_THRESHOLD = 32
 _GRID_CACHE_SIZE = 8
 """How many grids keep their state graph cached."""
 
-IndexArray = npt.NDArray[np.intp]
 
 
 class _StateGraph:
@@ -229,17 +228,5 @@ def _search(graph: _StateGraph, goal: int, turns: list[list[float]]) -> array[fl
             np.minimum.at(view, candidates, offers)
             if owner is None:
                 owner = np.empty(4 * size + 4, dtype=np.intp)
-            candidates = _dedupe(candidates, owner, graph.ranks)
+            candidates = dedupe(candidates, owner, graph.ranks)
             frontier = candidates if candidates.size > _VECTOR_THRESHOLD else candidates.tolist()
-
-
-def _dedupe(states: IndexArray, owner: IndexArray, ranks: IndexArray) -> IndexArray:
-    """One copy of each value of ``states``, via the ``owner`` scratch array (no sort).
-
-    Each position writes its rank into ``owner[state]``; exactly one write per
-    state survives (NumPy does not say which), and only that position matches.
-    """
-    order = ranks[: states.size]
-    owner[states] = order
-    unique: IndexArray = states[owner[states] == order]
-    return unique
