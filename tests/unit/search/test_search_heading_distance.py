@@ -9,9 +9,8 @@ from mrmp.core.errors import NoPathError
 from mrmp.core.grid import Grid
 from mrmp.core.heading import HEADINGS, Heading
 from mrmp.core.scenario import Timing
-from mrmp.search import astar
+from mrmp.search import astar, heading_distance
 from mrmp.search.graph import path_cost
-from mrmp.search import heading_distance
 from mrmp.search.heading_distance import heading_distances
 
 
