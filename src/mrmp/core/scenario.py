@@ -170,6 +170,17 @@ class Scenario:
         """A copy with some fields replaced (a frozen dataclass ``replace``)."""
         return replace(self, **changes)  # type: ignore[arg-type]
 
+    @property
+    def perfect_network(self) -> bool:
+        """Whether the simulators deliver every message at once and once: no fault on the network and no link
+        with faults of its own (any link counts, as the simulators keep a faulty network's bookkeeping for it).
+
+        >>> from mrmp.core.grid import Grid
+        >>> Scenario(Grid(1, 1), ()).perfect_network, Scenario(Grid(1, 1), (), network=NetworkFaults(loss=0.1)).perfect_network
+        (True, False)
+        """
+        return self.network.is_perfect and not self.links
+
     def worst_faults(self) -> NetworkFaults:
         """The worst loss, delay, duplication and reordering over the network and all its links.
 

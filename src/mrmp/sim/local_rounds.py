@@ -59,7 +59,7 @@ from mrmp.robot.pibt_reliable import ReliablePibtRobot
 from mrmp.robot.pibt_robot import RESERVE_RADIUS
 from mrmp.sim.metrics import default_max_ticks
 from mrmp.sim.rounds import NO_ROBOT, RoundsSimulator
-from mrmp.sim.ticking import TickObserver, link_faults, run_result, scenario_network
+from mrmp.sim.ticking import TickObserver, run_result, scenario_network
 
 __all__ = ["STEP_RETRIES", "LocalRoundsSimulator"]
 
@@ -119,7 +119,7 @@ class LocalRoundsSimulator(RoundsSimulator):
         tie_penalties: bool | None = None,
         step_ticks: int | None = None,
     ) -> None:
-        self.perfect = scenario.network.is_perfect and not link_faults(scenario)
+        self.perfect = scenario.perfect_network
         worst = scenario.worst_faults()
         self.retry = 2 * worst.delay_max + 1
         if step_ticks is None:

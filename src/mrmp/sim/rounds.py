@@ -171,7 +171,7 @@ class RoundsSimulator:
         self._durations: list[list[float]] = [[] for _ in scenario.robots]
         self._random = stream_random(scenario.seed, Stream.NETWORK)
         self._links = link_faults(scenario)
-        self._perfect = scenario.network.is_perfect and not self._links
+        self._perfect = scenario.perfect_network
         self._near: dict[int, list[tuple[int, ...] | None]] = {}
         self._occupant: list[int] = []  # robot on every flat cell this step, NO_ROBOT where none
         self._receivers = [robot.receive_once for robot in self.robots]  # the perfect network's deliveries
