@@ -64,6 +64,7 @@ import numpy as np
 from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
 from mrmp.core.heading import HEADINGS, quarter_turns, right_turns
+from mrmp.search.flat_grid import flat_grid
 from mrmp.search.guidance import guidance_costs
 from mrmp.search.wavefront import IndexArray, dedupe
 
@@ -95,11 +96,11 @@ class _StateGraph:
         x_size, y_size = grid.x_size, grid.y_size
         size = x_size * y_size
         self.size = size
-        cell_costs = [float(grid.cost((x, y))) for x in range(x_size) for y in range(y_size)]
+        per_state = [cost for cost in flat_grid(grid).costs for _ in range(4)]
         extra = guidance_costs(guidance, grid)
-        self.costs = [cost for cost in cell_costs for _ in range(4)] + [0.0] * 4
         if extra is not None:
-            self.costs = [cost + more for cost, more in zip(self.costs, extra)] + [0.0] * 4
+            per_state = [cost + more for cost, more in zip(per_state, extra, strict=True)]
+        self.costs = per_state + [0.0] * 4
         behind = [size] * (4 * size + 4)
         for x in range(x_size):
             for y in range(y_size):
