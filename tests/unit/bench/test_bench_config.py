@@ -1,5 +1,7 @@
-"""Benchmark configurations: one-line errors with file:line, matrix expansion, stable run ids."""
+"""Benchmark configurations: one-line errors with file:line, matrix expansion, stable run ids; entries naming League of
+Robot Runners problems (runs, records)."""
 
+import json
 import shutil
 from pathlib import Path
 
@@ -9,6 +11,10 @@ from mrmp.core.errors import InputError
 from mrmp.core.scenario import NetworkFaults
 from mrmp.experiments.bench_config import bench_config_from_text, load_bench_config
 from mrmp.experiments.matrix import BenchRun
+from mrmp.experiments.records import build_scenario, execute_run
+from mrmp.io.lorr import load_lorr_scenario
+from mrmp.io.report_input import record_from_dict
+from mrmp.sim.simulator import simulate
 
 ROOT = Path(__file__).resolve().parents[3]
 MAPS = ROOT / "maps"
@@ -37,10 +43,11 @@ max_ticks: 300
 
 @pytest.fixture
 def folder(tmp_path):
-    """A folder holding maps/ with the empty-32-32 files."""
+    """A folder holding maps/ with the empty-32-32 files, and lorr/ with the LoRR example problem."""
     (tmp_path / "maps").mkdir()
     for name in ("empty-32-32.map", "empty-32-32-random-1.scen"):
         shutil.copy(MAPS / name, tmp_path / "maps" / name)
+    shutil.copytree(ROOT / "examples" / "lorr", tmp_path / "lorr")
     return tmp_path
 
 
@@ -120,8 +127,13 @@ def test_per_map_agents_and_skipped_counts_are_notes_not_errors(folder):
     ],
 )
 def test_errors_are_one_line_each_with_file_and_line(folder, change, expected):
-    text = GOOD.replace(*change)
-    assert text != GOOD
+    assert_reported(folder, GOOD, change, expected)
+
+
+def assert_reported(folder, config, change, expected):
+    """``config`` changed by ``change`` is refused with ``expected`` (``FILE:LINE: ...``, the file in ``folder``)."""
+    text = config.replace(*change)
+    assert text != config
     found = problems(folder, text)
     assert any(line.startswith(str(folder / expected.split(":", 1)[0]) + ":" + expected.split(":", 1)[1]) for line in found), found
     assert all("\n" not in line for line in found)
@@ -159,3 +171,73 @@ def test_the_example_configurations_read(name):
     if name == "generated":
         assert all(run.generator is not None for run in config.runs)
         assert {dict(run.generator)["kind"] for run in config.runs} == {"random", "maze", "warehouse", "room"}
+
+
+LORR = """\
+maps:
+  - lorr: lorr/maze-example_40.json
+    agents: [10, 40]
+policies: [pibt]
+faults:
+  - {loss: 0.0}
+  - {loss: 0.2}
+max_ticks: 60
+"""
+
+
+def test_a_lorr_entry_runs_its_first_n_robots_lifelong_for_max_ticks_steps(folder):
+    config = read(folder, LORR)
+    assert [(run.agents, run.faults.loss) for run in config.runs] == [(10, 0.0), (10, 0.2), (40, 0.0), (40, 0.2)]
+    assert all(run.lifelong and run.lorr == str(folder / "lorr" / "maze-example_40.json") for run in config.runs)
+    assert {run.map_name for run in config.runs} == {"maze-example_40"}
+    scenario = build_scenario(config.runs[0])
+    assert len(scenario.robots) == 10 and scenario.max_ticks == 60 and scenario.policy.body == "turning"
+    assert scenario.tasks is not None and scenario.tasks.reveal == 15  # numTasksReveal 1.5 x 10 robots
+
+
+def test_a_lorr_run_records_the_tasks_the_simulator_finishes_on_the_same_problem(folder):
+    run = read(folder, LORR).runs[2]  # all 40 robots, a perfect network
+    record = execute_run(run)
+    assert record["status"] == "done" and record["collisions"] == 0
+    direct = simulate(load_lorr_scenario(folder / "lorr" / "maze-example_40.json", 60))
+    assert direct.tasks is not None and record["tasks_finished"] == direct.tasks.finished > 0
+    typed = record_from_dict(json.loads(json.dumps(record)))
+    assert typed.tasks_finished == record["tasks_finished"] and typed.lorr == run.lorr
+
+
+def test_without_agents_a_lorr_entry_takes_the_problems_team_and_more_robots_are_a_note(folder):
+    config = read(folder, LORR.replace("    agents: [10, 40]\n", ""))
+    assert {run.agents for run in config.runs} == {40}
+    config = read(folder, LORR.replace("[10, 40]", "[10, 41]"))
+    assert {run.agents for run in config.runs} == {10}
+    assert config.notes == ("skipped N=41 on maze-example_40: its teamSize is 40",)
+
+
+def test_run_ids_of_lorr_runs_name_the_problem_and_leave_other_ids_unchanged(folder, tmp_path_factory):
+    ids = [run.run_id for run in read(folder, LORR).runs]
+    moved = tmp_path_factory.mktemp("elsewhere")
+    shutil.copytree(folder / "lorr", moved / "lorr")
+    assert ids == [run.run_id for run in read(moved, LORR).runs]
+    run = read(folder, LORR).runs[0]
+    assert "lorr" in run.identity() and "lorr" not in run.with_changes(lorr=None).identity()
+
+
+@pytest.mark.parametrize(
+    ("change", "expected"),
+    [
+        (("policies: [pibt]", "policies: [pibt, lacam]"), "bench.yaml:2: maps[0]: LoRR problems are lifelong: lacam is a central planner"),
+        (("lorr/maze-example_40.json", "lorr/missing.json"), "bench.yaml:2: maps[0].lorr: LoRR problem file not found"),
+        (("    agents: [10, 40]\n", "    agents: [10, 40]\n    scen: [x.scen]\n"), "bench.yaml:4: maps[0]: unknown key 'scen'"),
+    ],
+)
+def test_errors_of_lorr_entries_are_one_line_each_with_file_and_line(folder, change, expected):
+    assert_reported(folder, LORR, change, expected)
+
+
+def test_a_malformed_problem_is_reported_in_its_own_file_and_line(folder):
+    problem = folder / "lorr" / "maze-example_40.json"
+    data = json.loads(problem.read_text())
+    data["teamSize"] = "many"
+    problem.write_text(json.dumps(data, indent=4))
+    found = problems(folder, LORR)
+    assert any(line.startswith(str(problem)) and "teamSize" in line for line in found), found
