@@ -45,6 +45,7 @@ import subprocess
 import sys
 import tempfile
 import time
+from collections.abc import Iterator
 from dataclasses import asdict, dataclass, replace
 from pathlib import Path
 
@@ -158,24 +159,37 @@ def start_kit_run(program: Path, problem: Path, steps: int, plan_ms: int, scratc
 
 def measure(
     program: Path, start_kit: Path, case: str, steps: int, plan_ms: int, fleets: list[tuple[str, str]], scratch: Path
-) -> list[Row]:
-    """One case, the Start-Kit first, then mrmp once per ``(sequencing, guidance)`` of ``fleets``."""
+) -> Iterator[Row]:
+    """One case, the Start-Kit first, then mrmp once per ``(sequencing, guidance)`` of ``fleets``: each row as soon as
+    it is measured."""
     problem, name = case_problem(start_kit, case, scratch)
     start_kit_tasks, start_kit_step = start_kit_run(program, problem, steps, plan_ms, scratch)
-    rows = []
+    lorr = load_lorr_scenario(problem, steps)
+    robots = len(lorr.robots)
     for sequencing, guidance in fleets:
-        scenario = load_lorr_scenario(problem, steps)
-        scenario = scenario.with_changes(policy=replace(scenario.policy, sequencing=sequencing, guidance=guidance))
+        scenario = lorr.with_changes(policy=replace(lorr.policy, sequencing=sequencing, guidance=guidance))
         started = time.perf_counter()
         result = simulate(scenario)
         wall = time.perf_counter() - started
         assert result.tasks is not None
-        robots = len(scenario.robots)
-        rows.append(Row(
+        yield Row(
             name, robots, steps, sequencing, guidance, start_kit_tasks, result.tasks.finished, start_kit_step,
             wall / max(1, result.ticks), len(result.collisions), result.messages / max(1, result.ticks * robots),
-        ))  # fmt: skip
-    return rows
+        )  # fmt: skip
+
+
+def listed(text: str, known: tuple[str, ...], option: str) -> list[str]:
+    """The comma-separated names of ``text``, each one of ``known``.
+
+    Raises
+    ------
+    InputError
+        Naming ``option`` when a name is not known.
+    """
+    names = text.split(",")
+    if any(name not in known for name in names):
+        raise InputError(f"{option}: expected some of {', '.join(known)}, got {text!r}")
+    return names
 
 
 def main() -> int:
@@ -188,13 +202,11 @@ def main() -> int:
     parser.add_argument("--guidances", default="crisscross,none", help="mrmp's lanes, comma-separated")
     parser.add_argument("--out", type=Path, default=Path("lorr-results.jsonl"), help="JSON lines, one per case")
     arguments = parser.parse_args()
-    sequencings = arguments.sequencings.split(",")
-    unknown = [name for name in sequencings if name not in SEQUENCINGS]
-    if unknown:
-        return fail(f"--sequencings: expected some of {', '.join(SEQUENCINGS)}, got {arguments.sequencings!r}")
-    guidances = arguments.guidances.split(",")
-    if any(name not in GUIDANCES for name in guidances):
-        return fail(f"--guidances: expected some of {', '.join(GUIDANCES)}, got {arguments.guidances!r}")
+    try:
+        sequencings = listed(arguments.sequencings, SEQUENCINGS, "--sequencings")
+        guidances = listed(arguments.guidances, GUIDANCES, "--guidances")
+    except InputError as error:
+        return fail(str(error))
     fleets = [(sequencing, guidance) for sequencing in sequencings for guidance in guidances]
     start_kit = arguments.start_kit.resolve()
     if not (start_kit / "CMakeLists.txt").is_file() or not (start_kit / "default_planner").is_dir():
@@ -215,23 +227,27 @@ def main() -> int:
     with tempfile.TemporaryDirectory(prefix="mrmp-lorr-") as folder:
         scratch = Path(folder)
         for case in arguments.cases.split(","):
+            rows = measure(program, start_kit, case, arguments.steps, arguments.plan_ms, fleets, scratch)
             try:
-                rows = measure(program, start_kit, case, arguments.steps, arguments.plan_ms, fleets, scratch)
+                for row in rows:
+                    write_row(arguments.out, row)
             except InputError as error:
                 return fail(str(error))
             except subprocess.CalledProcessError as error:
                 return fail(f"{case}: the Start-Kit failed with exit code {error.returncode}")
-            for row in rows:
-                with arguments.out.open("a") as out:
-                    out.write(json.dumps({**asdict(row), "task_ratio": row.task_ratio, "time_ratio": row.time_ratio}) + "\n")
-                print(
-                    f"{row.problem:<26} {row.robots:>5} {row.steps:>5} {row.sequencing:>10} {row.guidance:>10} "
-                    f"{row.start_kit_tasks:>8} {row.mrmp_tasks:>10} {row.task_ratio:>6.3f} {row.start_kit_step_s:>9.4f} "
-                    f"{row.mrmp_step_s:>11.4f} {row.time_ratio:>6.2f} {row.mrmp_collisions:>4} "
-                    f"{row.mrmp_messages_per_robot_step:>14.2f}",
-                    flush=True,
-                )
     return 0
+
+
+def write_row(out: Path, row: Row) -> None:
+    """Append ``row`` to ``out`` (JSON lines), then print it."""
+    with out.open("a") as stream:
+        stream.write(json.dumps({**asdict(row), "task_ratio": row.task_ratio, "time_ratio": row.time_ratio}) + "\n")
+    print(
+        f"{row.problem:<26} {row.robots:>5} {row.steps:>5} {row.sequencing:>10} {row.guidance:>10} "
+        f"{row.start_kit_tasks:>8} {row.mrmp_tasks:>10} {row.task_ratio:>6.3f} {row.start_kit_step_s:>9.4f} "
+        f"{row.mrmp_step_s:>11.4f} {row.time_ratio:>6.2f} {row.mrmp_collisions:>4} {row.mrmp_messages_per_robot_step:>14.2f}",
+        flush=True,
+    )
 
 
 if __name__ == "__main__":
