@@ -458,6 +458,12 @@ def print_result(result: RunResult, console: Console) -> None:
             f"messages {result.messages}, {spent} {result.wall_time_s:.1f} s"
         )
         console.print(f"  dropped by robots: {rejected}; injected faults: {injected}", markup=False)
+        if result.tasks is not None:
+            errands = sum(robot.goals_reached for robot in result.robots)
+            console.print(f"  tasks finished within the run's steps: {result.tasks.finished} ({errands} errands), by the task desk's book")
+            not_visited = result.network.get("tasks_errands_not_visited", 0)
+            if not_visited:
+                console.print(f"  [red]{not_visited} of those errands were never entered by their robot's body (referee)[/red]")
         if network.get("missed_lines"):
             console.print(f"  grid lines missed by bodies: {network['missed_lines']} (positions believed wrong from then on)")
     elif result.tasks is not None:
@@ -650,8 +656,8 @@ def _validate_run(scenario: Scenario, request: RunRequest) -> None:
     """Refuse, before anything runs, the combinations of options that cannot be honoured."""
     entry = policy_entry(scenario.policy.name)
     planned = request.planner is not None  # the plan replaces the policy: its limits do not apply
-    if scenario.lifelong and (request.live or planned):
-        raise InputError(Problem("--lifelong", "lifelong runs are simulated with a decentralized policy (not --live, not --planner)"))
+    if scenario.lifelong and planned:
+        raise InputError(Problem("--lifelong", "lifelong runs are decentralized: no --planner"))
     if request.unsafe and entry.always_guarded and not planned:
         raise InputError(Problem("--unsafe", f"{entry.name} always enters cells through the safety layer; it has no unsafe form"))
     if request.live and entry.live_driver is None and not planned:
@@ -716,10 +722,13 @@ def _validate_live(scenario: Scenario, request: RunRequest) -> None:
     if not 1 <= request.robots_per_process <= MAX_LIVE_ROBOTS:
         reason = f"must be 1 to {MAX_LIVE_ROBOTS}, got {request.robots_per_process}"
         raise InputError(Problem("--robots-per-process", reason))
-    from mrmp.live.launcher import check_hosting
+    from mrmp.live.launcher import check_hosting, check_tasks
 
     planned = request.planner is not None
     check_hosting(request.robots_per_process, request.transport, bool(request.kill), planned, request.ros2)  # before any plan
+    check_tasks(scenario, request.transport, planned)
+    if request.lorr_output is not None:
+        raise InputError(Problem("--lorr-output", "writes a simulated run (LoRR's output has one action a step of every robot)"))
     _fraction(request.jitter, "--jitter")
     _fraction(request.miss_line, "--miss-line")
     if request.results is not None:
@@ -1100,6 +1109,7 @@ def agent(
     transport: Annotated[str, typer.Option(help="How the robots talk.", metavar=choices(TRANSPORTS.names), autocompletion=lambda: list(TRANSPORTS.names))] = "udp",
     bind: Annotated[str, typer.Option(help="UDP: address to receive on.", metavar="HOST:PORT")] = "127.0.0.1:9001",
     peer: Annotated[list[str] | None, typer.Option(help="UDP: a peer (repeat for each).", metavar="ID=HOST:PORT", show_default=False)] = None,
+    task_desk: Annotated[str, typer.Option(help="UDP, lifelong runs: the task desk's address (mrmp run --live starts it).", metavar="HOST:PORT", show_default="none")] = "",
     group: Annotated[str, typer.Option(help="Multicast: the group.", metavar="HOST:PORT")] = "239.255.77.1:47000",
     interface: Annotated[str, typer.Option(help="Multicast: IPv4 address of the interface to use.", metavar="IPV4")] = "127.0.0.1",
     listen: Annotated[str, typer.Option(help="Zenoh: this robot's endpoint, e.g. tcp/127.0.0.1:7447.", metavar="ENDPOINT", show_default="none")] = "",
@@ -1162,8 +1172,10 @@ def agent(
             raise InputError(Problem("--robot", "names a robot twice"))
         if len(robot) > 1 and (plan is not None or ros2 or drive != "simulated"):
             raise InputError(Problem("--robot", "one robot per process with --plan, --ros2 or --drive ros2"))
+        _check_task_desk(scenario, transport, task_desk)
         transport_values = {
             "bind": bind, "peer": peer, "group": group, "interface": interface, "listen": listen, "connect": connect, "fleet": fleet,
+            "task_desk": task_desk,
         }
         specs = TRANSPORTS.hosted(transport, transport_values, ids, robot)
         missing = specs[0].entry.unavailable()
@@ -1208,6 +1220,22 @@ def agent(
         raise _fail(error.problems) from None
     raise typer.Exit(0 if all(report.arrived for report in reports) else 1)
 
+
+
+def _check_task_desk(scenario: Scenario, transport: str, task_desk: str) -> None:
+    """Refuse a lifelong robot without its task desk, or one whose policy or transport cannot reach a desk, and a
+    desk for a robot that is not lifelong."""
+    if not scenario.lifelong:
+        if task_desk:
+            raise InputError(Problem("--task-desk", "a task desk serves a lifelong run (lifelong: true)"))
+        return
+    entry = policy_entry(scenario.policy.name)
+    if not entry.live_tasks:
+        raise InputError(Problem("--policy", f"{entry.name} does not take tasks live (a lifelong run live is pibt's)"))
+    if not TRANSPORTS.entry(transport).reaches_desk:
+        raise InputError(Problem("--transport", f"a lifelong robot reaches its task desk over udp, not {transport}"))
+    if not task_desk:
+        raise InputError(Problem("--task-desk", "a lifelong robot takes its tasks from a task desk: give its HOST:PORT"))
 
 
 def _ros2_domain(option: str = "--ros2") -> int:

@@ -12,6 +12,12 @@ parent-death signal before it runs anything, and watches the launcher
 Each robot's transport arguments come from the transport's entry in
 :data:`~mrmp.live.transport_table.TRANSPORTS`, for a fleet laid out on
 loopback (:class:`~mrmp.live.transport_entry.FleetLayout`).
+
+A lifelong run with a task stream (a League of Robot Runners problem) has a
+task desk too (:mod:`mrmp.live.task_desk`): a thread of the launcher with a
+socket of its own, which gives the robots their tasks as the world's task
+manager does, and writes ``tasks.json``. The run lasts the scenario's
+``max_ticks`` steps of every robot; tasks finished within them are counted.
 """
 
 from __future__ import annotations
@@ -35,15 +41,21 @@ from mrmp.core.limits import MAX_RUN_SECONDS
 from mrmp.core.progress import LiveProgress
 from mrmp.core.result import RunResult
 from mrmp.core.scenario import Scenario
+from mrmp.core.seeds import Stream, derive_seed
+from mrmp.core.tasks import TaskLog
 from mrmp.io.lifetime import preexec_dying_with
 from mrmp.io.live_files import prepare_folder, read_json, write_key_file
 from mrmp.io.plans import write_plan, write_share
 from mrmp.io.scenario_file import save_scenario
 from mrmp.live.agent import AgentTiming
+from mrmp.live.referee import errands_not_visited
 from mrmp.live.results import ideal_makespan, live_result
-from mrmp.live.transport import LiveFaults
+from mrmp.live.task_desk import TaskDesk, desk_problem
+from mrmp.live.task_server import TaskServer
+from mrmp.live.transport import LiveFaults, UdpTransport
 from mrmp.live.transport_entry import FleetLayout
 from mrmp.live.transport_table import FAULTS, TRANSPORTS
+from mrmp.protocol.auth import Opener, Sealer
 from mrmp.sim.policy_table import body_problem, policy_entry
 
 
@@ -82,6 +94,7 @@ class _RunFiles:
     results: Path
     scenario: Path
     key: Path
+    key_bytes: bytes
     done: Path
     shares: list[Path]
     """Each robot's share of the central plan, by index (empty without a plan)."""
@@ -136,11 +149,18 @@ def run_live(
     body_issue = body_problem(scenario, live=True, planned=options.plan is not None)
     if body_issue is not None:
         raise InputError(body_issue)
+    check_tasks(scenario, options.transport, options.plan is not None)
     files = _write_run_files(scenario, options, ids)
     session = random.SystemRandom().randrange(1, 2**31)
-    layout = FleetLayout.on_loopback(ids, fleet=f"mrmp/{session}")
+    layout = FleetLayout.on_loopback(ids, fleet=f"mrmp/{session}", desk=scenario.tasks is not None)
     timeout = options.timeout or run_timeout(scenario, options.time_scale)
-    fleet = _start_fleet(options, files, layout, session, timeout)
+    desk = _start_desk(scenario, options, files, layout, session)
+    try:
+        fleet = _start_fleet(options, files, layout, session, timeout)
+    except BaseException:
+        if desk is not None:
+            desk.stop()
+        raise
     hosting = "" if options.robots_per_process == 1 else f" ({options.robots_per_process} robots per process)"
     say(
         f"live: {len(ids)} robots in {len(fleet.agents)} processes{hosting} and a referee over {options.transport} on loopback; "
@@ -149,11 +169,69 @@ def run_live(
     note = policy_entry(scenario.policy.name).live_note if options.plan is None else ""
     if note:
         say(f"live: {note}")
-    stop_reason = _watch(fleet, options.kill, say, on_progress)
+    try:
+        stop_reason = _watch(fleet, options.kill, say, on_progress)
+    finally:
+        if desk is not None:
+            desk.stop()
     wall_time = time.monotonic() - fleet.started
     reports = [_read_if_there(files.results / f"agent-{index}.json") for index in range(len(ids))]
     verdict = _read_if_there(files.results / "referee.json")
-    return _judge(scenario, options, reports, verdict, _overall_stop_reason(stop_reason, reports), wall_time)
+    result = _judge(scenario, options, reports, verdict, _overall_stop_reason(stop_reason, reports), wall_time)
+    return result if desk is None else with_desk(result, desk.desk, verdict)
+
+
+def check_tasks(scenario: Scenario, transport: str, planned: bool) -> None:
+    """Refuse a live lifelong run that cannot be honoured: one without a task stream (its goals would be drawn by
+    nobody), with a plan, a policy that takes no tasks live, a transport that reaches no desk, or a task longer
+    than a task message carries."""
+    if not scenario.lifelong:
+        return
+    if scenario.tasks is None:
+        raise InputError(Problem("--lifelong", "a live lifelong run takes its tasks from a task stream (a LoRR problem)"))
+    entry = policy_entry(scenario.policy.name)
+    if planned or not entry.live_tasks:
+        who = "a plan" if planned else entry.name
+        raise InputError(Problem("--policy", f"{who} does not take tasks live (a lifelong run live is pibt's)"))
+    if not TRANSPORTS.entry(transport).reaches_desk:
+        raise InputError(Problem("--transport", f"a lifelong robot reaches its task desk over udp, not {transport}"))
+    problem = desk_problem(scenario.tasks)
+    if problem is not None:
+        raise InputError(Problem("tasks", problem))
+
+
+def _start_desk(
+    scenario: Scenario, options: LiveOptions, files: _RunFiles, layout: FleetLayout, session: int
+) -> TaskServer | None:
+    """Start the task desk of a run with a task stream (None without one), at the layout's desk address."""
+    if scenario.tasks is None or layout.desk is None:
+        return None
+    assert scenario.max_ticks is not None
+    starts = [robot.start for robot in scenario.robots]
+    desk = TaskDesk(scenario.tasks, scenario.grid, starts, scenario.max_ticks)
+    robots = {index: (layout.host, port) for index, port in enumerate(layout.ports)}
+    opened = UdpTransport(layout.desk, robots)
+    transport = FAULTS.wrap(opened, options.faults, seed=derive_seed(options.seed, Stream.LIVE_FAULTS, len(starts)))
+    sealer, opener = Sealer(files.key_bytes, session), Opener(files.key_bytes, session, fleet_size=len(starts))
+    server = TaskServer(desk, transport, sealer, opener, files.results / "tasks.json")
+    server.start()
+    return server
+
+
+def with_desk(result: RunResult, desk: TaskDesk, verdict: dict | None) -> RunResult:
+    """``result`` with what the task desk saw within the run's steps: tasks finished, errands per robot, and
+    (``network["tasks_errands_not_visited"]``) how many of those errands the referee's ground truth (``verdict``)
+    does not show the robot's body entering."""
+    log = desk.book.log
+    events = [event for event in log.events if event[0] <= desk.steps]
+    for _, robot, _, _ in events:
+        result.robots[robot].goals_reached += 1
+    tasks = TaskLog(desk.finished, events, list(log.revealed), [list(entries) for entries in log.schedules], [])
+    errands = {task: cells for task, _, cells in log.revealed}
+    not_visited = errands_not_visited(events, errands, verdict["intervals"] if verdict else [])
+    stop_reason = "time up" if result.stop_reason == "all arrived" else result.stop_reason  # every robot did its steps
+    network = {**result.network, "tasks_errands_not_visited": len(not_visited)}
+    return replace(result, lifelong=True, tasks=tasks, stop_reason=stop_reason, network=network)
 
 
 def run_timeout(scenario: Scenario, time_scale: float) -> float:
@@ -165,7 +243,14 @@ def run_timeout(scenario: Scenario, time_scale: float) -> float:
     30.0
     """
     timeout = max(30.0, 10.0 * ideal_makespan(scenario, time_scale) + 3.0 * len(scenario.robots))
+    if scenario.lifelong and scenario.max_ticks is not None:  # its steps, each a cell time or a step's decisions
+        step_seconds = scenario.timing.cell_time / time_scale + LIFELONG_STEP_FLOOR_S
+        timeout = max(timeout, 3.0 * scenario.max_ticks * step_seconds + 3.0 * len(scenario.robots))
     return min(timeout, MAX_RUN_SECONDS)
+
+
+LIFELONG_STEP_FLOOR_S = 0.35
+"""Seconds a live step takes beyond its move, at most, for the timeout of a lifelong run (a step's decisions)."""
 
 
 def _check(options: LiveOptions, ids: list[str]) -> None:
@@ -202,7 +287,7 @@ def _write_run_files(scenario: Scenario, options: LiveOptions, ids: list[str]) -
     results = prepare_folder(options.results) if options.results else Path(tempfile.mkdtemp(prefix="mrmp-live-"))
     for stale in [
         *results.glob("trace-*.jsonl"), *results.glob("agent-*.json"), *results.glob("plan-*.json"),
-        results / "referee.json", results / "done",
+        results / "referee.json", results / "done", results / "tasks.json",
     ]:
         stale.unlink(missing_ok=True)
     scenario_file = results / "scenario.yaml"
@@ -214,8 +299,9 @@ def _write_run_files(scenario: Scenario, options: LiveOptions, ids: list[str]) -
             shares.append(results / f"plan-{index}.json")
             write_share(shares[-1], ids[index], policy.moves, policy.dependencies, policy.dependents)
     key_file = results / "fleet.key"
-    write_key_file(key_file, os.urandom(32).hex().encode())
-    return _RunFiles(results, scenario_file, key_file, results / "done", shares)
+    key = os.urandom(32).hex().encode()
+    write_key_file(key_file, key)
+    return _RunFiles(results, scenario_file, key_file, key, results / "done", shares)
 
 
 def _start(command: list[str]) -> subprocess.Popen[bytes]:

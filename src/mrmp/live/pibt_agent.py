@@ -93,14 +93,19 @@ from mrmp.protocol.messages import (
 )
 from mrmp.protocol.pibt_local import CallAckMessage
 from mrmp.protocol.safety import SafetyLayer
+from mrmp.protocol.tasks import TaskMessage
 from mrmp.robot.messaging import Outgoing
 from mrmp.robot.pibt_live import LivePibtRobot
 from mrmp.robot.pibt_synchronized import SynchronizedPibtRobot
+from mrmp.robot.task_taker import TaskTaker
 from mrmp.search.flat_map import FlatMap
 
 __all__ = ["PibtAgent", "PibtBrain", "PibtTiming", "open_repeat"]
 
 M = TypeVar("M", bound=Message)
+
+TASK_RETRY = 0.1
+"""Seconds between two sends of a lifelong robot's task report that the desk has not answered."""
 
 POLL = 0.01
 """Seconds between two polls of a live ``pibt`` robot at least: a third of its retransmission interval
@@ -257,6 +262,10 @@ class PibtBrain:
         self._claimed_at = -math.inf
         self._began = 0.0
         self.crash_after = crash_after
+        self.tasks = TaskTaker(index, len(scenario.robots), TASK_RETRY) if scenario.lifelong else None
+        """A lifelong robot's tasks, from the task desk (one past the last robot on the wire); None: one goal."""
+        self.last_step = scenario.max_ticks if scenario.lifelong else None
+        """A lifelong robot's last step: its run is done once it is over (it still takes part until its fleet's is)."""
 
     # -- time -------------------------------------------------------------------------------
 
@@ -270,11 +279,11 @@ class PibtBrain:
 
     def expire(self, now: float) -> list[Outgoing]:
         """Run the step clock and every timer: begin and end steps, act, resend, claim; return what to send."""
-        out: list[Outgoing] = []
         if self.t0 is None:
-            return out
+            return []
+        out = self._task_reports(now)
         if self.synchronized:
-            return self._expire_synchronized(now)
+            return out + self._expire_synchronized(now)
         robot, timing = self.robot, self.timing
         begins = self.t0 + self.step * timing.step  # when the next step begins
         if self._deciding and now >= begins - timing.step + timing.hold:
@@ -331,9 +340,39 @@ class PibtBrain:
         """Begin the next step, held while a queued move is not granted; the brain acts on it at its next run."""
         self.step += 1
         self._began = now
+        self._follow_tasks()
         out.extend(self.robot.begin_step(self.step, now=self._ms(now), held=self._move_queued()))
         self._deciding = True
         self._act = True
+
+    def _follow_tasks(self) -> None:
+        """A lifelong robot, as a step begins: its goal becomes its task's next errand, or, free, its cell (as the
+        simulator's task book hands them out at the end of a tick). Once its last step is over, its goal is its
+        cell: it stays, moving only when a peer whose steps are not over pushes it."""
+        tasks, robot = self.tasks, self.robot
+        if tasks is None:
+            return
+        present = self.flat.cells[robot.present]
+        over = self.last_step is not None and self.step > self.last_step
+        goal = robot.present if over else self.flat.index(tasks.goal(present))
+        if goal != robot.goal:
+            robot.goal = goal
+            robot.elapsed = 0
+
+    def _step_ends_on(self, cell: int) -> None:
+        """The step ends with the robot on ``cell``, as it has decided for good: an errand reached there counts
+        now, and the desk hears of it at once, so that the robot's next task can be there when its next step
+        begins."""
+        if self.tasks is not None:
+            self.tasks.step_ended(self.step, self.flat.cells[cell])
+
+    def _task_reports(self, now: float) -> list[Outgoing]:
+        """A lifelong robot's report to the task desk, when one is due (:class:`~mrmp.robot.task_taker.TaskTaker`)."""
+        tasks = self.tasks
+        if tasks is None:
+            return []
+        reports = tasks.due(now, self.flat.cells[self.robot.present], self.step)
+        return [Outgoing(self._stamp(report), (tasks.desk,)) for report in reports]
 
     def _crash_silent(self, now: float) -> None:
         """Take every peer silent for ``crash_after`` seconds for crashed.
@@ -365,6 +404,7 @@ class PibtBrain:
         robot = self.robot
         assert robot.target is not None
         self._decided = robot.target
+        self._step_ends_on(robot.target)
         if robot.target != robot.present:
             cell = self.flat.cells[robot.target]
             self.queue.append(cell)
@@ -379,6 +419,7 @@ class PibtBrain:
         before, heading = robot.present, robot.heading
         after = robot.finish_step()
         assert decided is None or decided == after, "a robot's decision for good changed"
+        self._step_ends_on(after)
         if decided is None and after != before:
             cell = self.flat.cells[after]
             self.queue.append(cell)
@@ -430,7 +471,9 @@ class PibtBrain:
 
     @property
     def settled(self) -> bool:
-        """On its goal, decided and there in body."""
+        """On its goal, decided and there in body; a lifelong robot: its last step over, and still in body."""
+        if self.last_step is not None:
+            return self.step > self.last_step and not self.queue and not self.moving
         return self.robot.at_goal and not self.queue and not self.moving
 
     # -- messages ---------------------------------------------------------------------------
@@ -446,6 +489,9 @@ class PibtBrain:
     def receive(self, message: Message, now: float) -> list[Outgoing]:
         """Take in one message; return the answers to send at once."""
         sender = message.sender
+        if isinstance(message, TaskMessage):
+            self._take_task(message)
+            return []
         if sender == self.index or not 0 <= sender < self.safety.fleet_size:
             self.dropped["own" if sender == self.index else "unknown_sender"] += 1
             return []
@@ -489,6 +535,16 @@ class PibtBrain:
             return []
         self.dropped["other_type"] += 1
         return []
+
+    def _take_task(self, message: TaskMessage) -> None:
+        """The task desk's answer: a task to take at the next step, or an acknowledgement (from the desk only)."""
+        if self.tasks is None or message.sender != self.tasks.desk:
+            self.dropped["unknown_sender"] += 1
+            return
+        if not all(self.flat.grid.in_bounds(cell) and self.flat.grid.is_free(cell) for cell in message.errands):
+            self.dropped["off_map"] += 1  # not a cell this robot can reach: no desk of its fleet sent it
+            return
+        self.tasks.take(message)
 
     def _take_farewell(self, message: FarewellMessage) -> None:
         """A peer's run is over: an obstacle on its cell for good, and done for the end of the run (it is heard
@@ -581,6 +637,8 @@ class PibtAgent(LiveDriver):
         brain = self.robot
         counts = {**brain.safety.stats.__dict__, **{f"pibt_{name}": count for name, count in brain.robot.stats.items()}}
         counts["pibt_steps"] = brain.step
+        if brain.tasks is not None:
+            counts.update({f"task_{name}": count for name, count in brain.tasks.stats.items()})
         return counts
 
     # -- the receiving thread: repeats of PIBT messages pass --------------------------------

@@ -341,7 +341,8 @@ class _HostedRobot:
             recorder = OccupancyRecorder(sink, heading_sink=trace.write_heading)
             body = simulated_body(scenario, index, recorder, options.time_scale, options.jitter, options.miss_line, options.seed)
         sealer = Sealer(options.key, options.session)
-        opener = Opener(options.key, options.session, fleet_size=len(scenario.robots))
+        members = len(scenario.robots) + scenario.lifelong  # a lifelong fleet's task desk is one more member
+        opener = Opener(options.key, options.session, fleet_size=members)
         agent = LIVE_DRIVERS[driver_kind(scenario, following_plan=policy is not None)](
             scenario, index, transport, body, sealer, opener, DriverOptions(options.timing, options.seed, options.guarded), policy
         )

@@ -10,7 +10,10 @@ referee reports, as the lockstep referee does (:mod:`mrmp.sim.referee`):
 * ``obstacle`` / ``off_grid``: a robot entering a blocked cell or leaving the grid.
 
 For bodies that turn in place, the referee process judges their actions too
-(``action``: :mod:`mrmp.live.action_referee`).
+(``action``: :mod:`mrmp.live.action_referee`). In a lifelong run, the errands
+the task desk counted are judged on the same ground truth
+(:func:`errands_not_visited`): a robot reached an errand only if its body
+entered the errand's cell.
 
 Times are seconds on the clock every process of the run shares
 (``time.monotonic`` on one machine); collisions carry the time in milliseconds
@@ -29,8 +32,9 @@ Examples
 from __future__ import annotations
 
 import math
-from collections.abc import Sequence
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
+from typing import Any
 
 from mrmp.core.cell import Cell
 from mrmp.core.grid import Grid
@@ -122,6 +126,23 @@ class IntervalReferee:
                 found.append((t, Collision(kind, self._tick(t), (ids[robot_a], ids[robot_b]), shown)))
         found.sort(key=lambda item: item[0])
         return [collision for _, collision in found]
+
+
+def errands_not_visited(
+    events: Sequence[tuple[int, int, int, int]],
+    errands: Mapping[int, Sequence[Cell]],
+    intervals: Sequence[Mapping[str, Any]],
+) -> list[tuple[int, int, int, int]]:
+    """The task desk's ``events`` (``(step, robot, task, errands done)``) whose errand the robot's body never
+    covered, by its ground-truth ``intervals`` (``referee.json``'s: ``robot``, ``cell``, ``start``, ``end``);
+    ``errands``: each task's errand cells, by task id.
+
+    >>> intervals = [{"robot": 0, "cell": [0, 1], "start": 0.0, "end": None}]
+    >>> errands_not_visited([(3, 0, 7, 1), (5, 0, 7, 2)], {7: [(0, 1), (0, 2)]}, intervals)
+    [(5, 0, 7, 2)]
+    """
+    covered = {(int(interval["robot"]), (int(interval["cell"][0]), int(interval["cell"][1]))) for interval in intervals}
+    return [event for event in events if (event[1], tuple(errands[event[2]][event[3] - 1])) not in covered]
 
 
 Span = tuple[float, float, Interval, Interval]

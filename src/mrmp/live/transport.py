@@ -189,10 +189,13 @@ class UdpTransport(_UdpSocket):
         Local address to receive on (port 0 picks a free port; see :attr:`address`).
     peers:
         Each peer's address, by robot index.
+    services:
+        Addresses reached by an index too, but never by a datagram to every peer (a lifelong run's task desk).
     """
 
-    def __init__(self, bind: Address, peers: Mapping[int, Address]) -> None:
+    def __init__(self, bind: Address, peers: Mapping[int, Address], services: Mapping[int, Address] | None = None) -> None:
         self.peers = dict(peers)
+        self.services = dict(services or {})
         self._socket = socket.socket(socket.AF_INET, socket.SOCK_DGRAM)
         try:
             self._socket.bind(bind)
@@ -206,7 +209,7 @@ class UdpTransport(_UdpSocket):
         if recipient is None:
             targets = list(self.peers.values())
         else:
-            address = self.peers.get(recipient)
+            address = self.peers.get(recipient, self.services.get(recipient))
             targets = [address] if address is not None else []  # no address: lost, as on any network
         for address in targets:
             with contextlib.suppress(OSError):  # an unreachable peer is a lost datagram, as on any network

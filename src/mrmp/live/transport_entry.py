@@ -74,7 +74,8 @@ class FleetLayout:
 
     ``ports`` has one port per robot (by index), free for UDP and TCP on
     ``host``; ``group_port`` is one more, for a transport that uses one group
-    for the whole fleet; ``fleet`` names this fleet (unique per run).
+    for the whole fleet; ``fleet`` names this fleet (unique per run);
+    ``desk_port``, where a lifelong run's task desk listens (None: no desk).
 
     >>> layout = FleetLayout(("A", "B"), (9001, 9002), 9003, "mrmp/7")
     >>> layout.size, layout.host, layout.others(0)
@@ -86,18 +87,23 @@ class FleetLayout:
     group_port: int
     fleet: str
     host: str = LOOPBACK
+    desk_port: int | None = None
 
     @classmethod
-    def on_loopback(cls, ids: Sequence[str], fleet: str) -> FleetLayout:
-        """A layout on loopback with ports free right now (:func:`free_ports`).
+    def on_loopback(cls, ids: Sequence[str], fleet: str, desk: bool = False) -> FleetLayout:
+        """A layout on loopback with ports free right now (:func:`free_ports`), and one for a task desk if ``desk``.
 
-        >>> layout = FleetLayout.on_loopback(["A", "B", "C"], "mrmp/1")
-        >>> len(set(layout.ports) | {layout.group_port}), layout.fleet
-        (4, 'mrmp/1')
+        >>> layout = FleetLayout.on_loopback(["A", "B", "C"], "mrmp/1", desk=True)
+        >>> len(set(layout.ports) | {layout.group_port, layout.desk_port}), layout.fleet
+        (5, 'mrmp/1')
         """
-        ports = free_ports(len(ids))
-        group_port = free_ports(1)[0]
-        return cls(tuple(ids), tuple(ports), group_port, fleet)
+        ports = free_ports(len(ids) + 1 + desk)
+        return cls(tuple(ids), tuple(ports[: len(ids)]), ports[len(ids)], fleet, desk_port=ports[-1] if desk else None)
+
+    @property
+    def desk(self) -> tuple[str, int] | None:
+        """The task desk's address, or None without one."""
+        return None if self.desk_port is None else (self.host, self.desk_port)
 
     @property
     def size(self) -> int:
@@ -157,9 +163,11 @@ class TransportEntry(ABC, Generic[OptionsT]):
     """
 
     name: ClassVar[str]
+    """The ``--transport`` value that selects this transport."""
     hosts_several: ClassVar[bool] = False
     """Whether one ``mrmp agent`` can host several robots over it, each with a transport of its own (:meth:`hosting`)."""
-    """The ``--transport`` value that selects this transport."""
+    reaches_desk: ClassVar[bool] = False
+    """Whether its robots reach a lifelong run's task desk (``--task-desk``; :mod:`mrmp.live.task_desk`)."""
 
     summary: ClassVar[str]
     """One line on what it is."""

@@ -62,17 +62,19 @@ def _text(address: Address) -> str:
 
 @dataclass(frozen=True)
 class UdpOptions:
-    """UDP unicast: the address to receive on, and every peer's address by robot index."""
+    """UDP unicast: the address to receive on, every peer's address by robot index, and a lifelong run's task
+    desk's (None: no desk)."""
 
     bind: Address = ("127.0.0.1", 0)
     peers: Mapping[int, Address] = field(default_factory=dict)
+    desk: Address | None = None
 
 
 class UdpEntry(TransportEntry[UdpOptions]):
     """UDP unicast to every peer's address (:class:`~mrmp.live.transport.UdpTransport`).
 
     >>> UdpEntry().parse({"bind": "127.0.0.1:9001", "peer": ["B=127.0.0.1:9002"]}, ["A", "B"], 0)
-    UdpOptions(bind=('127.0.0.1', 9001), peers={1: ('127.0.0.1', 9002)})
+    UdpOptions(bind=('127.0.0.1', 9001), peers={1: ('127.0.0.1', 9002)}, desk=None)
     >>> UdpEntry().parse({"bind": "127.0.0.1:9001", "peer": []}, ["A", "B"], 0)
     Traceback (most recent call last):
     ...
@@ -82,6 +84,7 @@ class UdpEntry(TransportEntry[UdpOptions]):
     name = "udp"
     summary = "UDP unicast to every peer's address"
     delivery = Delivery(longest=MAX_DATAGRAM_BYTES + 1)
+    reaches_desk = True
 
     def parse(self, values: Mapping[str, Any], ids: Sequence[str], index: int) -> UdpOptions:
         peers: dict[int, Address] = {}
@@ -97,21 +100,25 @@ class UdpEntry(TransportEntry[UdpOptions]):
         if missing:
             give = "give --peer ID=HOST:PORT for every other robot"
             raise InputError(Problem("--peer", f"no address for {', '.join(missing)}: {give}"))
-        return UdpOptions(_address(values, "bind"), peers)
+        desk = _address(values, "task_desk") if values.get("task_desk") else None
+        return UdpOptions(_address(values, "bind"), peers, desk)
 
     def hosts(self, options: UdpOptions) -> list[str]:
-        return [options.bind[0], *(address[0] for address in options.peers.values())]
+        desk = [] if options.desk is None else [options.desk[0]]
+        return [options.bind[0], *(address[0] for address in options.peers.values()), *desk]
 
     def open(self, options: UdpOptions, index: int, fleet_size: int) -> Transport:
-        return UdpTransport(options.bind, options.peers)
+        """The robot's socket; the desk, if any, is reached as index ``fleet_size`` (one past the last robot)."""
+        return UdpTransport(options.bind, options.peers, {} if options.desk is None else {fleet_size: options.desk})
 
     def fleet_options(self, layout: FleetLayout, index: int) -> UdpOptions:
         host = layout.host
-        return UdpOptions((host, layout.ports[index]), {other: (host, port) for other, port in layout.others(index)})
+        return UdpOptions((host, layout.ports[index]), {other: (host, port) for other, port in layout.others(index)}, layout.desk)
 
     def arguments(self, options: UdpOptions, ids: Sequence[str]) -> list[str]:
         peers = [f"--peer={ids[other]}={_text(address)}" for other, address in options.peers.items()]
-        return [f"--bind={_text(options.bind)}", *peers]
+        desk = [] if options.desk is None else [f"--task-desk={_text(options.desk)}"]
+        return [f"--bind={_text(options.bind)}", *peers, *desk]
 
     hosts_several = True
 
@@ -138,7 +145,8 @@ class UdpEntry(TransportEntry[UdpOptions]):
         >>> UdpEntry().hosting_arguments(FleetLayout(("A", "B"), (9001, 9002), 9003, "mrmp/7"), [1])
         ['--peer=A=127.0.0.1:9001', '--peer=B=127.0.0.1:9002']
         """
-        return [f"--peer={robot}={layout.host}:{port}" for robot, port in zip(layout.ids, layout.ports, strict=True)]
+        desk = [] if layout.desk is None else [f"--task-desk={_text(layout.desk)}"]
+        return [f"--peer={robot}={layout.host}:{port}" for robot, port in zip(layout.ids, layout.ports, strict=True)] + desk
 
 
 # -- UDP multicast ------------------------------------------------------------------------------

@@ -24,8 +24,11 @@ What the harness adds is what a real fleet has and a single process does not:
   robot's next turn starts no sooner. Each robot has its own processor, as
   each real robot has; nothing is shared but the network.
 
+A lifelong run's task desk (:mod:`mrmp.live.task_desk`) is a member of the
+network too, one past the last robot, answering at once what reaches it.
+
 The run writes what a live run writes (``agent-<i>.json``, ``trace-<i>.jsonl``,
-``referee.json``) and is judged by the same referee and result builder
+``referee.json``, and ``tasks.json`` with a desk) and is judged by the same referee and result builder
 (:func:`mrmp.live.process.run_referee`, :func:`mrmp.live.results.live_result`),
 its times in virtual seconds; its ``wall_time_s`` is the CPU time the
 harness spent, and its ``network`` counts the turns run (``virtual_turns``)
@@ -66,11 +69,13 @@ from mrmp.core.seeds import Stream, derive_seed
 from mrmp.io.live_files import TraceWriter, read_json, write_json
 from mrmp.live.body import OccupancyRecorder
 from mrmp.live.driver import AgentTiming, LiveDriver
-from mrmp.live.launcher import run_timeout
+from mrmp.live.launcher import check_tasks, run_timeout, with_desk
 from mrmp.live.process import LIVE_DRIVERS, DriverOptions, driver_kind, fleet_timing, run_referee, simulated_body
 from mrmp.live.results import live_result
+from mrmp.live.task_desk import TaskDesk
 from mrmp.live.transport import FaultCounts, LiveFaults
 from mrmp.protocol.auth import Opener, Sealer
+from mrmp.protocol.tasks import TaskReportMessage
 from mrmp.search.flat_map import FlatMap
 from mrmp.sim.policy_table import body_problem
 
@@ -129,12 +134,14 @@ class VirtualNetwork:
     (1.001, [(1, b'hello'), (2, b'hello')])
     """
 
-    def __init__(self, robots: int, faults: LiveFaults, latency: float, seed: int) -> None:
+    def __init__(self, robots: int, faults: LiveFaults, latency: float, seed: int, services: int = 0) -> None:
         self.robots = robots
+        """The robots, members ``0 .. robots - 1``: a datagram to every peer reaches them."""
         self.faults = faults
         self.latency = latency
         self.random = random.Random(seed)
-        self.counts = [FaultCounts() for _ in range(robots)]
+        self.counts = [FaultCounts() for _ in range(robots + services)]
+        """Per member (the robots, then ``services`` more reached by their index only, as a task desk is)."""
         self._queue: list[tuple[float, int, int, bytes]] = []
         self._order = itertools.count()
 
@@ -211,7 +218,9 @@ class _VirtualFleet:
         self.options = options
         self.now = 0.0
         robots = len(scenario.robots)
-        self.network = VirtualNetwork(robots, options.faults, options.latency, derive_seed(options.seed, Stream.LIVE_FAULTS, 0))
+        desk = scenario.tasks is not None
+        network_seed = derive_seed(options.seed, Stream.LIVE_FAULTS, 0)
+        self.network = VirtualNetwork(robots, options.faults, options.latency, network_seed, services=desk)
         key, session = os.urandom(32), random.Random(options.seed).randrange(1, 2**31)
         timing = fleet_timing(options.timing, robots)
         self.timing = replace(timing, timeout=options.timeout or run_timeout(scenario, options.time_scale))
@@ -222,19 +231,27 @@ class _VirtualFleet:
             trace = TraceWriter(options.results / f"trace-{index}.jsonl", index)
             recorder = OccupancyRecorder(trace.write, heading_sink=trace.write_heading)
             body = simulated_body(scenario, index, recorder, options.time_scale, options.jitter, seed=options.seed)
-            sealer, opener = Sealer(key, session), Opener(key, session, fleet_size=robots)
+            sealer, opener = Sealer(key, session), Opener(key, session, fleet_size=robots + desk)
             driver = kind(scenario, index, _NoSockets(), body, sealer, opener, shared, None)
             driver.clock = self.clock
             outbox = _Outbox()
             driver.send_through(outbox)
             self.robots.append(_Robot(driver, outbox, trace))
         self._wakes: list[tuple[float, int, int]] = [(0.0, index, 0) for index in range(robots)]
+        self.desk: TaskDesk | None = None
+        if scenario.tasks is not None and scenario.max_ticks is not None:
+            self.desk = TaskDesk(scenario.tasks, scenario.grid, [spec.start for spec in scenario.robots], scenario.max_ticks)
+            self._desk_envelope = Sealer(key, session), Opener(key, session, fleet_size=robots)
+            self._desk_version = 0
+            self._wake_desk(0.0)
         self.turns = 0
         """Turns of the robots' main loops run."""
         self.datagrams = 0
         """Datagrams the robots took in or sent."""
         self.to_ended = 0
         """Datagrams that reached a robot whose process had ended (lost on it)."""
+        self.stopped = 0
+        """Robots whose run is over."""
 
     def clock(self) -> float:
         """The virtual time: what every driver's clock reads."""
@@ -248,7 +265,7 @@ class _VirtualFleet:
         network = self.network
         unfinished = "timeout"
         try:
-            while self._wakes or network.next_arrival() < math.inf:
+            while self.stopped < len(self.robots) and (self._wakes or network.next_arrival() < math.inf):
                 next_robot = self._wakes[0][0] if self._wakes else math.inf
                 self.now = min(next_robot, network.next_arrival())
                 if self.now > end:
@@ -258,6 +275,10 @@ class _VirtualFleet:
                         self._deliver(recipient, data, arrival)
                     continue
                 _, index, version = heapq.heappop(self._wakes)
+                if index == len(self.robots):
+                    if version == self._desk_version:
+                        self._desk_turn()
+                    continue
                 robot = self.robots[index]
                 if version == robot.version and not robot.done:
                     self._turn(index, robot)
@@ -270,6 +291,9 @@ class _VirtualFleet:
                 robot.done = True
 
     def _deliver(self, recipient: int, data: bytes, arrival: float) -> None:
+        if recipient == len(self.robots):
+            self._desk_takes(data, arrival)
+            return
         robot = self.robots[recipient]
         if robot.done:
             self.to_ended += 1
@@ -293,10 +317,34 @@ class _VirtualFleet:
         robot.outbox.datagrams.clear()
         if wake is None:
             robot.done = True
+            self.stopped += 1
             driver.fill_report(now)
             return
         at, woken_by_messages = driver.wake_rule(now, wake, timers=driver.running)
         self._schedule(index, robot, max(at, robot.busy_until), woken_by_messages)
+
+    def _desk_takes(self, data: bytes, arrival: float) -> None:
+        """The desk answers what reached it at once (a datagram not a task report is counted by its opener)."""
+        assert self.desk is not None
+        sealer, opener = self._desk_envelope
+        report = opener.open(data)
+        if isinstance(report, TaskReportMessage):
+            self.network.post(self.desk.index, sealer.seal(self.desk.take(report)), report.sender, at=arrival)
+            self._wake_desk(arrival)  # a task finished may have given others a task to tell
+
+    def _desk_turn(self) -> None:
+        """The desk tells the robots the tasks they have not named yet; it wakes again for the next."""
+        assert self.desk is not None
+        sealer = self._desk_envelope[0]
+        for robot, message in self.desk.due(self.now):
+            self.network.post(self.desk.index, sealer.seal(message), robot, at=self.now)
+        self._wake_desk(self.desk.next_due())
+
+    def _wake_desk(self, at: float) -> None:
+        """Wake the desk at ``at`` (at once if that is past; never when ``inf``), instead of when it was to wake."""
+        if at < math.inf:
+            self._desk_version += 1
+            heapq.heappush(self._wakes, (max(at, self.now), len(self.robots), self._desk_version))
 
     def _schedule(self, index: int, robot: _Robot, at: float, woken_by_messages: bool) -> None:
         robot.version += 1
@@ -341,12 +389,13 @@ def run_virtual(scenario: Scenario, options: VirtualOptions) -> RunResult:
     body_issue = body_problem(scenario, live=True)
     if body_issue is not None:
         raise InputError(body_issue)
+    check_tasks(scenario, "udp", planned=False)
     try:
         options.results.mkdir(parents=True, exist_ok=True)
     except OSError as error:
         raise InputError(Problem("--results", f"cannot make {options.results}: {error.strerror}")) from None
-    for stale in (*options.results.glob("agent-*.json"), *options.results.glob("trace-*.jsonl")):
-        stale.unlink()
+    for stale in (*options.results.glob("agent-*.json"), *options.results.glob("trace-*.jsonl"), options.results / "tasks.json"):
+        stale.unlink(missing_ok=True)
     started = time.process_time()
     fleet = _VirtualFleet(scenario, options)
     fleet.run()
@@ -366,5 +415,9 @@ def run_virtual(scenario: Scenario, options: VirtualOptions) -> RunResult:
         time_scale=options.time_scale,
     )
     harness = {"virtual_turns": fleet.turns, "virtual_datagrams": fleet.datagrams, "virtual_to_ended": fleet.to_ended}
-    return replace(result, network={**result.network, **harness})
+    result = replace(result, network={**result.network, **harness})
+    if fleet.desk is None:
+        return result
+    write_json(options.results / "tasks.json", fleet.desk.summary())
+    return with_desk(result, fleet.desk, verdict)
 

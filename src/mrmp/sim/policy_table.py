@@ -111,6 +111,9 @@ class PolicyEntry:
         Its bodies always enter cells through the safety layer (it has no ``--unsafe`` form).
     records_messages:
         Its simulator can keep a message log (``--show-messages``).
+    live_tasks:
+        Its live driver takes a lifelong run's tasks from the task desk
+        (:mod:`mrmp.live.task_desk`): it can run a task stream live.
     bodies:
         The body models (:mod:`mrmp.core.body`) its robots plan for and its
         simulator drives.
@@ -129,6 +132,7 @@ class PolicyEntry:
     live_note: str = ""
     always_guarded: bool = False
     records_messages: bool = False
+    live_tasks: bool = False
     bodies: tuple[str, ...] = (DEFAULT_BODY,)
     live_bodies: tuple[str, ...] = (DEFAULT_BODY,)
 
@@ -223,6 +227,7 @@ POLICY_TABLE: dict[str, PolicyEntry] = {
         simulator=pibt_simulator,
         runs="runs in synchronous rounds (mrmp.sim.rounds)",
         live_driver="pibt",
+        live_tasks=True,
         live_note=(
             "pibt runs live with local sequencing, whatever policy.sequencing says"
             " (no driver can order live processes; sequencing: driver is the simulator's)"

@@ -146,42 +146,59 @@ class TaskBook:
             for robot, task in enumerate(self.task_of):
                 if task is not None:
                     self.log.busy_ticks[robot] += 1
-        reached = self._errands_reached(tick, cells)
-        self._reveal(tick)
-        self._schedule(tick, cells)
+        reached = [
+            robot
+            for robot, task in enumerate(self.task_of)
+            if task is not None and cells[robot] == task.errands[task.next_errand]
+        ]
+        for robot in reached:
+            self.reach(robot, tick)
+        self.reveal(tick)
+        self.schedule(tick, cells)
         return TaskUpdate(reached, self._new_goals(cells))
 
-    def _errands_reached(self, tick: int, cells: Sequence[Cell]) -> list[int]:
-        reached = []
-        for robot, task in enumerate(self.task_of):
-            if task is None or cells[robot] != task.errands[task.next_errand]:
-                continue
-            task.next_errand += 1
-            reached.append(robot)
-            self.log.events.append((tick, robot, task.task_id, task.next_errand))
-            if task.next_errand == len(task.errands):
-                self.log.finished += 1
-                del self.open[task.task_id]
-                self._give(robot, None, tick)
-        return reached
+    def reach(self, robot: int, tick: int) -> Task:
+        """Robot ``robot`` reached its task's next errand at the end of ``tick``: log the event; a robot that
+        reached the last one finishes the task and is free. Its task (finished or not).
 
-    def _reveal(self, tick: int) -> None:
+        Raises
+        ------
+        ValueError
+            If the robot has no task.
+        """
+        task = self.task_of[robot]
+        if task is None:
+            raise ValueError(f"robot {robot} has no task to reach an errand of")
+        task.next_errand += 1
+        self.log.events.append((tick, robot, task.task_id, task.next_errand))
+        if task.next_errand == len(task.errands):
+            self.log.finished += 1
+            del self.open[task.task_id]
+            self._give(robot, None, tick)
+        return task
+
+    def reveal(self, tick: int) -> None:
+        """Reveal tasks at ``tick`` until :attr:`~mrmp.core.tasks.TaskStream.reveal` are revealed and unfinished."""
         while len(self.open) < self.stream.reveal:
             task = Task(self._next_id, self.stream.task_errands(self._next_id), tick)
             self.open[task.task_id] = task
             self.log.revealed.append((task.task_id, tick, task.errands))
             self._next_id += 1
 
-    def _schedule(self, tick: int, cells: Sequence[Cell]) -> None:
+    def schedule(self, tick: int, cells: Sequence[Cell]) -> list[int]:
+        """Give free tasks to the free robots at ``tick`` by the stream's scheduler (the free robots standing on
+        ``cells``, by robot index); the robots given a task."""
         free_robots = [robot for robot, task in enumerate(self.task_of) if task is None]
         if not free_robots:
-            return
+            return []
         free_tasks = [task for task in self.open.values() if task.robot is None]
-        for robot, task_id in self._scheduler(free_robots, free_tasks, cells, self.flat).items():
+        given = self._scheduler(free_robots, free_tasks, cells, self.flat)
+        for robot, task_id in given.items():
             task = self.open[task_id]
             if task.robot is not None or self.task_of[robot] is not None:
                 raise ValueError(f"scheduler {self.stream.scheduler} gave task {task_id} or robot {robot} twice")
             self._give(robot, task, tick)
+        return list(given)
 
     def _give(self, robot: int, task: Task | None, tick: int) -> None:
         self.task_of[robot] = task

@@ -112,7 +112,10 @@ def test_mrmp_run_takes_a_lorr_problem_and_writes_its_output(tmp_path: Path) -> 
     [
         (["--steps", "0"], "--steps: must be between 1 and"),
         (["--lorr-output", "x.json", "--body", "omni"], "--lorr-output: LoRR's actions are those of turning bodies"),
-        (["--live"], "--lifelong: lifelong runs are simulated"),
+        (["--live", "--policy", "causal"], "--policy: causal does not take tasks live"),
+        (["--live", "--transport", "multicast"], "--transport: a lifelong robot reaches its task desk over udp"),
+        (["--live", "--lorr-output", "x.json"], "--lorr-output: writes a simulated run"),
+        (["--planner", "lacam"], "--lifelong: lifelong runs are decentralized"),
         (["--lorr-output", "x.json", "--loss", "0.1"], "--lorr-output: LoRR's output has one action a step"),
     ],
 )

@@ -67,4 +67,4 @@ def test_cli_lifelong_reports_throughput(tmp_path):
     assert data["lifelong"] is True and data["throughput"] > 0
     assert sum(robot["goals_reached"] for robot in data["robots"]) == round(data["throughput"] * data["ticks"])
     refused = CliRunner().invoke(app, ["run", str(scenario), "--live"])
-    assert refused.exit_code == 2 and "lifelong runs are simulated" in refused.output
+    assert refused.exit_code == 2 and "--lifelong: a live lifelong run takes its tasks from a task stream" in refused.output
