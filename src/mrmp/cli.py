@@ -1172,7 +1172,7 @@ def agent(
             raise InputError(Problem("--robot", "names a robot twice"))
         if len(robot) > 1 and (plan is not None or ros2 or drive != "simulated"):
             raise InputError(Problem("--robot", "one robot per process with --plan, --ros2 or --drive ros2"))
-        _check_task_desk(scenario, transport, task_desk)
+        _check_task_desk(scenario, transport, task_desk, plan is not None)
         transport_values = {
             "bind": bind, "peer": peer, "group": group, "interface": interface, "listen": listen, "connect": connect, "fleet": fleet,
             "task_desk": task_desk,
@@ -1222,18 +1222,16 @@ def agent(
 
 
 
-def _check_task_desk(scenario: Scenario, transport: str, task_desk: str) -> None:
+def _check_task_desk(scenario: Scenario, transport: str, task_desk: str, planned: bool) -> None:
     """Refuse a lifelong robot without its task desk, or one whose policy or transport cannot reach a desk, and a
     desk for a robot that is not lifelong."""
+    from mrmp.live.launcher import check_task_taker
+
     if not scenario.lifelong:
         if task_desk:
             raise InputError(Problem("--task-desk", "a task desk serves a lifelong run (lifelong: true)"))
         return
-    entry = policy_entry(scenario.policy.name)
-    if not entry.live_tasks:
-        raise InputError(Problem("--policy", f"{entry.name} does not take tasks live (a lifelong run live is pibt's)"))
-    if not TRANSPORTS.entry(transport).reaches_desk:
-        raise InputError(Problem("--transport", f"a lifelong robot reaches its task desk over udp, not {transport}"))
+    check_task_taker(scenario, transport, planned)
     if not task_desk:
         raise InputError(Problem("--task-desk", "a lifelong robot takes its tasks from a task desk: give its HOST:PORT"))
 

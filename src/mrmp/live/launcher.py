@@ -189,15 +189,21 @@ def check_tasks(scenario: Scenario, transport: str, planned: bool) -> None:
         return
     if scenario.tasks is None:
         raise InputError(Problem("--lifelong", "a live lifelong run takes its tasks from a task stream (a LoRR problem)"))
+    check_task_taker(scenario, transport, planned)
+    problem = desk_problem(scenario.tasks)
+    if problem is not None:
+        raise InputError(Problem("tasks", problem))
+
+
+def check_task_taker(scenario: Scenario, transport: str, planned: bool) -> None:
+    """Refuse a robot of a lifelong run that cannot take tasks from a desk: one following a plan, one whose policy
+    takes no tasks live, or one whose transport reaches no desk."""
     entry = policy_entry(scenario.policy.name)
     if planned or not entry.live_tasks:
         who = "a plan" if planned else entry.name
         raise InputError(Problem("--policy", f"{who} does not take tasks live (a lifelong run live is pibt's)"))
     if not TRANSPORTS.entry(transport).reaches_desk:
         raise InputError(Problem("--transport", f"a lifelong robot reaches its task desk over udp, not {transport}"))
-    problem = desk_problem(scenario.tasks)
-    if problem is not None:
-        raise InputError(Problem("tasks", problem))
 
 
 def _start_desk(

@@ -46,6 +46,11 @@ it with what a live robot adds, sans-IO (fed with the clock, never reading it):
   ended by the robots");
 * a peer silent for ``crash_after`` seconds is taken for crashed (an obstacle
   on its last known cell, no longer waited for), until it is heard again;
+* **lifelong**: a robot of a lifelong run takes its tasks from the task desk
+  (:class:`~mrmp.robot.task_taker.TaskTaker`, :mod:`mrmp.live.task_desk`):
+  its goal, set as a step begins, is its task's next errand; an errand counts
+  as soon as the robot decides for good to end a step on it; after its last
+  step (the scenario's ``max_ticks``) its goal is its cell and it is done;
 * the brain's timers run in whole milliseconds since ``t0``.
 
 :class:`PibtAgent` is the process around it (:class:`~mrmp.live.driver.LiveDriver`):

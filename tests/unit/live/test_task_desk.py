@@ -147,3 +147,30 @@ def test_the_errand_check_catches_robots_that_report_errands_they_never_reached(
     monkeypatch.setattr(TaskTaker, "step_ended", reached_wherever)
     result = run_virtual(lifelong(robots=6, steps=20), VirtualOptions(results=tmp_path, time_scale=5))
     assert result.network["tasks_errands_not_visited"] > 0
+
+
+# -- mrmp agent ---------------------------------------------------------------------------------
+
+
+@pytest.mark.parametrize(
+    ("lifelong", "arguments", "message"),
+    [
+        (True, [], "--task-desk: a lifelong robot takes its tasks from a task desk"),
+        (True, ["--policy", "astar"], "--policy: astar does not take tasks live"),
+        (False, ["--task-desk", "127.0.0.1:9009"], "--task-desk: a task desk serves a lifelong run"),
+    ],
+)
+def test_mrmp_agent_refuses_a_robot_and_a_desk_that_do_not_go_together(
+    tmp_path: Path, lifelong: bool, arguments: list[str], message: str
+) -> None:
+    from typer.testing import CliRunner
+
+    from mrmp.cli import app
+
+    scenario = tmp_path / "s.yaml"
+    scenario.write_text(
+        "map: {rows: ['....', '....']}\nrobots:\n  - {id: A, start: [0, 0], goal: [0, 0]}\n  - {id: B, start: [1, 3], goal: [1, 3]}\n"
+        f"policy: {{name: pibt, body: turning}}\nlifelong: {str(lifelong).lower()}\nmax_ticks: 10\n"
+    )
+    result = CliRunner().invoke(app, ["agent", str(scenario), "--robot", "A", "--peer", "B=127.0.0.1:9002", *arguments])
+    assert result.exit_code == 2 and message in result.output and "Traceback" not in result.output
