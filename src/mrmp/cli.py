@@ -692,8 +692,7 @@ def _validate_run(scenario: Scenario, request: RunRequest) -> None:
         raise InputError(Problem("--lorr-output", "writes the run of a LoRR problem (a .json problem file)"))
     if request.lorr_output is not None and not body_model(scenario.policy.body).turns_in_place:
         raise InputError(Problem("--lorr-output", f"LoRR's actions are those of turning bodies, not {scenario.policy.body}"))
-    faulty = not scenario.perfect_network
-    if request.lorr_output is not None and faulty and scenario.policy.name == "pibt" and scenario.policy.sequencing == "local":
+    if request.lorr_output is not None and not entry.tick_is_a_step(scenario):
         raise InputError(Problem("--lorr-output", "LoRR's output has one action a step; over a faulty network a step of "
                                  "local sequencing spans several ticks: add --sequencing driver or drop the faults"))  # fmt: skip
     if request.virtual_clock and not request.live:

@@ -114,6 +114,9 @@ class PolicyEntry:
     live_tasks:
         Its live driver takes a lifelong run's tasks from the task desk
         (:mod:`mrmp.live.task_desk`): it can run a task stream live.
+    tick_is_a_step:
+        Whether every tick of its simulator's run of a scenario is one step of every robot (one
+        action each, as LoRR's output has): by default, yes.
     bodies:
         The body models (:mod:`mrmp.core.body`) its robots plan for and its
         simulator drives.
@@ -133,6 +136,7 @@ class PolicyEntry:
     always_guarded: bool = False
     records_messages: bool = False
     live_tasks: bool = False
+    tick_is_a_step: Callable[[Scenario], bool] = lambda scenario: True
     bodies: tuple[str, ...] = (DEFAULT_BODY,)
     live_bodies: tuple[str, ...] = (DEFAULT_BODY,)
 
@@ -191,6 +195,19 @@ def pibt_simulator(scenario: Scenario, on_tick: TickObserver | None = None) -> R
     return RoundsSimulator(scenario, on_tick=on_tick)
 
 
+def pibt_tick_is_a_step(scenario: Scenario) -> bool:
+    """Whether policy ``pibt``'s simulator makes a step of every tick: not with local sequencing over a faulty
+    network, whose steps span several ticks (:class:`~mrmp.sim.local_rounds.LocalRoundsSimulator`).
+
+    >>> from mrmp.core import Grid, RobotSpec
+    >>> from mrmp.core.scenario import NetworkFaults
+    >>> swap = Scenario(Grid(1, 2), (RobotSpec("A", (0, 0), (0, 1)),), policy=PolicyOptions(name="pibt"))
+    >>> pibt_tick_is_a_step(swap), pibt_tick_is_a_step(swap.with_changes(network=NetworkFaults(loss=0.1)))
+    (True, False)
+    """
+    return scenario.perfect_network or options_from(PibtOptions, scenario.policy).sequencing != "local"
+
+
 POLICY_TABLE: dict[str, PolicyEntry] = {
     "thesis": PolicyEntry(
         "thesis",
@@ -228,6 +245,7 @@ POLICY_TABLE: dict[str, PolicyEntry] = {
         runs="runs in synchronous rounds (mrmp.sim.rounds)",
         live_driver="pibt",
         live_tasks=True,
+        tick_is_a_step=pibt_tick_is_a_step,
         live_note=(
             "pibt runs live with local sequencing, whatever policy.sequencing says"
             " (no driver can order live processes; sequencing: driver is the simulator's)"
