@@ -427,7 +427,9 @@ def fleet_progress(results: Path, robots: int, elapsed_s: float) -> LiveProgress
         arrived += bool(report.get("arrived"))
         messages += int(report.get("messages_sent", 0))
         faults.update({kind: int(count) for kind, count in dict(report.get("faults", {})).items() if kind != "sent"})
-    return LiveProgress(robots, arrived, messages, dict(faults), elapsed_s)
+    desk = _read_if_there(results / "tasks.json")  # a lifelong run's task desk: written atomically as it changes
+    tasks = None if desk is None else int(desk.get("finished", 0))
+    return LiveProgress(robots, arrived, messages, dict(faults), elapsed_s, tasks)
 
 
 def _fleet_start(fleet: _Fleet) -> float | None:
