@@ -85,9 +85,10 @@ class Setting:
     flag:
         Its ``mrmp run`` option: ``--name``, or ``--name/--no-name`` for a switch.
     check:
-        Why a value is wrong (None when it is right).
+        Why a value is wrong (None when it is right), beyond ``choices``.
     choices:
-        The values it may take, when they are a list of names (listed by ``mrmp run --help``).
+        The values it may take, when they are a list of names (listed by ``mrmp run --help``; any other
+        value is wrong: :meth:`problem`).
     """
 
     help: str
@@ -104,6 +105,16 @@ class Setting:
         'policy.radius'
         """
         return f"policy.{self.yaml_key}"
+
+    def problem(self, value: object) -> str | None:
+        """Why ``value`` is wrong for this setting (not one of its ``choices``, or its ``check``'s reason), or None.
+
+        >>> Setting("", "sequencing", "--sequencing", choices=("local", "driver")).problem("central")
+        "must be one of local, driver, got 'central'"
+        """
+        if self.choices and value not in self.choices:
+            return f"must be one of {', '.join(self.choices)}, got {value!r}"
+        return self.check(value)
 
 
 def setting(
@@ -134,7 +145,7 @@ def setting_problems(options: object) -> list[Problem]:
     """Every wrong setting of an options dataclass instance, each named by its field path."""
     problems = []
     for field, info in settings(type(options)):
-        reason = info.check(getattr(options, field.name))
+        reason = info.problem(getattr(options, field.name))
         if reason is not None:
             problems.append(Problem(info.path, reason))
     return problems
@@ -147,26 +158,17 @@ def check_settings(options: object) -> None:
         raise InputError(problems)
 
 
-def _one_of_resolutions(value: object) -> str | None:
-    return None if value in RESOLUTIONS else f"must be one of {', '.join(RESOLUTIONS)}, got {value!r}"
-
-
 def _radius_in_bounds(value: int) -> str | None:
     if value < 2:
         return f"must be at least 2 (cells), got {value}"
     return None if value <= MAX_RADIUS else f"must be at most {MAX_RADIUS} (cells), got {value}"
 
 
-def _one_of_searches(value: object) -> str | None:
-    choices = (POLICY_DEFAULT_SEARCH, *SEARCH_NAMES)
-    return None if value in choices else f"must be one of {', '.join(choices)}, got {value!r}"
-
-
 def resolve_setting() -> Any:
     """``resolve``: the thesis's two collision-avoidance techniques (section 2.1), ``divert`` or ``wait``."""
     return setting(
         "divert", help="Conflict resolution: divert (change of route) or wait (velocity tuning).", yaml_key="resolve",
-        flag="--resolve", check=_one_of_resolutions, choices=RESOLUTIONS,
+        flag="--resolve", choices=RESOLUTIONS,
     )
 
 
@@ -203,24 +205,16 @@ def search_setting() -> Any:
         POLICY_DEFAULT_SEARCH,
         help=f"thesis, astar: the single-robot search; {POLICY_DEFAULT_SEARCH} is the policy's own "
         "(thesis: update-coordinate, astar: astar).",
-        yaml_key="search", flag="--search", check=_one_of_searches, choices=(POLICY_DEFAULT_SEARCH, *SEARCH_NAMES),
+        yaml_key="search", flag="--search", choices=(POLICY_DEFAULT_SEARCH, *SEARCH_NAMES),
     )
-
-
-def _one_of_sequencings(value: object) -> str | None:
-    return None if value in SEQUENCINGS else f"must be one of {', '.join(SEQUENCINGS)}, got {value!r}"
 
 
 def sequencing_setting() -> Any:
     """``sequencing``: who orders ``pibt``'s calls, ``driver`` (the simulator) or ``local`` (the robots themselves)."""
     return setting(
         "local", help="pibt: who orders the robots' calls: local (the robots themselves) or driver (the simulator).",
-        yaml_key="sequencing", flag="--sequencing", check=_one_of_sequencings, choices=SEQUENCINGS,
+        yaml_key="sequencing", flag="--sequencing", choices=SEQUENCINGS,
     )  # fmt: skip
-
-
-def _one_of_synchronizers(value: object) -> str | None:
-    return None if value in SYNCHRONIZERS else f"must be one of {', '.join(SYNCHRONIZERS)}, got {value!r}"
 
 
 def synchronizer_setting() -> Any:
@@ -229,12 +223,8 @@ def synchronizer_setting() -> Any:
         "clock",
         help="pibt (local sequencing, simulated or live): when a robot ends its step: clock (a time common to all) or "
         "local (once every robot within 2 cells has decided; a local synchronizer).",
-        yaml_key="synchronizer", flag="--synchronizer", check=_one_of_synchronizers, choices=SYNCHRONIZERS,
+        yaml_key="synchronizer", flag="--synchronizer", choices=SYNCHRONIZERS,
     )  # fmt: skip
-
-
-def _one_of_guidances(value: object) -> str | None:
-    return None if value in GUIDANCES else f"must be one of {', '.join(GUIDANCES)}, got {value!r}"
 
 
 def guidance_setting() -> Any:
@@ -243,12 +233,8 @@ def guidance_setting() -> Any:
         "none",
         help="pibt with turning bodies (others ignore it): the lanes that shape the robots' distance tables: none, "
         "or crisscross (rows and columns alternate direction; a move against its lane counts one step more).",
-        yaml_key="guidance", flag="--guidance", check=_one_of_guidances, choices=GUIDANCES,
+        yaml_key="guidance", flag="--guidance", choices=GUIDANCES,
     )  # fmt: skip
-
-
-def _one_of_bodies(value: object) -> str | None:
-    return None if value in BODY_NAMES else f"must be one of {', '.join(BODY_NAMES)}, got {value!r}"
 
 
 def body_setting() -> Any:
@@ -270,7 +256,7 @@ def body_setting() -> Any:
         help="The body model robots plan for and drive: omni (any direction, turns free: the classic MAPF model) or "
         "turning (LoRR's MAPF_T: forward, a quarter turn either way, or wait; pibt with sequencing: driver, simulated). "
         "thesis is known to the referee and the execution bound only.",
-        yaml_key="body", flag="--body", check=_one_of_bodies, choices=BODY_NAMES,
+        yaml_key="body", flag="--body", choices=BODY_NAMES,
     )  # fmt: skip
 
 
