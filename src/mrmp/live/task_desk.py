@@ -87,10 +87,21 @@ class TaskDesk:
         The run's steps: tasks finished after the last are not counted.
     retry:
         Seconds between two sends of a task its robot has not named in a report yet.
+    flat:
+        The map's flat form, when the caller has one already (its distance lists serve the scheduler); made here
+        from ``grid`` otherwise.
     """
 
-    def __init__(self, stream: TaskStream, grid: Grid, starts: Sequence[Cell], steps: int, retry: float = 0.1) -> None:
-        self.book = TaskBook(stream, FlatMap(grid), len(starts))
+    def __init__(
+        self,
+        stream: TaskStream,
+        grid: Grid,
+        starts: Sequence[Cell],
+        steps: int,
+        retry: float = 0.1,
+        flat: FlatMap | None = None,
+    ) -> None:
+        self.book = TaskBook(stream, flat if flat is not None else FlatMap(grid), len(starts))
         self.index = len(starts)
         """The desk's index on the wire: one past the last robot's."""
         self.steps = steps

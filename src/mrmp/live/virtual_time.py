@@ -240,7 +240,8 @@ class _VirtualFleet:
         self._wakes: list[tuple[float, int, int]] = [(0.0, index, 0) for index in range(robots)]
         self.desk: TaskDesk | None = None
         if scenario.tasks is not None and scenario.max_ticks is not None:
-            self.desk = TaskDesk(scenario.tasks, scenario.grid, [spec.start for spec in scenario.robots], scenario.max_ticks)
+            starts = [spec.start for spec in scenario.robots]
+            self.desk = TaskDesk(scenario.tasks, scenario.grid, starts, scenario.max_ticks, flat=shared.flat)
             self._desk_envelope = Sealer(key, session), Opener(key, session, fleet_size=robots)
             self._desk_version = 0
             self._wake_desk(0.0)
