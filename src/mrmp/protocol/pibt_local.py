@@ -17,7 +17,12 @@ sends :class:`NewsBeaconMessage`: a beacon that also says where the sender
 last heard some peers stood, so that its neighbours learn of the robots around
 it without hearing each of them.
 
-Registered in the message table (:mod:`mrmp.protocol.wire`) under codes 40 to 43.
+A call of higher priority that meets a robot busy in a call of lower
+priority takes it over (wound-wait): :class:`CallWoundMessage` asks the
+lower call to give up, and every robot of it that gives up says so to the
+robots around it (:class:`CallAbortMessage`).
+
+Registered in the message table (:mod:`mrmp.protocol.wire`) under codes 40 to 45.
 
 Examples
 --------
@@ -29,6 +34,8 @@ Examples
 7
 >>> decode(encode(CallAckMessage(4, 1, 12, 9, NO_CLAIM, 0, 0, 0))).claim
 (-1, -1)
+>>> decode(encode(CallAbortMessage(5, 12, 12, root=7))), len(encode(CallWoundMessage(6, 13, 12)))
+(CallAbortMessage(sender=5, seq=12, step=12, root=7), 14)
 >>> beacon = NewsBeaconMessage(3, 11, 12, (4, 5), (9, 9), 2, 30, news=((7, (4, 8), 11), (8, (2, 5), 12)))
 >>> decode(encode(beacon)) == beacon, len(encode(beacon))
 (True, 72)
@@ -47,9 +54,11 @@ from mrmp.protocol.wire import DecodeError, WireFormat, register
 __all__ = [
     "MAX_NEWS",
     "NO_CLAIM",
+    "CallAbortMessage",
     "CallAckMessage",
     "CallInheritMessage",
     "CallReserveMessage",
+    "CallWoundMessage",
     "News",
     "NewsBeaconMessage",
 ]
@@ -124,6 +133,30 @@ class CallAckMessage(PibtMessage):
     def rank(self) -> tuple[int, int, int]:
         """The priority of the call of the claim: ``(elapsed, tie, -root)``, larger first."""
         return (self.root_elapsed, self.root_tie, -self.root)
+
+
+@dataclass(frozen=True, slots=True)
+class CallWoundMessage(PibtMessage):
+    """From a robot to the robot it asked in its call: a call of higher priority wants a robot of this call.
+
+    The recipient gives the call up (:class:`CallAbortMessage`) if it has not
+    decided for good; if it is itself waiting for the answer of the robot it
+    asked, it passes the message on to that robot first.
+    """
+
+    sender: int
+    seq: int
+    step: int
+
+
+@dataclass(frozen=True, slots=True)
+class CallAbortMessage(PibtMessage):
+    """The sender gave up the call of robot ``root`` this step: its provisional reservation is void; it is free again."""
+
+    sender: int
+    seq: int
+    step: int
+    root: int
 
 
 News = tuple[int, Cell, int]
@@ -207,4 +240,12 @@ CALL_ACK = register(
 )
 NEWS_BEACON = register(
     WireFormat(43, NewsBeaconMessage, BEACON.layout + "B", BEACON.pack, _unpack_news_beacon, cells=_news_cells)
+)
+CALL_WOUND = register(
+    WireFormat(44, CallWoundMessage, "!I", lambda m: (m.step,), lambda sender, seq, f, _: CallWoundMessage(sender, seq, *f))
+)
+CALL_ABORT = register(
+    WireFormat(
+        45, CallAbortMessage, "!II", lambda m: (m.step, m.root), lambda sender, seq, f, _: CallAbortMessage(sender, seq, *f)
+    )
 )

@@ -37,7 +37,8 @@ then acts):
    earlier reservation of it, since both reservers stand next to the cell and
    so within 2 cells of each other). In the next round both hear of it; the
    call of lower priority withdraws and tries its next cell; staying on one's
-   own cell always wins (whoever reserved it asked its occupant, who refuses).
+   own cell always wins (whoever reserved it asked its occupant, who refuses),
+   except against a call of higher priority that takes the occupant over (7).
    A robot that has decided and whose reservation survived its round says so:
    the same reservation, marked *final*, and the answer to its parent. A
    reservation that no other robot can rival is final at once: every robot
@@ -45,9 +46,20 @@ then acts):
    decided for good (:meth:`LocalPibtRobot._uncontested`);
 5. a robot treats the cell of a neighbour as free to take only when that
    neighbour's reservation elsewhere is final, or the neighbour is in the same
-   call (PIBT's rotations); a neighbour busy in another call is passed by;
+   call (PIBT's rotations);
 6. at the end of the step a robot moves if it has decided *finally*; one that
-   has not (it did not finish in time) stays and counts an abandoned step.
+   has not (it did not finish in time) stays and counts an abandoned step;
+7. calls meet as transactions do under *wound-wait* (:attr:`LocalPibtRobot.preempts`):
+   a call that needs a robot busy in a call of lower priority (or a cell that
+   such a call reserved and whose occupant has not decided for good) asks the
+   robot anyway; the robot, unless it has decided for good, gives its call up
+   (:class:`~mrmp.protocol.pibt_local.CallAbortMessage`, passed up to the
+   root; a robot waiting for the answer of the robot it asked first passes
+   :class:`~mrmp.protocol.pibt_local.CallWoundMessage` down to it) and takes
+   the request. A call that needs a robot busy in a call of higher priority
+   waits until that robot has decided for good or given up. So where calls
+   started apart meet, the one of higher priority goes on as if it had run
+   first, as in central PIBT.
 
 **Bodies that turn in place** (``turning``) follow the *ahead-or-stay* rule
 (:attr:`~mrmp.robot.pibt_robot.PibtRobot.turns_by_staying`): a robot decides
@@ -62,8 +74,10 @@ it looked at the start rule and could not start yet; a waiting robot looks
 again only once no robot it waits for is left), ``withdrawn`` (reservations lost to a call
 of higher priority), ``refused`` (requests refused because it was busy),
 ``passed_busy`` (cells passed by because their occupant was busy in another
-call), ``settled_at_once`` (reservations final at once, with no rival
-possible) and ``abandoned`` (steps it ended undecided); :attr:`LocalPibtRobot.stalled`
+call: with ``turning`` bodies, or without :attr:`LocalPibtRobot.preempts`),
+``settled_at_once`` (reservations final at once, with no rival possible),
+``aborted`` (calls it gave up for a call of higher priority), ``blocked`` (times it
+waited for a robot busy in a call of higher priority) and ``abandoned`` (steps it ended undecided); :attr:`LocalPibtRobot.stalled`
 and :attr:`LocalPibtRobot.reach` are its stall count and this step's reach.
 
 Examples
@@ -103,7 +117,13 @@ from collections import Counter
 
 from mrmp.core.heading import Heading
 from mrmp.protocol.messages import AnswerMessage, BeaconMessage, Message, PullMessage
-from mrmp.protocol.pibt_local import CallInheritMessage, CallReserveMessage, NewsBeaconMessage
+from mrmp.protocol.pibt_local import (
+    CallAbortMessage,
+    CallInheritMessage,
+    CallReserveMessage,
+    CallWoundMessage,
+    NewsBeaconMessage,
+)
 from mrmp.robot.messaging import Handlers, Outgoing
 from mrmp.robot.pibt_robot import MIN_RADIUS, RESERVE_RADIUS, PibtRobot
 from mrmp.search.flat_map import FlatMap
@@ -168,6 +188,12 @@ class LocalPibtRobot(PibtRobot):
         self._lost = False
         self._withdrawn = False  # lost its reservation while waiting for an answer: the answer comes first
         self._done = False
+        self._blocked_by: int | None = None  # a robot of a call of higher priority whose cell it waits for
+        self._unblocked = False  # that robot decided for good or gave its call up
+        self._wound: CallInheritMessage | None = None  # the request of a call of higher priority, kept until free
+        self._wounded = False  # a call of higher priority wants a robot of its call: give it up
+        self._wound_passed = False  # the robot it asked was told so
+        self._child_gave_up = False  # the robot it asked gave the call up
         self.stalled = 0
         self.reach = radius
         self._y_size = flat.y_size
@@ -196,6 +222,8 @@ class LocalPibtRobot(PibtRobot):
         self._own_rank = self._rank
         self._confirmed, self._finishing, self._lost, self._done = True, None, False, False
         self._withdrawn = False
+        self._blocked_by, self._unblocked = None, False
+        self._wound, self._wounded, self._wound_passed, self._child_gave_up = None, False, False, False
         self.wake = True  # evaluate the start rule once the beacons are in
         return out
 
@@ -283,7 +311,7 @@ class LocalPibtRobot(PibtRobot):
                 reserved[old] = self._parent  # its own cell stays promised to the robot that pushed it
             else:
                 del reserved[old]  # a reservation replaced (after a lost conflict or backtracking)
-                self._restore_final_holder(old)
+                self._restore_holder(old)
         targets[sender] = cell
         rank = self._claims[sender] = (message.root_elapsed, message.root_tie, -message.root)
         final = message.final
@@ -293,6 +321,8 @@ class LocalPibtRobot(PibtRobot):
                 self._above -= 1
             self._final.add(sender)
             self._calls.pop(sender, None)
+            if sender == self._blocked_by:
+                self._unblocked = True  # the robot of a call of higher priority it waited for decided for good
         else:
             self._calls[sender] = message.root
         if cell == self.target and not self._confirmed and sender != self.index:
@@ -305,8 +335,32 @@ class LocalPibtRobot(PibtRobot):
         holder = reserved.get(cell)
         if holder is None or holder == sender or targets.get(holder) != cell or self._outranks(sender, holder, cell):
             reserved[cell] = sender  # two claims of one cell in one round: the winner holds it, as the robots decide
+        if self._unblocked:
+            return True
         # a robot waiting to start reconsiders when the last robot it may have waited for decided for good
         if self.target is None and final and (old is not None or waited):
+            return self.reconsiders_at_every_decision or (not self._above and not self._calls)
+        return False
+
+    @informing.on(CallAbortMessage)
+    def _take_abort(self, message: CallAbortMessage) -> bool:
+        """A robot gave its call up: forget its reservation; act when it was the robot this one asked or waits for."""
+        if self._done:
+            return False
+        sender = message.sender
+        cell = self._targets.pop(sender, None)
+        if cell is not None and self._reserved.get(cell) == sender:
+            del self._reserved[cell]
+            self._restore_holder(cell)
+        self._calls.pop(sender, None)
+        self._claims.pop(sender, None)
+        if sender == self._waiting and message.root == self._root:
+            self._child_gave_up = True  # the robot it asked gave this call up (not one it was in before it was asked)
+            return True
+        if sender == self._blocked_by:
+            self._unblocked = True
+            return True
+        if self.target is None and self._parent is None and self._blocked_by is None:
             return self.reconsiders_at_every_decision or (not self._above and not self._calls)
         return False
 
@@ -319,17 +373,20 @@ class LocalPibtRobot(PibtRobot):
     least the radius). A brain that learns of decisions otherwise sets it.
     """
 
-    def _restore_final_holder(self, cell: int) -> None:
-        """Give ``cell`` back to the robot heard to have decided for good on it, if one did.
+    def _restore_holder(self, cell: int) -> None:
+        """Give ``cell``, whose holder here gave its claim up, to the best claim of it still standing, if any.
 
-        Its claim may have lost here to a provisional one heard first, whose
-        sender has since moved on: a decision for good holds whatever came before.
+        Another claim may have lost here to the one given up: a decision for
+        good heard first, whose holder has since moved on, or (when a call of
+        higher priority takes a robot over) a provisional claim that lost to
+        its occupant staying, before the occupant gave its call up.
         """
-        targets, reserved = self._targets, self._reserved
-        for robot in self._final:
-            if targets.get(robot) == cell:
-                reserved[cell] = robot
-                return
+        best: int | None = None
+        for robot, target in self._targets.items():
+            if target == cell and (best is None or self._outranks(robot, best, cell)):
+                best = robot
+        if best is not None:
+            self._reserved[cell] = best
 
     def _outranks(self, claimant: int, holder: int, cell: int) -> bool:
         """Whether ``claimant``'s claim of ``cell`` beats ``holder``'s.
@@ -353,6 +410,8 @@ class LocalPibtRobot(PibtRobot):
         """Act on this round: settle the last round's reservation, take requests and answers, maybe start."""
         out: list[Outgoing] = []
         self.wake = False
+        if self._preempts() and not self._done and (self._control or self._child_gave_up):
+            self._take_wounds(out)
         if self._lost:
             self._lost = False
             self.stats["withdrawn"] += 1
@@ -377,13 +436,95 @@ class LocalPibtRobot(PibtRobot):
                     self._take_answer(message, out)
                 elif isinstance(message, PullMessage):
                     self._take_pull_local(message, out)
-        if self.target is None and self._parent is None:
+        if self._unblocked:
+            self._unblocked = False
+            if self._blocked_by is not None and not self._done:
+                self._blocked_by = None
+                self._continue(out)  # the cell it waited for: look at it again
+        if self._wound is not None and (self._done or self._idle()):
+            wound, self._wound = self._wound, None
+            self._take_inherit_local(wound, out)  # refused when decided for good, taken when free
+        if self._idle():
             if self._may_start():
                 self._root, self._rank = self.index, self.priority
                 self._begin_call(out)
             else:
                 self.stats["waits"] += 1
         return out
+
+    def _idle(self) -> bool:
+        """Whether the robot is in no call: it has reserved nothing, nobody asked it, and it waits for no cell."""
+        return self.target is None and self._parent is None and self._blocked_by is None
+
+    preempts = True
+    """Whether a call of higher priority takes over the robots of a call of lower priority that it meets (wound-wait).
+
+    Rosenkrantz, Stearns and Lewis, "System level concurrency control for
+    distributed database systems", ACM TODS 3(2), 1978: an older transaction
+    that needs what a younger one holds *wounds* it (the younger one is
+    aborted), a younger one waits for an older one. Here the call of higher
+    priority asks the robot anyway (:class:`CallInheritMessage`); the robot,
+    if it has not decided for good, gives its call up
+    (:class:`~mrmp.protocol.pibt_local.CallAbortMessage`, after telling the
+    robot it asked to do the same, :class:`~mrmp.protocol.pibt_local.CallWoundMessage`)
+    and takes the request. A call that meets a robot busy in a call of higher
+    priority waits until that robot has decided for good or given up, instead
+    of passing its cell by. So the call of higher priority decides as it would
+    had it run first, as in central PIBT. Only a robot that has not decided for
+    good gives a call up, and a decision for good never rests on a call that
+    can still be given up: a rotation ends its call at once.
+    """
+
+    def _preempts(self) -> bool:
+        """Whether this robot's calls take robots over from calls of lower priority (:attr:`preempts`; not ``turning``)."""
+        return self.preempts and not self.turning
+
+    def _take_wounds(self, out: list[Outgoing]) -> None:
+        """Before anything else this round: give the call up when a call of higher priority wants one of its robots.
+
+        Wounded (a request of a call of higher priority, or the robot that
+        asked this one passing such a request on): give the call up at once
+        when waiting for no answer; else pass the request on to the robot it
+        asked, and give up when that robot does. The robot it asked giving up
+        makes it give up too.
+        """
+        busy = not self._idle()
+        for message in self._control:
+            if isinstance(message, CallWoundMessage):
+                if message.sender == self._parent and busy:
+                    self._wounded = True
+                elif self._wound is not None and message.sender == self._wound.sender:
+                    self._refuse(self._wound, out)  # its asker gives its own call up: this robot never joined it
+                    self._wound = None
+            elif isinstance(message, CallInheritMessage) and busy and self._preempts() and message.rank > self._rank:
+                self._wounded = True
+        if self._child_gave_up or (self._wounded and self._waiting is None):
+            self._abort(out)
+        elif self._wounded and not self._wound_passed:
+            self._wound_passed = True
+            assert self._waiting is not None
+            out.append(Outgoing(CallWoundMessage(self.index, self._seq(), self.step), (self._waiting,)))
+
+    def _abort(self, out: list[Outgoing]) -> None:
+        """Give the call up: forget its reservations and say so to the robots within 2 cells; free again."""
+        self.stats["aborted"] += 1
+        root = self._root
+        reserved, targets = self._reserved, self._targets
+        targets.pop(self.index, None)
+        if self.target is not None and reserved.get(self.target) == self.index:
+            del reserved[self.target]
+            self._restore_holder(self.target)
+        if self._parent is not None and reserved.get(self.present) == self._parent:
+            del reserved[self.present]
+            self._restore_holder(self.present)
+        self.target = self._parent = self._waiting = self._blocked_by = self._finishing = self._pulled = None
+        self._confirmed, self._lost, self._withdrawn, self._unblocked = True, False, False, False
+        self._wounded, self._wound_passed, self._child_gave_up = False, False, False
+        self._root, self._rank = self.index, self.priority
+        self.seq += 1
+        decided = self._final
+        recipients = tuple(robot for robot in self._listeners if robot not in decided)
+        out.append(Outgoing(CallAbortMessage(self.index, self.seq, self.step, root), recipients))
 
     def _withdraw(self, out: list[Outgoing]) -> None:
         """The reservation lost to a call of higher priority: the next cell, once the robot asked for it (if any) answered."""
@@ -434,9 +575,14 @@ class LocalPibtRobot(PibtRobot):
         return []
 
     def _take_inherit_local(self, message: CallInheritMessage, out: list[Outgoing]) -> None:
-        if self.target is not None or self._parent is not None:
-            self.stats["refused"] += 1  # busy in a call already: the asker tries its next cell
-            out.append(Outgoing(AnswerMessage(self.index, self._seq(), self.step, False), (message.sender,)))
+        if self._wounded and not self._done and not self._idle() and message.rank > self._rank:
+            if self._wound is None:
+                self._wound = message  # taken once its call is given up (:meth:`_take_wounds`)
+                return
+            if message.rank > self._wound.rank:
+                self._wound, message = message, self._wound  # the request of the highest call is kept, the other refused
+        if self.target is not None or self._parent is not None or self._blocked_by is not None:
+            self._refuse(message, out)  # busy in a call already: the asker tries its next cell
             return
         self._reserved[self.present] = message.sender
         self._targets[message.sender] = self.present
@@ -445,10 +591,16 @@ class LocalPibtRobot(PibtRobot):
         self._root, self._rank = message.root, message.rank
         self._begin_call(out)
 
+    def _refuse(self, message: CallInheritMessage, out: list[Outgoing]) -> None:
+        """Answer a request that this robot stays, without taking part in the call."""
+        self.stats["refused"] += 1
+        out.append(Outgoing(AnswerMessage(self.index, self._seq(), self.step, False), (message.sender,)))
+
     def _take_pull_local(self, message: PullMessage, out: list[Outgoing]) -> None:
         cell = self.flat.index(message.cell)
         if self.target is None and self._parent is None and cell not in self._reserved:
-            self._root, self._rank = self.index, self.priority
+            self._rank = max(self.priority, self._claims.get(message.sender, NO_RANK))
+            self._root = -self._rank[2]
             self._candidates, self._next, self._pulled = [cell], 0, None
             self._continue(out)
 
@@ -510,15 +662,18 @@ class LocalPibtRobot(PibtRobot):
         return Outgoing(message, tuple(recipients))
 
     def _continue(self, out: list[Outgoing]) -> None:
+        if self._wounded:
+            self._abort(out)  # a call of higher priority wants a robot of this call: give it up instead of going on
+            return
         here = self.present
         reserved, occupants, targets, final = self._reserved, self._occupants, self._targets, self._final
         candidates = self._candidates
         while self._next < len(candidates):
             cell = candidates[self._next]
-            if cell in reserved:
+            occupant = occupants.get(cell)
+            if cell in reserved and not self._contestable(cell, occupant):
                 self._next += 1
                 continue
-            occupant = occupants.get(cell)
             if self.turning and cell != here and cell != self._ahead_cell:
                 if self._turns_toward(cell, occupant, out):
                     return
@@ -530,6 +685,14 @@ class LocalPibtRobot(PibtRobot):
                 self._claim(cell, True, out)
                 return
             target = targets.get(occupant)
+            if target is not None and self._preempts() and self._calls.get(occupant, self._root) != self._root:
+                if self._claims.get(occupant, NO_RANK) < self._rank:
+                    self._ask(cell, occupant, out)  # busy in a call of lower priority: wound it (:attr:`preempts`)
+                    return
+                if target != here:
+                    self.stats["blocked"] += 1
+                    self._blocked_by = occupant  # busy in a call of higher priority: wait until it decides
+                    return
             if target == here:
                 self._next += 1  # the occupant moves into our cell: taking its cell would swap
                 continue
@@ -541,13 +704,29 @@ class LocalPibtRobot(PibtRobot):
                 self.stats["passed_busy"] += 1  # busy in another call: it may yet stay
                 self._next += 1
                 continue
-            self._reserve(cell, out)
-            self._waiting = occupant  # priority inheritance
-            root, (elapsed, tie, _) = self._root, self._rank
-            inherit = CallInheritMessage(self.index, self._seq(), self.step, self.flat.cells[cell], root, elapsed, tie)
-            out.append(Outgoing(inherit, (occupant,)))
+            self._ask(cell, occupant, out)
             return
         self._claim(here, False, out)  # no candidate left: stay
+
+    def _contestable(self, cell: int, occupant: int | None) -> bool:
+        """Whether ``cell``, reserved, is reserved in a call of lower priority and its occupant can still be asked.
+
+        Then the call asks the occupant as if the cell were not reserved: the
+        occupant takes the request of higher priority first, or gives its own
+        call up for it (:attr:`preempts`).
+        """
+        if not self._preempts() or occupant is None or occupant == self.index or occupant in self._final:
+            return False
+        holder = self._reserved[cell]
+        return holder != self.index and holder not in self._final and self._claims.get(holder, NO_RANK) < self._rank
+
+    def _ask(self, cell: int, occupant: int, out: list[Outgoing]) -> None:
+        """Reserve ``cell`` and ask its ``occupant`` to decide within this call (priority inheritance)."""
+        self._reserve(cell, out)
+        self._waiting = occupant
+        root, (elapsed, tie, _) = self._root, self._rank
+        inherit = CallInheritMessage(self.index, self._seq(), self.step, self.flat.cells[cell], root, elapsed, tie)
+        out.append(Outgoing(inherit, (occupant,)))
 
     def _turns_toward(self, cell: int, occupant: int | None, out: list[Outgoing]) -> bool:
         """Ahead-or-stay: the robot chose ``cell``, which its body does not face; False when it passes the cell by.

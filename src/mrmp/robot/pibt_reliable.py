@@ -104,6 +104,10 @@ class ReliablePibtRobot(LocalPibtRobot):
 
     rotations = False
 
+    preempts = False
+    """No wound-wait (:attr:`~mrmp.robot.pibt_local.LocalPibtRobot.preempts`): a call that meets a robot busy in
+    another call passes its cell by, as before."""
+
     reach_cap = 0
     """The reach stays the radio radius: only robots within 2 cells acknowledge a final reservation, so a robot
     farther away that waited for it could wait in vain for the rest of the step (and an abandoned step, counted

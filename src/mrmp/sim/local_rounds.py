@@ -68,6 +68,7 @@ STEP_RETRIES = 8
 
 ROBOT_COUNTS = (
     "waits", "withdrawn", "refused", "passed_busy", "settled_at_once", "abandoned", "acks", "retransmissions",
+    "aborted", "blocked",
 )  # fmt: skip
 """What the robots count themselves, reported in the result's ``network``."""
 

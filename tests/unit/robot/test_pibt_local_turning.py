@@ -156,7 +156,7 @@ def test_a_claim_decided_for_good_holds_before_its_claimants_beacon_comes_in(bro
     """
     if broken:
         monkeypatch.setattr(LocalPibtRobot, "_outranks", occupant_first)
-        monkeypatch.setattr(LocalPibtRobot, "_restore_final_holder", lambda self, cell: None)
+        monkeypatch.setattr(LocalPibtRobot, "_restore_holder", lambda self, cell: None)
     flat = FlatMap(Grid(1, 4))
     robot = LocalPibtRobot(0, flat.index((0, 0)), flat.index((0, 3)), flat, tie=3)
     robot.begin_step(1)
