@@ -13,8 +13,10 @@ driver (:class:`mrmp.sim.rounds.RoundsSimulator`) and with local sequencing
 * rounds/step and msg/robot/step (messages, one per recipient);
 * for local sequencing, the robots' own counts per robot and step: rounds
   waited before starting, reservations withdrawn, requests refused, cells
-  passed by because their occupant was busy, steps abandoned, and (over a
-  faulty network) retransmissions.
+  passed by because their occupant was busy, calls given up for a call of
+  higher priority (``aborted``), waits for a robot busy in a call of higher
+  priority (``blocked``), steps abandoned, and (over a faulty network)
+  retransmissions.
 
 With ``--loss``, ``--duplicate`` or ``--delay-max`` both run over that
 network: the sequenced driver's link layer retransmits until every message
@@ -102,7 +104,8 @@ def main() -> int:
     simulators = [(label, simulator) for label, simulator in simulators if arguments.order in (None, label)]
     print(
         f"{'map':<30} {'N':>5} {'order':>6} {'success':>7} {'SoC/LB':>7} {'mksp':>5} {'ms/step':>8} {'x drv':>6} {'rnd/step':>8}"
-        f" {'msg/r/s':>7} {'wait':>6} {'withdr':>7} {'refuse':>7} {'passed':>7} {'aband':>6} {'retrans':>7}"
+        f" {'msg/r/s':>7} {'wait':>6} {'withdr':>7} {'refuse':>7} {'passed':>7} {'abort':>7} {'block':>7}"
+        f" {'aband':>6} {'retrans':>7}"
     )
     for name, scenario in cases(arguments):
         agents = len(scenario.robots)
@@ -135,6 +138,8 @@ def main() -> int:
                     ("withdrawn", 7),
                     ("refused", 7),
                     ("passed_busy", 7),
+                    ("aborted", 7),
+                    ("blocked", 7),
                     ("abandoned", 6),
                     ("retransmissions", 7),
                 )

@@ -57,7 +57,8 @@ then acts):
    root; a robot waiting for the answer of the robot it asked first passes
    :class:`~mrmp.protocol.pibt_local.CallWoundMessage` down to it) and takes
    the request. A call that needs a robot busy in a call of higher priority
-   waits until that robot has decided for good or given up. So where calls
+   waits until that robot has decided for good or given up, and a robot pulled
+   by the swap technique claims with its puller's call's rank. So where calls
    started apart meet, the one of higher priority goes on as if it had run
    first, as in central PIBT.
 
@@ -599,7 +600,9 @@ class LocalPibtRobot(PibtRobot):
     def _take_pull_local(self, message: PullMessage, out: list[Outgoing]) -> None:
         cell = self.flat.index(message.cell)
         if self.target is None and self._parent is None and cell not in self._reserved:
-            self._rank = max(self.priority, self._claims.get(message.sender, NO_RANK))
+            self._rank = self.priority
+            if self._preempts():  # the pull is part of the puller's call, as in central PIBT (rule 7)
+                self._rank = max(self._rank, self._claims.get(message.sender, NO_RANK))
             self._root = -self._rank[2]
             self._candidates, self._next, self._pulled = [cell], 0, None
             self._continue(out)
