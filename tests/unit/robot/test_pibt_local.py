@@ -520,14 +520,26 @@ class PulledAtItsOwnPriority(LocalPibtRobot):
             self._continue(out)
 
 
+def warehouse_400(seed):
+    maps = Path(__file__).resolve().parents[3] / "maps"
+    name = "warehouse-10-20-10-2-1"
+    scenario = load_movingai_scenario(maps / f"{name}.map", maps / f"{name}-random-1.scen", 400)
+    return scenario.with_changes(seed=seed, max_ticks=500)
+
+
+@pytest.mark.slow
+def test_warehouse_with_400_robots_arrives_on_every_seed_of_the_bench():
+    """``bench/pibt_scale.py --only warehouse-10-20-10-2-1 --seeds 15``: every seed arrives, within 500 ticks."""
+    for seed in range(15):
+        result = LocalRoundsSimulator(warehouse_400(seed)).run()
+        assert result.success and result.collisions == [] and result.network["abandoned"] == 0, seed
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize(("seed", "broken"), [(1, NoTakeOver), (0, PulledAtItsOwnPriority)])
 def test_warehouse_jams_that_local_sequencing_gets_through(seed, broken):
     """warehouse-10-20-10-2-1 with 400 robots: the default arrives within 500 ticks; each broken rule jams a corridor."""
-    maps = Path(__file__).resolve().parents[3] / "maps"
-    name = "warehouse-10-20-10-2-1"
-    scenario = load_movingai_scenario(maps / f"{name}.map", maps / f"{name}-random-1.scen", 400)
-    scenario = scenario.with_changes(seed=seed, max_ticks=500)
+    scenario = warehouse_400(seed)
 
     class Simulator(LocalRoundsSimulator):
         robot_type = broken
