@@ -101,6 +101,27 @@ class Handlers:
         """The method (unbound) that takes in ``message``, or None when the brain has none for its type."""
         return self._table.get(type(message))
 
+    def copy(self) -> Handlers:
+        """A copy of the table, for a subclass whose brain takes some types of message in its own way.
+
+        >>> class Echo:
+        ...     handlers = Handlers()
+        ...     @handlers.on(ClaimMessage)
+        ...     def _take_claim(self, message, now):
+        ...         return [Outgoing(message, (message.sender,))]
+        >>> class Quiet(Echo):
+        ...     handlers = Echo.handlers.copy()
+        ...     @handlers.on(ClaimMessage)
+        ...     def _ignore_claim(self, message, now):
+        ...         return []
+        >>> claim = ClaimMessage(3, 1, 1, (0, 1))
+        >>> len(Quiet.handlers.get(claim)(Quiet(), claim, 0.0)), len(Echo.handlers.get(claim)(Echo(), claim, 0.0))
+        (0, 1)
+        """
+        copied = Handlers()
+        copied._table.update(self._table)
+        return copied
+
 
 class MessageEndpoint:
     """Numbering, state messages and datagram decoding of a robot brain (see the module docstring).

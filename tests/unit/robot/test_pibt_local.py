@@ -453,10 +453,14 @@ class KeepsTheRequestOfAQuitter(LocalPibtRobot):
         super()._take_wounds(out)
 
 
-def any_root_gives_up(table):
+class AnyAbortEndsTheCall(LocalPibtRobot):
     """Broken: an abort of the robot a robot asked ends the asker's call whichever call it gave up (the robot's old one)."""
-    take = table[CallAbortMessage]
-    return lambda self, message: take(self, dataclasses.replace(message, root=self._root))
+
+    informing = LocalPibtRobot.informing.copy()
+
+    @informing.on(CallAbortMessage)
+    def _take_any_abort(self, message):
+        return self._take_abort(dataclasses.replace(message, root=self._root))
 
 
 def crowd_at(seed, radius):
@@ -486,12 +490,13 @@ def test_a_given_up_claim_hands_its_cell_to_the_claim_still_standing():
     assert Simulator(crowd_at(1, 3)).run().collisions != []
 
 
-def test_an_abort_ends_the_askers_call_only_when_it_gives_that_call_up(monkeypatch):
+def test_an_abort_ends_the_askers_call_only_when_it_gives_that_call_up():
+    class Simulator(LocalRoundsSimulator):
+        robot_type = AnyAbortEndsTheCall
+
     cases = [(6, 2), (22, 2), (53, 2)]
     assert all(LocalRoundsSimulator(crowd_at(*case)).run().collisions == [] for case in cases)
-    table = LocalPibtRobot.informing._table
-    monkeypatch.setitem(table, CallAbortMessage, any_root_gives_up(table))
-    assert all(LocalRoundsSimulator(crowd_at(*case)).run().collisions != [] for case in cases)
+    assert all(Simulator(crowd_at(*case)).run().collisions != [] for case in cases)
 
 
 def test_a_request_whose_asker_gave_its_call_up_is_refused():
