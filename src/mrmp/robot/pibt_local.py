@@ -361,7 +361,7 @@ class LocalPibtRobot(PibtRobot):
         if sender == self._blocked_by:
             self._unblocked = True
             return True
-        if self.target is None and self._parent is None and self._blocked_by is None:
+        if self._idle():
             return self.reconsiders_at_every_decision or (not self._above and not self._calls)
         return False
 
@@ -522,10 +522,9 @@ class LocalPibtRobot(PibtRobot):
         self._confirmed, self._lost, self._withdrawn, self._unblocked = True, False, False, False
         self._wounded, self._wound_passed, self._child_gave_up = False, False, False
         self._root, self._rank = self.index, self.priority
-        self.seq += 1
         decided = self._final
         recipients = tuple(robot for robot in self._listeners if robot not in decided)
-        out.append(Outgoing(CallAbortMessage(self.index, self.seq, self.step, root), recipients))
+        out.append(Outgoing(CallAbortMessage(self.index, self._seq(), self.step, root), recipients))
 
     def _withdraw(self, out: list[Outgoing]) -> None:
         """The reservation lost to a call of higher priority: the next cell, once the robot asked for it (if any) answered."""
@@ -582,7 +581,7 @@ class LocalPibtRobot(PibtRobot):
                 return
             if message.rank > self._wound.rank:
                 self._wound, message = message, self._wound  # the request of the highest call is kept, the other refused
-        if self.target is not None or self._parent is not None or self._blocked_by is not None:
+        if not self._idle():
             self._refuse(message, out)  # busy in a call already: the asker tries its next cell
             return
         self._reserved[self.present] = message.sender
@@ -599,7 +598,7 @@ class LocalPibtRobot(PibtRobot):
 
     def _take_pull_local(self, message: PullMessage, out: list[Outgoing]) -> None:
         cell = self.flat.index(message.cell)
-        if self.target is None and self._parent is None and cell not in self._reserved:
+        if self._idle() and cell not in self._reserved:
             self._rank = self.priority
             if self._preempts():  # the pull is part of the puller's call, as in central PIBT (rule 7)
                 self._rank = max(self._rank, self._claims.get(message.sender, NO_RANK))
