@@ -92,7 +92,7 @@ class TaskServer:
             data = self.transport.receive(min(POLL_S, max(0.0, desk.next_due() - now)))
             if data is not None:
                 self._answer(data)
-            if self.desk.changes != self._written and time.monotonic() - written_at >= WRITE_EVERY_S:
+            if desk.changes != self._written and time.monotonic() - written_at >= WRITE_EVERY_S:
                 self._write()
                 written_at = time.monotonic()
 

@@ -117,8 +117,7 @@ class UdpEntry(TransportEntry[UdpOptions]):
 
     def arguments(self, options: UdpOptions, ids: Sequence[str]) -> list[str]:
         peers = [f"--peer={ids[other]}={_text(address)}" for other, address in options.peers.items()]
-        desk = [] if options.desk is None else [f"--task-desk={_text(options.desk)}"]
-        return [f"--bind={_text(options.bind)}", *peers, *desk]
+        return [f"--bind={_text(options.bind)}", *peers, *_desk_arguments(options.desk)]
 
     hosts_several = True
 
@@ -145,8 +144,13 @@ class UdpEntry(TransportEntry[UdpOptions]):
         >>> UdpEntry().hosting_arguments(FleetLayout(("A", "B"), (9001, 9002), 9003, "mrmp/7"), [1])
         ['--peer=A=127.0.0.1:9001', '--peer=B=127.0.0.1:9002']
         """
-        desk = [] if layout.desk is None else [f"--task-desk={_text(layout.desk)}"]
-        return [f"--peer={robot}={layout.host}:{port}" for robot, port in zip(layout.ids, layout.ports, strict=True)] + desk
+        peers = [f"--peer={robot}={layout.host}:{port}" for robot, port in zip(layout.ids, layout.ports, strict=True)]
+        return peers + _desk_arguments(layout.desk)
+
+
+def _desk_arguments(desk: Address | None) -> list[str]:
+    """``mrmp agent``'s argument for a lifelong run's task desk at ``desk`` (none without a desk)."""
+    return [] if desk is None else [f"--task-desk={_text(desk)}"]
 
 
 # -- UDP multicast ------------------------------------------------------------------------------
