@@ -38,8 +38,8 @@ common clock; the simulator's makespan stays that of the clock's lockstep.
 live robots and the simulator plan in that body's model, a step is one action
 (a cell or a quarter turn, one cell time), and the execution bound is
 :func:`mrmp.centralized.body_time.execution_seconds` of the simulator's cells
-and headings as live bodies drive them (a robot enters a cell once its occupant
-has arrived elsewhere).
+and headings as live turning bodies drive them (a robot starts into a cell once its
+occupant has started out: "Following while driving" in ``docs/protocol.md``).
 
 Usage: python bench/live_pibt.py [--cases udp24,zenoh24,udp64,side] [--time-scale 2] [--before REV]
        [--synchronizer clock|local] [--body omni|turning]
@@ -146,7 +146,7 @@ def execution_bound(scenario: Scenario, time_scale: float) -> float:
         starts = [robot.heading for robot in scenario.robots]
         headings = [robot.headings for robot in run.robots]
         cells = [robot.path for robot in run.robots]
-        return execution_seconds(cells, starts, scenario.timing, time_scale, body_model(BODY), headings, follows=False)
+        return execution_seconds(cells, starts, scenario.timing, time_scale, body_model(BODY), headings)
     local = scenario.with_changes(policy=PolicyOptions(name="pibt", sequencing="local"), network=NetworkFaults())
     paths: list[list[Cell]] = [list(robot.path) for robot in LocalRoundsSimulator(local).run().robots]
     length = max(len(path) for path in paths)

@@ -19,13 +19,16 @@ Bodies (``--bodies``, comma-separated; ``docs/protocol.md``, "Body models"):
   their next cell while they wait.
 
 The live execution bound (:func:`mrmp.centralized.body_time.execution_seconds`) is the
-soonest live bodies can carry the plan out, whatever messages cost. Live bodies cover
-both cells while they move, so the safety layer hands a cell over once its occupant
-has arrived elsewhere: a robot that follows another into a cell it leaves in the same
-tick starts once the other has arrived (``follows=False``). It is what the messages are
-measured against. Before the runs, the bound is printed as a multiple of the plan's
-ticks times the cell time (for ``thesis``, also the bound of bodies that turn in no
-time: what following alone costs).
+soonest live bodies can carry the plan out, whatever messages cost. The thesis's bodies
+cover both cells while they move, so the safety layer hands a cell over once its
+occupant has arrived elsewhere: a robot that follows another into a cell it leaves in
+the same tick starts once the other has arrived. ``turning`` bodies are followed while
+they drive (``docs/protocol.md``, "Following while driving"): a robot starts into a
+cell once its occupant has started out, as the plan's model allows, and the bound is
+the plan's makespan (``--kill`` runs drive without following, and are bounded so). It
+is what the messages are measured against. Before the runs, the bound is printed as a
+multiple of the plan's ticks times the cell time (for ``thesis``, also the bound of
+bodies that turn in no time: what not following costs).
 
 Usage: python bench/live_plan.py [--agents 48] [--bodies thesis,turning] [--time-scales 2,5] [--loss 0.1] [--kill 3@2]
 """
@@ -79,29 +82,32 @@ def main() -> int:
         if plan.paths is None:
             print(f"{name:>7} lacam: no plan ({plan.status}: {plan.message})")
             continue
-        _say_bounds(name, scenario, plan)
+        _say_bounds(name, scenario, plan, follows=not kill)
         for scale in [float(text) for text in arguments.time_scales.split(",")]:
             _run(name, scenario, plan, scale, arguments.loss, kill)
     return 0
 
 
-def _bound(name: str, scenario: Scenario, plan: PlanningResult, scale: float, turn_time: float | None = None) -> float:
-    """The live execution bound of ``plan`` driven by ``name`` bodies (module docstring), in seconds at ``scale``."""
+def _bound(
+    name: str, scenario: Scenario, plan: PlanningResult, scale: float, follows: bool, turn_time: float | None = None
+) -> float:
+    """The live execution bound of ``plan`` driven by ``name`` bodies (module docstring), in seconds at ``scale``;
+    ``follows``: whether bodies that may be followed while they drive are (not in a run that kills robots)."""
     assert plan.paths is not None
     headings = [robot.heading for robot in scenario.robots]
     timing = scenario.timing if turn_time is None else replace(scenario.timing, turn_time=turn_time)
     if name == "thesis":
         return execution_seconds(plan.paths, headings, timing, scale)
-    return execution_seconds(plan.paths, headings, timing, scale, body=body_model(name), follows=False)
+    return execution_seconds(plan.paths, headings, timing, scale, body=body_model(name), follows=follows)
 
 
-def _say_bounds(name: str, scenario: Scenario, plan: PlanningResult) -> None:
+def _say_bounds(name: str, scenario: Scenario, plan: PlanningResult, follows: bool) -> None:
     """Print the plan's makespan and its live execution bound as a multiple of its ticks times the cell time."""
     ticks = plan.makespan() * scenario.timing.cell_time
     line = f"{name:>7}: {PLANNED_BODY[name]} plan, makespan {plan.makespan()} ticks; live execution bound"
-    line += f" {_bound(name, scenario, plan, 1.0) / ticks:.2f} times its ticks x cell time"
+    line += f" {_bound(name, scenario, plan, 1.0, follows) / ticks:.2f} times its ticks x cell time"
     if name == "thesis":
-        line += f" ({_bound(name, scenario, plan, 1.0, turn_time=0.0) / ticks:.2f} with bodies turning in no time)"
+        line += f" ({_bound(name, scenario, plan, 1.0, follows, turn_time=0.0) / ticks:.2f} with bodies turning in no time)"
     print(line)
 
 
@@ -114,7 +120,7 @@ def _run(name: str, scenario: Scenario, plan: PlanningResult, scale: float, loss
     moves = max(1, result.network.get("moves", 0))
     turns = sum(robot.turns for robot in result.robots) if name == "turning" else 0
     planned = plan.makespan() * scenario.timing.cell_time / scale
-    bound = _bound(name, scenario, plan, scale)
+    bound = _bound(name, scenario, plan, scale, follows=not kill)
     print(
         f"{name:>7} {scale:>5g} {arrived:>4}/{len(result.robots):<3} {len(result.collisions):>4}"
         f" {result.time_makespan_s:>7.2f} {planned:>7.2f} {result.time_makespan_s / planned:>6.2f} {bound:>7.2f}"

@@ -8,8 +8,9 @@ per datagram it takes in or sends). It prints, per case: robots arrived,
 collisions (the live referee's), the virtual makespan, the simulator's makespan
 (``pibt`` with local sequencing over a perfect network, one cell time a step)
 and the execution bound (those decisions carried out by live bodies, with no
-time for messages: :func:`mrmp.centralized.body_time.execution_seconds`, a
-body entering a cell once its occupant has arrived elsewhere) with the ratio
+time for messages: :func:`mrmp.centralized.body_time.execution_seconds`; a
+thesis body enters a cell once its occupant has arrived elsewhere, a turning one
+once its occupant has started out) with the ratio
 to each, moves, datagrams per move, the robots' own counts (steps begun held,
 held robots that gave up, abandoned steps, retransmissions), and what the
 harness cost: its CPU seconds and microseconds per datagram handled (the same
@@ -66,7 +67,7 @@ def simulated_seconds(scenario: Scenario, time_scale: float) -> tuple[int, float
     headings = [robot.headings for robot in run.robots]
     live_body = body_model("turning") if scenario.policy.body == "turning" else body_model("thesis")
     try:
-        bound = execution_seconds(cells, starts, scenario.timing, time_scale, live_body, headings, follows=False)
+        bound = execution_seconds(cells, starts, scenario.timing, time_scale, live_body, headings)
     except PlanDeadlockError:  # a rotation of the simulator's: live bodies that never follow cannot carry it out
         bound = None
     return run.makespan, bound

@@ -1126,6 +1126,7 @@ def agent(
     reorder: Annotated[float, typer.Option(help="Inject: probability that a sent message is held back.")] = 0.0,
     listen_time: Annotated[float, typer.Option(help="Seconds between announcing Next and deciding.")] = 0.05,
     unsafe: Annotated[bool, typer.Option("--unsafe", help="No safety layer: the policy as written.")] = False,
+    no_follow: Annotated[bool, typer.Option("--no-follow", help="A body that turns in place keeps its cell until it has arrived in the next one, so that nobody follows it in (mrmp run --live sets it when it kills robots: a body stopped mid-drive could be driven into).")] = False,
     plan: Annotated[Path | None, typer.Option(help="Follow this robot's share of a central plan (plan-<index>.json).", show_default="none: the policy decides")] = None,
     seed: Annotated[int, typer.Option(help="Seed of the body's and the fault injector's randomness.")] = 0,
     timeout: Annotated[float, typer.Option(help="Give up after this many seconds.")] = 600.0,
@@ -1195,6 +1196,7 @@ def agent(
             jitter=_fraction(jitter, "--jitter"),
             miss_line=_fraction(miss_line, "--miss-line"),
             guarded=not unsafe and scenario.safety,
+            follow=not no_follow,
             seed=seed,
             timing=AgentTiming(
                 listen_time=_not_negative(listen_time, "--listen-time", MAX_STEP_SECONDS),

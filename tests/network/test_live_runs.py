@@ -209,6 +209,42 @@ def test_a_turning_plan_is_driven_live_by_turning_bodies_through_loss_and_jitter
         assert robot.turns == needed, robot.id
 
 
+def followings(results: Path) -> int:
+    """How often a body started into a cell before the body it followed there had left it, by the referee's intervals."""
+    intervals = json.loads((results / "referee.json").read_text())["intervals"]
+    by_cell: dict[tuple[int, int], list[tuple[float, float, int]]] = {}
+    for interval in intervals:
+        end = interval["end"] if interval["end"] is not None else float("inf")
+        by_cell.setdefault(tuple(interval["cell"]), []).append((interval["start"], end, interval["robot"]))
+    count = 0
+    for spans in by_cell.values():
+        spans.sort()
+        count += sum(1 for before, after in itertools.pairwise(spans) if after[0] < before[1] and after[2] != before[2])
+    return count
+
+
+def test_turning_bodies_follow_one_another_live_as_the_plan_has_them(tmp_path):
+    """Bodies that turn in place, with no jitter, are followed while they drive (``docs/protocol.md``, "Following
+    while driving"): executing a LaCAM plan for them over lossy UDP, robots start into cells their occupants are
+    still driving out of, and the referee, which judges such followings by their order and footprints, finds
+    no collision. The same plan with bodies that jitter is driven without a single following."""
+    from mrmp.centralized.registry import plan_with
+    from mrmp.io import load_movingai_scenario
+
+    maps = Path(__file__).resolve().parents[2] / "maps"
+    loaded = load_movingai_scenario(maps / "random-32-32-20.map", maps / "random-32-32-20-random-1.scen", 16)
+    scenario = loaded.with_changes(policy=PolicyOptions(body="turning"))
+    plan = plan_with("lacam", scenario, time_limit_s=30)
+    assert plan.solved and plan.paths is not None
+    faults = LiveFaults(loss=0.2)
+    result = live(scenario, tmp_path / "follows", time_scale=20, faults=faults, plan=plan, seed=3)
+    assert result.collisions == [] and result.success, result.stop_reason
+    assert followings(tmp_path / "follows" / "run") > 0
+    result = live(scenario, tmp_path / "jitters", time_scale=20, faults=faults, jitter=0.2, plan=plan, seed=3)
+    assert result.collisions == [] and result.success, result.stop_reason
+    assert followings(tmp_path / "jitters" / "run") == 0
+
+
 def test_killed_robot_in_a_live_plan_execution_blocks_only_the_goals_it_stands_on(tmp_path):
     """Sixteen robots execute a LaCAM plan; robot 3 is killed early. Robots waiting for it drop it or leave the
     plan (``mrmp.policies.plan_following``, crash rule): every robot whose goal the dead robot does not cut off

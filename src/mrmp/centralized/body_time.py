@@ -34,11 +34,13 @@ against.
   be carried out (no robot of it may start first).
 
 With ``follows=False`` a body that may follow is timed as live bodies drive
-it: the live safety layer hands a cell over once its occupant has *arrived*
-elsewhere (a live body covers both cells while it moves), so a robot enters
-a cell only then, as for ``thesis``; a ``turning`` body turns toward its next
-cell while it waits (:meth:`~mrmp.robot.robot.Robot.turn`), so its quarter
-turns overlap the wait.
+it when nobody may follow them (a live run that kills robots, or whose bodies
+jitter: :func:`mrmp.live.body.drives_for_following`): the live safety layer
+then hands a cell over once its occupant has *arrived* elsewhere, so a robot
+enters a cell only then, as for ``thesis``; a ``turning`` body turns toward its
+next cell while it waits (:meth:`~mrmp.robot.robot.Robot.turn`), so its quarter
+turns overlap the wait. Otherwise live ``turning`` bodies are followed while
+they drive, and the body's own rule times them.
 
 For a plan the body can carry out tick by tick (every move legal for it under
 :class:`~mrmp.sim.referee.Referee`), an action of tick ``t`` can start by
@@ -121,8 +123,8 @@ def execution_seconds(
     keeps its last heading once its list ends); only a ``turning`` body reads
     it, counting every quarter turn it shows, in place or before a move.
     ``follows`` overrides the body's following rule: False times the body
-    as live fleets drive it (module docstring; its turns are then derived
-    from the cell paths).
+    as live fleets that do not follow drive it (module docstring; its turns
+    are then derived from the cell paths).
 
     Raises
     ------

@@ -281,8 +281,10 @@ def action_dependencies(
     the leader leaves is the safety layer's lockstep rule
     (:class:`~mrmp.protocol.safety.SafetyLayer`, ``following``), not the
     graph. So these dependencies are for guarded robots of the lockstep
-    simulator only; the check is made on the strict graph, which a rotation
-    makes cyclic (the safety layer refuses rotations too).
+    simulator, and for live bodies followed while they drive (its rule
+    ``releases_on_start``: the leader's cell is granted once it drives out)
+    only; the check is made on the strict graph, which a rotation makes
+    cyclic (the safety layer refuses rotations too).
 
     >>> action_dependencies([[(0, 0), (0, 1), (0, 2)], [(0, 1), (0, 2), (0, 3)]], following=True)[1]
     [{0: [(1, 0)], 1: [(1, 1)]}, {}]

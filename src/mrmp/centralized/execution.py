@@ -28,8 +28,9 @@ from mrmp.policies.plan_following import PlanFollowingPolicy
 def plan_policies(plan: PlanningResult, *, following: bool = False, scheduled: bool = False) -> list[PlanFollowingPolicy]:
     """One plan-following policy per robot, in scenario order.
 
-    ``following``: robots guarded by the safety layer's lockstep rule may make
-    a move that follows another robot's in the same tick as that one
+    ``following``: robots guarded by the safety layer's lockstep rule, or
+    live bodies followed while they drive, may make a move that follows
+    another robot's in the same tick as that one
     (:func:`~mrmp.centralized.dependencies.action_dependencies`).
     ``scheduled``: each move waits for its planned tick too (drivers whose
     time is counted in the plan's ticks: the lockstep simulator).

@@ -89,6 +89,18 @@ class BodyModel:
     follows: bool
     rotations: bool
 
+    @property
+    def follows_while_driving(self) -> bool:
+        """Whether live bodies of this model may follow: each move a straight drive of one cell (its turns are
+        actions of their own), so a robot may start into a cell once its occupant has started driving out of it
+        (``docs/protocol.md``, "Following while driving"). A ``thesis`` body turns on the cell it leaves, and an
+        ``omni`` plan is driven live by the thesis's bodies: neither.
+
+        >>> [name for name, body in BODY_TABLE.items() if body.follows_while_driving]
+        ['turning']
+        """
+        return self.follows and self.turns_in_place
+
     def quarter_turns(self, facing: Heading, wanted: Heading) -> int:
         """How many quarter turns take the body from ``facing`` to ``wanted`` (0 for a body without heading).
 

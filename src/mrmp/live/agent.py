@@ -126,6 +126,7 @@ class Agent(LiveDriver):
             silence_timeout=timing.silence_timeout,
             state_radius=None if radius is None else live_state_radius(radius),
             body=body_model(scenario.policy.body),
+            follows_while_driving=body.follows,
         )
         self._repeat_at = math.inf  # when the state goes again after an arrival (a robot that listens for nothing)
         self._phase = Phase.LISTEN

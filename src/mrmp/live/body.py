@@ -88,6 +88,9 @@ class Body(Protocol):
     """The cell the robot believes it stands on (from its own sensors)."""
     heading: Heading
     moving: bool
+    follows: bool
+    """Whether a robot may start into a cell this body has started driving out of: its moves are straight drives
+    of one cell at the fleet's one speed (:func:`drives_for_following`)."""
 
     def start_move(self, target: Cell, now: float) -> None:
         """Turn toward the adjacent ``target`` and drive into it."""
@@ -100,6 +103,23 @@ class Body(Protocol):
     def next_event(self) -> float | None:
         """When ``poll`` next has something to do (an entry, the move's end); None: poll it as often as possible."""
         ...
+
+
+def drives_for_following(model: BodyModel | None, grid: Grid, jitter: float, miss_line: float) -> bool:
+    """Whether simulated bodies of ``model`` on ``grid`` may be followed: a model that follows while driving, each
+    move exactly one cell (no missed line) at the one speed of the fleet (no jitter, no cell that costs more to
+    enter: a slower leader could be caught up).
+
+    >>> from mrmp.core.body import body_model
+    >>> turning, plain = body_model("turning"), Grid(3, 3)
+    >>> drives_for_following(turning, plain, 0.0, 0.0), drives_for_following(turning, plain, 0.1, 0.0)
+    (True, False)
+    >>> drives_for_following(turning, Grid(3, 3, costs={(1, 1): 2.0}), 0.0, 0.0)
+    False
+    >>> drives_for_following(body_model("thesis"), plain, 0.0, 0.0), drives_for_following(None, plain, 0.0, 0.0)
+    (False, False)
+    """
+    return model is not None and model.follows_while_driving and jitter == 0 and miss_line == 0 and not grid.has_costs
 
 
 @dataclass
@@ -141,6 +161,10 @@ class SimulatedBody:
         Khepera III (right turns, then the cell); a model that turns in place
         drives only to the cell ahead and turns with :meth:`start_turn`, a
         quarter turn lasting one cell time.
+    follow:
+        Whether it may be followed while it drives (:attr:`follows`), where
+        :func:`drives_for_following` allows it; False keeps its cell until it
+        has arrived elsewhere.
 
     Examples
     --------
@@ -167,6 +191,7 @@ class SimulatedBody:
         rng: random.Random | None = None,
         recorder: OccupancyRecorder | None = None,
         model: BodyModel | None = None,
+        follow: bool = True,
     ) -> None:
         self.cell = start
         self.true_cell = start
@@ -183,6 +208,7 @@ class SimulatedBody:
         self.missed_lines = 0
         self.bumps = 0
         self.model = model
+        self.follows = follow and drives_for_following(model, grid, jitter, miss_line)
         self._segments: list[_Segment] = []
         self._target: Cell = start
         self._turning = False  # the action in progress is a turn in place
@@ -363,6 +389,7 @@ class LineCountingBody:
         self.settle_seconds = settle_seconds
         self.recorder = recorder or OccupancyRecorder()
         self.moving = False
+        self.follows = False  # it turns on the cell it leaves, and its speed is the motors'
         self.turns = 0
         self._phase = "idle"
         self._until = 0.0

@@ -36,6 +36,7 @@ from pathlib import Path
 
 from mrmp.centralized.execution import distributed_bytes, plan_policies
 from mrmp.centralized.plan import PlanningResult
+from mrmp.core.body import body_model
 from mrmp.core.errors import InputError, Problem
 from mrmp.core.limits import MAX_RUN_SECONDS
 from mrmp.core.progress import LiveProgress
@@ -48,6 +49,7 @@ from mrmp.io.live_files import prepare_folder, read_json, write_key_file
 from mrmp.io.plans import write_plan, write_share
 from mrmp.io.scenario_file import save_scenario
 from mrmp.live.agent import AgentTiming
+from mrmp.live.body import drives_for_following
 from mrmp.live.referee import errands_not_visited
 from mrmp.live.results import ideal_makespan, live_result
 from mrmp.live.task_desk import TaskDesk, desk_problem
@@ -288,6 +290,26 @@ def check_hosting(robots_per_process: int, transport: str, kill: bool, planned: 
         raise InputError(Problem("--robots-per-process", f"one robot per process over {transport}"))
 
 
+def bodies_follow(scenario: Scenario, options: LiveOptions) -> bool:
+    """Whether the run's bodies are followed while they drive (``docs/protocol.md``, "Following while driving"):
+    guarded bodies that may be (:func:`~mrmp.live.body.drives_for_following`), in a run that kills nobody (the
+    agents then get ``--no-follow``). A plan's moves that follow another's in its tick then wait only until the
+    leader stands on the cell (:func:`~mrmp.centralized.dependencies.action_dependencies`, ``following``): the
+    safety layer keeps the follower out until the leader drives on.
+
+    >>> from mrmp.core import Grid, PolicyOptions, RobotSpec
+    >>> scenario = Scenario(Grid(3, 3), (RobotSpec("a", (0, 0), (2, 2)),), policy=PolicyOptions(body="turning"))
+    >>> bodies_follow(scenario, LiveOptions()), bodies_follow(scenario, LiveOptions(jitter=0.1))
+    (True, False)
+    >>> omni = scenario.with_changes(policy=PolicyOptions())
+    >>> bodies_follow(scenario, LiveOptions(kill={"a": 1.0})), bodies_follow(omni, LiveOptions())
+    (False, False)
+    """
+    model = body_model(scenario.policy.body)
+    drives = drives_for_following(model, scenario.grid, options.jitter, options.miss_line)
+    return drives and options.guarded and scenario.safety and not options.kill
+
+
 def _write_run_files(scenario: Scenario, options: LiveOptions, ids: list[str]) -> _RunFiles:
     """Clear the results folder of an earlier run's files; write the scenario, the plan's shares and a fresh fleet key."""
     results = prepare_folder(options.results) if options.results else Path(tempfile.mkdtemp(prefix="mrmp-live-"))
@@ -301,7 +323,7 @@ def _write_run_files(scenario: Scenario, options: LiveOptions, ids: list[str]) -
     shares: list[Path] = []
     if options.plan is not None:
         write_plan(results / "plan.json", options.plan, ids)
-        for index, policy in enumerate(plan_policies(options.plan)):
+        for index, policy in enumerate(plan_policies(options.plan, following=bodies_follow(scenario, options))):
             shares.append(results / f"plan-{index}.json")
             write_share(shares[-1], ids[index], policy.moves, policy.dependencies, policy.dependents)
     key_file = results / "fleet.key"
@@ -359,6 +381,7 @@ def _agent_arguments(options: LiveOptions, files: _RunFiles, session: int, timeo
         f"--timeout={timeout}",
         f"--listen-time={options.timing.listen_time}",
         *([] if options.guarded else ["--unsafe"]),
+        *(["--no-follow"] if options.kill else []),  # a body killed mid-drive would be driven into
         *(["--ros2"] if options.ros2 else []),
     ]
 
@@ -515,7 +538,7 @@ def _judge(
             result,
             policy=options.plan.planner,
             planning_time_s=options.plan.planning_time_s,
-            plan_bytes=distributed_bytes(plan_policies(options.plan)),
+            plan_bytes=distributed_bytes(plan_policies(options.plan, following=bodies_follow(scenario, options))),
             plan_sum_of_costs=options.plan.sum_of_costs(),
             plan_makespan=options.plan.makespan(),
         )

@@ -202,6 +202,9 @@ class PibtBrain:
         Seconds between two sends of a claim or a release.
     crash_after:
         A peer silent for this long is taken for crashed (an obstacle where it was last known), until heard again.
+    follows:
+        Whether its body may be followed while it drives (:attr:`mrmp.live.body.Body.follows`): its cell is
+        released as the body starts out of it (:class:`~mrmp.protocol.safety.SafetyLayer`, ``releases_on_start``).
     """
 
     def __init__(
@@ -212,6 +215,7 @@ class PibtBrain:
         claim_retry: float = 0.05,
         crash_after: float = 6.0,
         flat: FlatMap | None = None,
+        follows: bool = False,
     ) -> None:
         spec = scenario.robots[index]
         flat = self.flat = flat if flat is not None else FlatMap(scenario.grid)
@@ -246,6 +250,7 @@ class PibtBrain:
             claim_timeout=math.inf,
             retry_interval=claim_retry,
             waits_for_release=True,
+            releases_on_start=follows,
         )
         self.dropped = self.robot.dropped
         self.queue: list[Cell | Heading] = []
@@ -609,7 +614,7 @@ class PibtAgent(LiveDriver):
         self.pibt_timing = pibt if pibt is not None else PibtTiming.for_body(self.cell_seconds, turn_seconds)
         self.robot = PibtBrain(
             scenario, index, self.pibt_timing, claim_retry=min(timing.claim_retry, 0.05),
-            crash_after=2 * timing.give_up_after, flat=flat,
+            crash_after=2 * timing.give_up_after, flat=flat, follows=body.follows,
         )  # fmt: skip
 
     # -- what the driver reads of the brain --------------------------------------------------

@@ -168,6 +168,9 @@ class AgentOptions:
     jitter: float = 0.0
     miss_line: float = 0.0
     guarded: bool = True
+    follow: bool = True
+    """Whether a body that may be followed while it drives is (:attr:`mrmp.live.body.Body.follows`): False keeps
+    a cell until the body has arrived elsewhere (a run that kills robots, whose bodies stop mid-drive)."""
     seed: int = 0
     timing: AgentTiming = field(default_factory=AgentTiming)
     plan: Path | None = None
@@ -339,7 +342,9 @@ class _HostedRobot:
             body = _ros2_body(driver, scenario, index, options, OccupancyRecorder(sink))
         else:
             recorder = OccupancyRecorder(sink, heading_sink=trace.write_heading)
-            body = simulated_body(scenario, index, recorder, options.time_scale, options.jitter, options.miss_line, options.seed)
+            body = simulated_body(
+                scenario, index, recorder, options.time_scale, options.jitter, options.miss_line, options.seed, options.follow
+            )
         sealer = Sealer(options.key, options.session)
         members = len(scenario.robots) + scenario.lifelong  # a lifelong fleet's task desk is one more member
         opener = Opener(options.key, options.session, fleet_size=members)
@@ -375,8 +380,10 @@ def simulated_body(
     jitter: float = 0.0,
     miss_line: float = 0.0,
     seed: int = 0,
+    follow: bool = True,
 ) -> SimulatedBody:
-    """Robot ``index``'s simulated body on its start cell, in the scenario's body model, its randomness from ``seed``."""
+    """Robot ``index``'s simulated body on its start cell, in the scenario's body model, its randomness from ``seed``
+    (``follow``: :class:`~mrmp.live.body.SimulatedBody`'s)."""
     spec = scenario.robots[index]
     return SimulatedBody(
         spec.start,
@@ -389,6 +396,7 @@ def simulated_body(
         rng=stream_random(seed, Stream.BODY, index),
         recorder=recorder,
         model=body_model(scenario.policy.body),
+        follow=follow,
     )
 
 
@@ -503,9 +511,10 @@ def run_referee(
     pending = [event for reader in readers for event in reader.read_new()]
     if start_time is None:
         start_time = min((t for _, _, _, t, _ in pending), default=time.monotonic())
-    referee = IntervalReferee(scenario.grid, ids, starts, start_time)
+    body = body_model(scenario.policy.body)
+    referee = IntervalReferee(scenario.grid, ids, starts, start_time, follows=body.follows_while_driving)
     actions = None
-    if body_model(scenario.policy.body).turns_in_place:  # its actions are judged too
+    if body.turns_in_place:  # its actions are judged too
         actions = TurningActions(ids, starts, [robot.heading for robot in scenario.robots], start_time)
     reported = 0
     finishing = False

@@ -29,6 +29,14 @@ enter, in the same tick, the cell its occupant leaves. A robot hands off only
 once its own claim has a majority, so the robots waiting on each other's
 handoffs form chains, never cycles: no swap, no rotation.
 
+**Following while driving** (``releases_on_start``, for live bodies that drive
+straight from cell to cell at one common speed: ``turning`` bodies, whose turns
+are actions of their own): a robot releases its Present the moment its body
+starts driving out of it, not once it has arrived; a robot following it in may
+then be granted the cell and start while the leader still covers part of it,
+always later than the leader started, so the two stay apart (``docs/protocol.md``,
+"Following while driving").
+
 **Standing claims** (``keep_refused``, with ``following``, for a perfect
 network): a refused claim is kept rather than given up at the step's end; its
 robot sends it no more, and its replicas grant it as soon as the cell has no
@@ -224,6 +232,13 @@ class SafetyLayer:
         it up (``docs/protocol.md``, "Claims that wait for a release"). A robot
         that follows another into its cell then starts as soon as the leader's
         release is in, not a retry later.
+    releases_on_start:
+        Live bodies that may follow while driving (no ``following``): the
+        Present is released when the body starts driving out of it
+        (:meth:`begin_move`), so that a robot may be granted it and start into
+        it behind its leader (module docstring). Only for bodies whose moves are
+        straight drives of one cell at one common speed, started by
+        :meth:`begin_move` the moment the drive starts.
     """
 
     def __init__(
@@ -238,6 +253,7 @@ class SafetyLayer:
         resend_refused: bool = True,
         keep_refused: bool = False,
         waits_for_release: bool = False,
+        releases_on_start: bool = False,
     ) -> None:
         self.index = index
         self.fleet_size = len(starts)
@@ -250,7 +266,11 @@ class SafetyLayer:
         self.resend_refused = resend_refused
         self.keep_refused = keep_refused and following
         self.waits_for_release = waits_for_release and not following
+        self.releases_on_start = releases_on_start and not following
         self.present_handed_off = False
+        self.present_released = False
+        """The body drives out of its Present, released already (``releases_on_start``)."""
+        self._grants_on_start: list[Send] = []
         self.present: Cell = starts[index]
         self.present_claim = 0
         self.target: Cell | None = None
@@ -277,7 +297,7 @@ class SafetyLayer:
 
     def owner_of(self, cell: Cell) -> int | None:
         """The robot this robot's registry names for ``cell`` (itself for its own cells), or None."""
-        if (cell == self.present and not self.present_handed_off) or cell == self.target:
+        if (cell == self.present and not self.present_handed_off and not self.present_released) or cell == self.target:
             return self.index
         if self.pending is not None and cell == self.pending.cell:
             return self.index
@@ -353,23 +373,46 @@ class SafetyLayer:
         return len(pending.refusers) > len(self.replicas_of(pending.cell)) - self.quorum
 
     def begin_move(self, cell: Cell) -> None:
-        """The body starts entering ``cell`` (which :meth:`may_enter` allowed, or any cell when unguarded)."""
+        """The body starts entering ``cell`` (which :meth:`may_enter` allowed, or any cell when unguarded).
+
+        With ``releases_on_start`` the Present is released now: its release
+        goes out with the next :meth:`releases_due`, and so does the grant this
+        robot, as a replica of its Present, gives to a claim that waited for it.
+
+        >>> leader = SafetyLayer(0, [(0, 1), (0, 0)], releases_on_start=True, waits_for_release=True)
+        >>> claim = leader.start_claim((0, 2), now=0.0)
+        >>> _ = leader.handle_reply(ReplyMessage(1, 1, 0, claim.claim, (0, 2), True), now=0.0)
+        >>> leader.handle_claim(ClaimMessage(1, 2, 1, (0, 1)), claimant_outranks=False).granted   # it stands there
+        False
+        >>> leader.begin_move((0, 2))   # it drives out: (0, 1) is released, and granted to the claim that waited
+        >>> [(type(message).__name__, message.cell, to) for message, to in leader.releases_due(now=0.1)]
+        [('ReleaseMessage', (0, 1), (1,)), ('ReplyMessage', (0, 1), (1,))]
+        >>> leader.owner_of((0, 1)), leader.owner_of((0, 2))
+        (1, 0)
+        """
         if self.pending is not None and self.pending.cell == cell:
             self.stats.granted += 1
             self.granted_claim = self.pending
         self.pending = None
         self.target = cell
+        if self.releases_on_start and cell != self.present and not self.present_released:
+            self.present_released = True
+            self._release(self.present, self.present_claim)
+            if self.index in self.replicas_of(self.present):
+                self._grants_on_start.extend(self._grant_deferred(self.present))
 
     def end_move(self, cell: Cell) -> None:
         """The body stands on ``cell``: it is the new Present; the cells left are released."""
         granted = self.granted_claim
         if cell != self.present:
-            self._release(self.present, self.present_claim)
+            if not self.present_released:
+                self._release(self.present, self.present_claim)
             self.present_claim = granted.number if granted is not None and granted.cell == cell else 0
         if granted is not None and granted.cell != cell:
             self._release(granted.cell, granted.number)  # the body stopped short of the cell it was allowed
         self.present = cell
         self.present_handed_off = False
+        self.present_released = False
         self.target = None
         self.granted_claim = None
 
@@ -478,7 +521,8 @@ class SafetyLayer:
             self.stats.releases += 1
 
     def releases_due(self, now: float) -> list[Send]:
-        """The releases due now (a claim just given up, or one to send again), without running the claim's timers."""
+        """The releases due now (a claim just given up, or one to send again), without running the claim's timers,
+        and the grants given as the body drove out of its Present (``releases_on_start``)."""
         sends: list[Send] = []
         for key, release in list(self._releases.items()):
             if now - release.sent_at < self.retry_interval:
@@ -490,6 +534,8 @@ class SafetyLayer:
             release.tries += 1
             release.sent_at = now
             sends.append((ReleaseMessage(self.index, 0, release.claim, release.cell), tuple(sorted(release.waiting))))
+        sends.extend(self._grants_on_start)
+        self._grants_on_start = []
         return sends
 
     # -- peers' messages ---------------------------------------------------------------

@@ -149,6 +149,10 @@ class Robot(MessageEndpoint):
         Its body model (:mod:`mrmp.core.body`; default ``omni``). A body that
         turns in place turns toward a neighbour it does not face before
         claiming it (module docstring); other bodies move to any neighbour.
+    follows_while_driving:
+        Live bodies that may be followed (:attr:`mrmp.live.body.Body.follows`):
+        the Present is released as the body starts driving out of it
+        (:class:`~mrmp.protocol.safety.SafetyLayer`, ``releases_on_start``).
     """
 
     def __init__(
@@ -168,6 +172,7 @@ class Robot(MessageEndpoint):
         state_refresh: int | None = None,
         lossy: bool = True,
         body: BodyModel | None = None,
+        follows_while_driving: bool = False,
     ) -> None:
         if state_refresh is not None and (state_refresh < 1 or state_radius is None or knowledge_lease is None):
             raise ValueError("a state refresh needs a positive period, a state radius and a knowledge lease")
@@ -204,6 +209,7 @@ class Robot(MessageEndpoint):
             following=following and guarded,
             resend_refused=lossy,
             keep_refused=not lossy,
+            releases_on_start=follows_while_driving and guarded,
         )
         self.seq = 0
         self.progress = 0

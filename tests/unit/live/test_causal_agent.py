@@ -28,7 +28,7 @@ class OneSecondBody:
     """A body whose every move takes one second."""
 
     def __init__(self, cell):
-        self.cell, self.heading, self.moving = cell, Heading.NORTH, False
+        self.cell, self.heading, self.moving, self.follows = cell, Heading.NORTH, False, False
 
     def start_move(self, target, now):
         self.target, self.ends_at, self.moving = target, now + 1.0, True
