@@ -190,3 +190,29 @@ def test_a_turning_body_draws_its_jitter_per_action():
         assert not body.poll(0.0)
         ends.add(round(body.next_event(), 6))
     assert len(ends) > 10 and all(0.2 * 0.7 - 1e-9 <= end <= 0.2 * 1.3 + 1e-9 for end in ends)
+
+
+def test_a_turning_body_is_followed_unless_it_jitters_misses_lines_or_is_told_not_to_be():
+    """``Body.follows`` (``docs/protocol.md``, "Following while driving"): only straight drives at the fleet's one
+    speed may be followed; ``mrmp agent --no-follow`` (a run that kills robots) turns it off."""
+    assert turning_body().follows
+    assert not turning_body(jitter=0.1).follows and not turning_body(miss_line=0.01).follows
+    assert not turning_body(follow=False).follows
+    assert not SimulatedBody((2, 2), Heading.NORTH, Grid(5, 5), Timing(2.0, 1.0)).follows  # the thesis's body
+
+
+def test_a_live_run_that_kills_robots_starts_them_without_following():
+    """A process killed mid-drive leaves its body between two cells: ``mrmp run --live --kill`` gives its agents
+    ``--no-follow``, and an agent so told drives a body nobody follows."""
+    from pathlib import Path
+
+    from mrmp.core import PolicyOptions, RobotSpec, Scenario
+    from mrmp.live.launcher import LiveOptions, _agent_arguments, _RunFiles
+    from mrmp.live.process import simulated_body
+
+    files = _RunFiles(Path("r"), Path("r/s.yaml"), Path("r/k"), b"k", Path("r/done"), [])
+    assert "--no-follow" in _agent_arguments(LiveOptions(kill={"a": 1.0}), files, 1, 10.0)
+    assert "--no-follow" not in _agent_arguments(LiveOptions(), files, 1, 10.0)
+    scenario = Scenario(Grid(3, 3), (RobotSpec("a", (0, 0), (2, 2)),), policy=PolicyOptions(body="turning"))
+    assert simulated_body(scenario, 0, OccupancyRecorder(), 1.0).follows
+    assert not simulated_body(scenario, 0, OccupancyRecorder(), 1.0, follow=False).follows
