@@ -338,6 +338,10 @@ class LiveDriver:
 
     robot: Brain
 
+    wakes_while_polling = False
+    """Whether a message arriving wakes the loop while it polls for the brain's timers too (:meth:`wake_rule`);
+    False: it waits for the next poll, a datagram costing no wake of its own."""
+
     def __init__(
         self,
         scenario: Scenario,
@@ -525,8 +529,8 @@ class LiveDriver:
         While the brain's ``timers`` may be due (they are not idle,
         :meth:`_timers_idle`), the loop polls as it always did: it sleeps at
         most ``poll`` seconds, and what arrives meanwhile waits for the next
-        turn. Otherwise it sleeps until ``until``, and the first message to
-        arrive wakes it at once.
+        turn, unless the driver :attr:`wakes_while_polling`. Otherwise it
+        sleeps until ``until``, and the first message to arrive wakes it at once.
         """
         now = self.clock()
         wake, woken_by_messages = self.wake_rule(now, until, timers)
@@ -539,7 +543,7 @@ class LiveDriver:
         """When the main loop, about to sleep at ``now`` until ``until``, wakes at the latest, and whether a
         message arriving earlier wakes it (:meth:`_sleep`; a driver on a virtual clock follows the same rule)."""
         if timers and not self._timers_idle():
-            return min(until, now + self.timing.poll), False
+            return min(until, now + self.timing.poll), self.wakes_while_polling
         return until, True
 
     def _nap(self, seconds: float) -> None:

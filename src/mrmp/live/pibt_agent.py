@@ -129,6 +129,10 @@ class PibtTiming:
     """How long the brain waits for an acknowledgement before it sends a message again."""
     hold: float
     """How long, from the step's start, a held robot waits for its grant before it stays."""
+    pace: float = 0.0
+    """With a local synchronizer, the least time from a step's start to the next's: one action of the body (a
+    step of the simulator is one action; a robot whose steps are shorter only waits for its body, or spends
+    beacons on steps in which it stays)."""
 
     @classmethod
     def for_body(
@@ -146,15 +150,17 @@ class PibtTiming:
         The decision phase is all of the step but the grace: a robot's move is
         queued the moment it decides for good, so a long phase costs nothing to
         the robots that decided and gives the others time. A held robot waits
-        for its grant for the fraction ``hold`` of the decision phase.
+        for its grant for the fraction ``hold`` of the decision phase. Steps
+        ended by the robots last at least a move with one right turn (``pace``).
 
         >>> PibtTiming.for_body(0.5, 0.25)
-        PibtTiming(decide=0.7, step=0.75, retry=0.03, hold=0.28)
-        >>> PibtTiming.for_body(0.1, 0.05)   # moves shorter than the decisions: the decisions set the pace
-        PibtTiming(decide=0.3, step=0.35, retry=0.03, hold=0.12)
+        PibtTiming(decide=0.7, step=0.75, retry=0.03, hold=0.28, pace=0.75)
+        >>> PibtTiming.for_body(0.1, 0.05)   # moves shorter than the decisions: the decisions set the clock's pace
+        PibtTiming(decide=0.3, step=0.35, retry=0.03, hold=0.12, pace=0.15)
         """
-        phase = max(decide, cell_seconds + turn_seconds - grace)
-        return cls(round(phase, 6), round(phase + grace, 6), retry, round(phase * hold, 6))
+        action = cell_seconds + turn_seconds
+        phase = max(decide, action - grace)
+        return cls(round(phase, 6), round(phase + grace, 6), retry, round(phase * hold, 6), round(action, 6))
 
 
 def open_repeat(opener: Opener, data: bytes) -> Message | None:
@@ -326,9 +332,10 @@ class PibtBrain:
 
         Step 1 begins at ``t0``; step ``k + 1`` at once when step ``k`` is done
         (:attr:`~mrmp.robot.pibt_synchronized.SynchronizedPibtRobot.step_done`),
-        held while the move decided in step ``k`` is not granted. A held robot
-        that has not been granted ``hold`` seconds after its step began gives up
-        and, at its turn, stays, as on the clock; no step ends undecided.
+        held while the move decided in step ``k`` is not granted, and no sooner
+        than ``pace`` after step ``k`` began. A held robot that has not been
+        granted ``hold`` seconds after its step began gives up and, at its
+        turn, stays, as on the clock; no step ends undecided.
         """
         robot = self.robot
         assert isinstance(robot, SynchronizedPibtRobot)
@@ -339,7 +346,7 @@ class PibtBrain:
             robot.give_up()
         self._crash_silent(now)
         self._run_brain(now, out)
-        if robot.step_done:
+        if robot.step_done and now - self._began >= self.timing.pace:
             self._finish_step()
             self._begin_next_step(now, out)
             self._run_brain(now, out)
@@ -592,6 +599,10 @@ class PibtAgent(LiveDriver):
     """
 
     robot: PibtBrain
+
+    wakes_while_polling = True
+    """A message wakes the robot at once: each is a hop of a call or of an acknowledgement, which would otherwise
+    wait up to a poll (10 ms) at every robot on its way."""
 
     def __init__(
         self,

@@ -414,3 +414,31 @@ def test_on_a_perfect_network_live_brains_make_the_simulators_decisions():
     assert [[cell for i, cell in enumerate(path) if i == 0 or path[i - 1] != cell] for path in fleet.decided_paths()] == [
         [tuple(cell) for i, cell in enumerate(robot.path) if i == 0 or robot.path[i - 1] != cell] for robot in simulated.robots
     ]
+
+
+def test_robots_ending_their_own_steps_take_no_step_shorter_than_an_action_of_their_bodies():
+    """``PibtTiming.pace``: robots settled on their goals, side by side, end their steps as soon as they have heard
+    each other; they begin one an action apart (a step of the simulator is one action), not as fast as their
+    messages go, each step costing beacons. Without the pace (a broken variant) they run many more steps."""
+    import dataclasses
+
+    robots = (RobotSpec("a", (0, 0), (0, 0)), RobotSpec("b", (0, 1), (0, 1)), RobotSpec("c", (1, 0), (1, 0)))
+    scenario = Scenario(Grid(5, 5), robots, timing=Timing(1.0, 0.5), policy=PolicyOptions(name="pibt", synchronizer="local"))
+    paced = PibtTiming.for_body(0.5, 0.25)
+    assert paced.pace == 0.75
+
+    def steps_in_three_seconds(timing):
+        fleet = BrainFleet(scenario, timing)
+        for brain in fleet.brains:
+            brain.start(0.0)
+        while fleet.now < 3.0:
+            while fleet.inbox and fleet.inbox[0][0] <= fleet.now:
+                _, _, peer, message = heapq.heappop(fleet.inbox)
+                fleet.send(peer, fleet.brains[peer].receive(message, fleet.now))
+            for index, brain in enumerate(fleet.brains):
+                fleet.send(index, brain.expire(fleet.now))
+            fleet.now = round(fleet.now + fleet.tick, 6)
+        return [brain.step for brain in fleet.brains]
+
+    assert steps_in_three_seconds(paced) == [4, 4, 4]  # steps begin at 0, 0.75, 1.5 and 2.25 s
+    assert min(steps_in_three_seconds(dataclasses.replace(paced, pace=0.0))) > 20
