@@ -151,7 +151,8 @@ class PibtTiming:
         queued the moment it decides for good, so a long phase costs nothing to
         the robots that decided and gives the others time. A held robot waits
         for its grant for the fraction ``hold`` of the decision phase. Steps
-        ended by the robots last at least a move with one right turn (``pace``).
+        ended by the robots last at least one action (``pace``: a move with
+        one right turn, or a cell time for a body that turns in place).
 
         >>> PibtTiming.for_body(0.5, 0.25)
         PibtTiming(decide=0.7, step=0.75, retry=0.03, hold=0.28, pace=0.75)
