@@ -127,21 +127,34 @@ def assert_disjoint(nodes, now):
             assert not covered[i] & covered[j], f"step {now}: robots {i} and {j} both cover {covered[i] & covered[j]}"
 
 
-def run(seed, robots, steps, oldest_first=False, waits=False):
+def adversarial_run(seed, robots, steps, make_node, act_once, check, oldest_first=False):
+    """``robots`` nodes (``make_node(index, starts)``) on the grid, each event either a random node's action
+    (``act_once(node, nodes, adversary, rng, now)``, True when a move ended) or a delivery of the adversary's;
+    ``check(nodes, now)`` after every event. Returns how many moves ended."""
     rng = random.Random(seed)
     cells = [(x, y) for x in range(SIZE) for y in range(SIZE)]
     starts = rng.sample(cells, robots)
-    nodes = [Node(i, starts, waits) for i in range(robots)]
+    nodes = [make_node(index, starts) for index in range(robots)]
     adversary = Adversary(nodes, rng, oldest_first)
     moves = 0
     for now in range(steps):
         node = rng.choice(nodes)
         if rng.random() < 0.55 and not node.crashed:
-            moves += act(node, adversary, rng, now)
+            moves += act_once(node, nodes, adversary, rng, now)
         elif adversary.bag:
             adversary.deliver_one()
-        assert_disjoint(nodes, now)
+        check(nodes, now)
     return moves
+
+
+def run(seed, robots, steps, oldest_first=False, waits=False):
+    def make_node(index, starts):
+        return Node(index, starts, waits)
+
+    def act_once(node, nodes, adversary, rng, now):
+        return act(node, adversary, rng, now)
+
+    return adversarial_run(seed, robots, steps, make_node, act_once, assert_disjoint, oldest_first)
 
 
 @settings(max_examples=400, derandomize=True, deadline=None)

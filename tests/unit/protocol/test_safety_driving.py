@@ -17,13 +17,12 @@ a replica that grants its own Present to a waiting claim as soon as it claims
 another cell.
 """
 
-import random
 import sys
 
 import pytest
 from hypothesis import given, settings
 from hypothesis import strategies as st
-from test_safety import SIZE, Adversary, caught, neighbours
+from test_safety import adversarial_run, caught, neighbours
 
 from mrmp.protocol.safety import SafetyLayer
 
@@ -95,42 +94,23 @@ def assert_followed_only(nodes, now):
         assert leader.layer.target != follower.layer.present, f"event {now}: swap of {leader.index}, {follower.index}"
 
 
-def run(seed, robots, steps):
-    rng = random.Random(seed)
-    cells = [(x, y) for x in range(SIZE) for y in range(SIZE)]
-    starts = rng.sample(cells, robots)
-    nodes = [Node(index, starts) for index in range(robots)]
-    adversary = Adversary(nodes, rng)
-    drives = 0
-    for now in range(steps):
-        node = rng.choice(nodes)
-        if rng.random() < 0.55 and not node.crashed:
-            drives += act(node, nodes, adversary, rng, now)
-        elif adversary.bag:
-            adversary.deliver_one()
-        assert_followed_only(nodes, now)
-    return drives
+def run(seed, robots, steps, check=assert_followed_only):
+    return adversarial_run(seed, robots, steps, Node, act, check)
 
 
 def followings(seed, robots, steps):
-    """How many drives began while the cell's last occupant still drove out of it (a run with the invariant off)."""
+    """How many drives began while the cell's last occupant still drove out of it."""
     count = 0
-    original = assert_followed_only
 
-    def count_followers(nodes, now):
+    def check_and_count(nodes, now):
         nonlocal count
-        original(nodes, now)
+        assert_followed_only(nodes, now)
         for node in nodes:
             target = node.layer.target
             if target is not None and node.began == now:
                 count += any(other.layer.present == target and other is not node for other in nodes)
 
-    module = sys.modules[__name__]
-    module.assert_followed_only = count_followers
-    try:
-        run(seed, robots, steps)
-    finally:
-        module.assert_followed_only = original
+    run(seed, robots, steps, check_and_count)
     return count
 
 
