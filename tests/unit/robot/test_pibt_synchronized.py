@@ -1,5 +1,6 @@
 """``pibt`` with a local synchronizer: robots end their own steps; no cell decided twice; every rule needed."""
 
+import dataclasses
 from pathlib import Path
 
 import pytest
@@ -9,7 +10,7 @@ from test_pibt_local import FAULTS, crowd
 from mrmp.core import Grid, NetworkFaults, PolicyOptions, RobotSpec, Scenario, Timing
 from mrmp.core.errors import InputError
 from mrmp.io import load_movingai_scenario
-from mrmp.live.pibt_agent import PibtBrain
+from mrmp.live.pibt_agent import PibtBrain, PibtTiming
 from mrmp.protocol.messages import BeaconMessage
 from mrmp.protocol.pibt_local import NO_CLAIM, CallAckMessage, CallReserveMessage
 from mrmp.robot.messaging import Outgoing
@@ -239,15 +240,21 @@ def test_local_step_ends_need_local_sequencing():
 # -- live: PibtBrain with the synchronizer, simulated bodies on an in-memory network ------------------------
 
 
-def test_live_brains_that_end_their_own_steps_arrive_over_a_lossy_network_and_their_bodies_never_collide():
+@pytest.mark.parametrize("paced", [True, False])
+def test_live_brains_that_end_their_own_steps_arrive_over_a_lossy_network_and_their_bodies_never_collide(paced):
+    """Steps at least an action long (``PibtTiming.pace``, the default) keep this fleet's steps together; without
+    the pace its robots run apart, in different steps (rule 4), and arrive without a collision all the same."""
     for seed in range(3):
         scenario = synchronized(crowd(seed, density=0.3, max_ticks=200))
-        fleet = BrainFleet(scenario, loss=0.2, seed=seed, tick=0.01)
+        timing = PibtTiming.for_body(scenario.timing.cell_time, scenario.timing.turn_time)
+        timing = timing if paced else dataclasses.replace(timing, pace=0.0)
+        fleet = BrainFleet(scenario, timing=timing, loss=0.2, seed=seed, tick=0.01)
         fleet.run(until=120)
         assert fleet.collisions() == [] and all(brain.settled for brain in fleet.brains)
         assert fleet.most_pending <= 1  # a held robot decides no second move before its first is granted
         assert all(brain.synchronized for brain in fleet.brains)
-        assert sum(brain.robot.stats["ahead"] for brain in fleet.brains) > 0  # robots were in different steps
+        if not paced:
+            assert sum(brain.robot.stats["ahead"] for brain in fleet.brains) > 0  # robots were in different steps
 
 
 CROSS = (
@@ -282,11 +289,11 @@ def distinct(cells):
 
 
 class NeverGivesUp(PibtBrain):
-    """A held robot that waits for its grant however long it takes (no ``give_up``)."""
+    """A held robot that waits for its grant however long it takes (its brain never gives up)."""
 
-    def _expire_synchronized(self, now):
-        self._began = now
-        return super()._expire_synchronized(now)
+    def __init__(self, *args, **kwargs):
+        super().__init__(*args, **kwargs)
+        self.robot.give_up = lambda: None
 
 
 def test_a_held_robot_that_never_gives_up_makes_a_convoy_move_one_body_at_a_time():
