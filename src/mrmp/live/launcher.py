@@ -237,7 +237,9 @@ def with_desk(result: RunResult, desk: TaskDesk, verdict: dict | None) -> RunRes
     tasks = TaskLog(desk.finished, events, list(log.revealed), [list(entries) for entries in log.schedules], [])
     errands = {task: cells for task, _, cells in log.revealed}
     not_visited = errands_not_visited(events, errands, verdict["intervals"] if verdict else [])
-    stop_reason = "time up" if result.stop_reason == "all arrived" else result.stop_reason  # every robot did its steps
+    # Every robot did its steps and stopped by itself; a peer silent at the end had said farewell, or its farewell
+    # was lost (its own report says it did its steps too, or the reason would name it).
+    stop_reason = "time up" if result.stop_reason in ("all arrived", "arrived; peers silent") else result.stop_reason
     network = {**result.network, "tasks_errands_not_visited": len(not_visited)}
     return replace(result, lifelong=True, tasks=tasks, stop_reason=stop_reason, network=network)
 
