@@ -47,7 +47,7 @@ from mrmp.centralized.registry import plan_with
 from mrmp.core import Scenario
 from mrmp.core.body import body_model
 from mrmp.io import load_movingai_scenario
-from mrmp.live.launcher import LiveOptions, run_live
+from mrmp.live.launcher import LiveOptions, bodies_follow, run_live
 from mrmp.live.transport import LiveFaults
 
 MAPS = Path(__file__).resolve().parents[1] / "maps"
@@ -82,7 +82,7 @@ def main() -> int:
         if plan.paths is None:
             print(f"{name:>7} lacam: no plan ({plan.status}: {plan.message})")
             continue
-        _say_bounds(name, scenario, plan, follows=not kill)
+        _say_bounds(name, scenario, plan, follows=bodies_follow(scenario, LiveOptions(kill=kill)))
         for scale in [float(text) for text in arguments.time_scales.split(",")]:
             _run(name, scenario, plan, scale, arguments.loss, kill)
     return 0
@@ -92,7 +92,7 @@ def _bound(
     name: str, scenario: Scenario, plan: PlanningResult, scale: float, follows: bool, turn_time: float | None = None
 ) -> float:
     """The live execution bound of ``plan`` driven by ``name`` bodies (module docstring), in seconds at ``scale``;
-    ``follows``: whether bodies that may be followed while they drive are (not in a run that kills robots)."""
+    ``follows``: whether bodies that may be followed while they drive are (:func:`~mrmp.live.launcher.bodies_follow`)."""
     assert plan.paths is not None
     headings = [robot.heading for robot in scenario.robots]
     timing = scenario.timing if turn_time is None else replace(scenario.timing, turn_time=turn_time)
@@ -120,7 +120,7 @@ def _run(name: str, scenario: Scenario, plan: PlanningResult, scale: float, loss
     moves = max(1, result.network.get("moves", 0))
     turns = sum(robot.turns for robot in result.robots) if name == "turning" else 0
     planned = plan.makespan() * scenario.timing.cell_time / scale
-    bound = _bound(name, scenario, plan, scale, follows=not kill)
+    bound = _bound(name, scenario, plan, scale, follows=bodies_follow(scenario, options))
     print(
         f"{name:>7} {scale:>5g} {arrived:>4}/{len(result.robots):<3} {len(result.collisions):>4}"
         f" {result.time_makespan_s:>7.2f} {planned:>7.2f} {result.time_makespan_s / planned:>6.2f} {bound:>7.2f}"

@@ -111,6 +111,8 @@ class IntervalReferee:
         self._open: dict[tuple[int, Cell], Interval] = {(index, cell): self.intervals[index] for index, cell in enumerate(starts)}
         self._latest: dict[int, Interval] = dict(enumerate(self.intervals))
         """Per robot, the cell it entered last (the one it drives out of when it enters another)."""
+        self._arriving: dict[tuple[int, Cell], Interval] = {}
+        """Per robot and cell it drives out of, the interval of the cell it drives into (arrived once it has left)."""
 
     def feed(self, robot: int, event: str, cell: Cell, t: float) -> None:
         """Take one event: ``"enter"`` (starts covering ``cell``) or ``"leave"`` (stops covering it)."""
@@ -122,6 +124,7 @@ class IntervalReferee:
                 if previous is not None and previous.end == math.inf:
                     interval.source = previous.cell
                     previous.exit_at, previous.exit_to = t, cell
+                    self._arriving[robot, previous.cell] = interval
                 self.intervals.append(interval)
                 self._open[key] = interval
                 self._latest[robot] = interval
@@ -129,9 +132,9 @@ class IntervalReferee:
             leaving = self._open.pop(key, None)
             if leaving is not None:
                 leaving.end = t
-                for (owner, _), interval in self._open.items():
-                    if owner == robot and interval.source == cell and interval.arrived == math.inf:
-                        interval.arrived = t
+                arriving = self._arriving.pop(key, None)
+                if arriving is not None:
+                    arriving.arrived = t
 
     def _tick(self, t: float) -> int:
         return round((t - self.start_time) * 1000)
