@@ -327,6 +327,9 @@ class LocalPibtRobot(PibtRobot):
         else:
             self._calls[sender] = message.root
         if cell == self.target and not self._confirmed and sender != self.index:
+            if sender == self._waiting:
+                reserved[cell] = sender  # the robot asked to leave it stays: its answer says whether it turns to leave
+                return True
             if cell != self.present and (message.final or rank > self._rank):
                 self._lost = True  # a call of higher priority reserved it in the same round: withdraw
                 reserved[cell] = sender

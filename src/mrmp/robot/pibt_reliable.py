@@ -31,7 +31,17 @@ acknowledged its messages):
   rotations): a step can end before such a call has finished, and the robot
   whose cell was taken would then stay;
 * the reach of a stalled robot does not grow (``reach_cap`` 0): the beacon
-  and the final reservation go to the radio radius only.
+  and the final reservation go to the radio radius only;
+* a robot asked to join a call first waits for every robot within 2 cells
+  that outranks the call and has not decided for good, other than robots of
+  that call (:attr:`ReliablePibtRobot.waits_to_join`): over a lossy network a
+  call started apart could otherwise take the cell that a robot of higher
+  rank wants, which central PIBT lets go first (``docs/protocol.md``, "Over a
+  faulty network", gives why no robot waits forever);
+* the claim of its own cell by the robot asked to leave it is no rival claim
+  (:meth:`_take_ack`, and :class:`~mrmp.robot.pibt_local.LocalPibtRobot`'s
+  reservations): the asker waits for its answer, in whatever order the two
+  come.
 
 The step ends at a tick the driver's clock fixes for everyone; a robot that
 has decided for good moves, any other stays (an abandoned step, counted).
@@ -74,7 +84,7 @@ from mrmp.core.heading import Heading
 from mrmp.protocol.messages import BeaconMessage, PibtMessage, PullMessage
 from mrmp.protocol.pibt_local import NO_CLAIM, CallAckMessage, CallInheritMessage, CallReserveMessage
 from mrmp.robot.messaging import Outgoing
-from mrmp.robot.pibt_local import LocalPibtRobot
+from mrmp.robot.pibt_local import NO_RANK, LocalPibtRobot
 from mrmp.robot.pibt_robot import MIN_RADIUS, RESERVE_RADIUS
 from mrmp.search.flat_map import FlatMap
 
@@ -151,6 +161,7 @@ class ReliablePibtRobot(LocalPibtRobot):
         self._deferred = False
         self._claim_seq = 0
         self._latest: dict[int, int] = {}
+        self._requests_waiting: list[CallInheritMessage] = []
 
     # -- the step ------------------------------------------------------------------
 
@@ -167,6 +178,7 @@ class ReliablePibtRobot(LocalPibtRobot):
         self._deferred = False
         self._claim_seq = 0
         self._latest = {}
+        self._requests_waiting = []
         return out
 
     def on_tick(self, now: int) -> list[Outgoing]:
@@ -231,6 +243,8 @@ class ReliablePibtRobot(LocalPibtRobot):
         return True
 
     def _take_ack(self, message: CallAckMessage) -> bool:
+        """An acknowledgement: its sender has the message; its claim, of higher rank, of the cell this robot claims
+        provisionally makes the robot withdraw (unless it is the claim to stay of the robot asked to leave)."""
         sender = message.sender
         if message.acked == self._beacon_seq:
             self._beacon_acks.add(sender)
@@ -239,7 +253,7 @@ class ReliablePibtRobot(LocalPibtRobot):
             entry.pending.discard(sender)
         if message.claim != NO_CLAIM and not self._confirmed and self.target is not None:
             cell = self.flat.index(message.claim)
-            if cell == self.target and cell != self.present and sender != self.index:
+            if cell == self.target and cell != self.present and sender not in (self.index, self._waiting):
                 theirs = (message.settled, self._occupants.get(cell) == sender, message.rank)
                 if theirs > (False, False, self._rank):
                     self._lost = True  # a call of higher priority claims our cell: withdraw
@@ -254,7 +268,11 @@ class ReliablePibtRobot(LocalPibtRobot):
         if self._deferred and self._complete():
             self._deferred = False
             super()._begin_call(out)
+        if self._requests_waiting:
+            self._take_waiting_requests(out)
         out.extend(super().act())
+        if self._requests_waiting and not self._idle():
+            self._take_waiting_requests(out)  # busy now, in its own call or another: refused
         self._track(out)
         if not self._confirmed and self._may_confirm():  # nobody within 2 cells to hear the claim: it stands at once
             settled = super().act()
@@ -287,6 +305,37 @@ class ReliablePibtRobot(LocalPibtRobot):
 
     def _may_start(self) -> bool:
         return self._complete() and super()._may_start()
+
+    waits_to_join = True
+    """Whether a robot asked to join a call first waits for every robot near it that outranks the call (module
+    docstring); meanwhile it may start its own call or join one of higher rank, and it refuses the request once busy."""
+
+    def _may_join(self, message: CallInheritMessage) -> bool:
+        """Every robot within 2 cells that outranks the call of ``message`` has decided for good, or is in that call."""
+        rank, root, asker = message.rank, message.root, message.sender
+        final, ranks, calls = self._final, self._ranks, self._calls
+        for other in self._near:
+            if other in final or other in (asker, root) or calls.get(other) == root:
+                continue
+            if ranks.get(other, NO_RANK) > rank:
+                return False
+        return True
+
+    def _take_inherit_local(self, message: CallInheritMessage, out: list[Outgoing]) -> None:
+        """A request to join a call: kept until the robot may join it (:attr:`waits_to_join`), then as in synchronous
+        rounds."""
+        if self.waits_to_join and self._idle() and not self._done and not (self._complete() and self._may_join(message)):
+            self._requests_waiting.append(message)
+            self.stats["join_waits"] += 1
+            return
+        super()._take_inherit_local(message, out)
+
+    def _take_waiting_requests(self, out: list[Outgoing]) -> None:
+        """Take up the requests that wait (:attr:`waits_to_join`), the call of highest rank first: joined, refused
+        when busy, or kept waiting."""
+        waiting, self._requests_waiting = self._requests_waiting, []
+        for message in sorted(waiting, key=lambda message: message.rank, reverse=True):
+            self._take_inherit_local(message, out)
 
     def _begin_call(self, out: list[Outgoing]) -> None:
         if not self._complete():

@@ -11,6 +11,7 @@ from mrmp.centralized.pibt_step import PIBT
 from mrmp.core import Grid, NetworkFaults, PolicyOptions, RobotSpec, Scenario
 from mrmp.core.errors import InputError
 from mrmp.core.grid import connected_regions
+from mrmp.core.heading import Heading
 from mrmp.io import load_movingai_scenario
 from mrmp.protocol.messages import AnswerMessage, BeaconMessage
 from mrmp.protocol.pibt_local import (
@@ -321,6 +322,7 @@ def test_a_pushed_robot_never_takes_its_own_cell_back_when_another_claim_of_it_i
     flat = FlatMap(Grid.from_rows(["....."]))
     cell = flat.index
     robot = ReliablePibtRobot(1, cell((0, 1)), cell((0, 4)), flat, tie=1)
+    robot.waits_to_join = False  # joins A's call at once, although B outranks it (the rule this test predates)
     robot.begin_step(1, sensed=[cell((0, 0)), cell((0, 2)), cell((0, 3))], now=0)
     robot.receive(BeaconMessage(0, 1, 1, (0, 0), (0, 4), 1, 0))  # A
     robot.receive(BeaconMessage(2, 1, 1, (0, 2), (0, 0), 2, 5))  # B
@@ -337,6 +339,49 @@ def test_a_pushed_robot_never_takes_its_own_cell_back_when_another_claim_of_it_i
     answers = [item for item in robot.act() if isinstance(item.message, AnswerMessage)]
     assert [(item.message.moved, item.recipients) for item in answers] == [(False, (0,))]
     assert robot.dropped["overtaken"] == 1
+
+
+def test_a_robot_asked_to_join_a_call_waits_for_the_robots_near_it_that_outrank_the_call():
+    """Over a faulty network a call may reach a robot before a robot next to it that outranks the call decides.
+
+    Robot R (1) is asked by A (0), whose call ranks below B (2), next to R and
+    undecided. R takes no part in A's call until B has decided for good (as
+    in central PIBT, where B goes first); then it does.
+    """
+    flat = FlatMap(Grid.from_rows(["....."]))
+    cell = flat.index
+    robot = ReliablePibtRobot(1, cell((0, 1)), cell((0, 4)), flat, tie=1)
+    robot.begin_step(1, sensed=[cell((0, 0)), cell((0, 2))], now=0)
+    robot.receive(BeaconMessage(0, 1, 1, (0, 0), (0, 4), 1, 0))  # A
+    robot.receive(BeaconMessage(2, 1, 1, (0, 2), (0, 0), 2, 5))  # B, which outranks A
+    robot.receive(CallReserveMessage(0, 2, 1, (0, 1), 0, 1, 0, False))  # A reserves R's cell ...
+    robot.receive(CallInheritMessage(0, 3, 1, (0, 1), 0, 1, 0))  # ... and asks R
+    waited = robot.act()
+    assert not [item for item in waited if isinstance(item.message, CallReserveMessage)]
+    assert robot._parent is None and robot.stats["join_waits"] == 1
+    robot.receive(CallReserveMessage(2, 2, 1, (0, 2), 2, 2, 5, True))  # B decides for good: it stays
+    joined = robot.act()
+    assert robot._parent == 0
+    assert [item.message.cell for item in joined if isinstance(item.message, CallReserveMessage)] == [(0, 1)]
+
+
+def test_the_stay_of_the_robot_asked_to_leave_is_no_rival_claim_of_its_cell():
+    """A turning robot asks the occupant of the cell ahead to leave; the occupant stays this step, turning to
+    leave the next. Its final reservation of its cell may come before its answer: the robot still stays facing
+    that cell, to follow it, as when the answer comes first (not withdrawing, and turning elsewhere)."""
+    flat = FlatMap(Grid.from_rows(["...", "..."]))
+    cell = flat.index
+    ahead = Heading.between((0, 1), (0, 2))
+    robot = ReliablePibtRobot(0, cell((0, 1)), cell((0, 2)), flat, tie=1, heading=ahead, turning=True, swap=False)
+    robot.begin_step(1, sensed=[cell((0, 2))], now=0)
+    robot.receive(BeaconMessage(1, 1, 1, (0, 2), (1, 2), 0, 0, ahead))  # the occupant, outranked by the robot
+    asked = [item.recipients for item in robot.act() if isinstance(item.message, CallInheritMessage)]
+    assert asked == [(1,)]
+    robot.receive(CallReserveMessage(1, 2, 1, (0, 2), 0, 0, 1, True))  # it stays for good, in the robot's call ...
+    robot.receive(AnswerMessage(1, 3, 1, False, True))  # ... turning to leave next step
+    robot.act()
+    assert robot.stats["withdrawn"] == 0
+    assert flat.cells[robot._stay_toward] == (0, 2)
 
 
 # -- progress on maps with dead ends: a stalled robot's reach grows ------------------------------------
