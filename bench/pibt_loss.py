@@ -27,24 +27,11 @@ import statistics
 import sys
 from pathlib import Path
 
-from mrmp.core import NetworkFaults, PolicyOptions, Scenario
-from mrmp.io import load_movingai_scenario, load_scenario
+from live_virtual import case_scenario
+from mrmp.core import NetworkFaults, Scenario
 from mrmp.sim.synchronized_rounds import SynchronizedRoundsSimulator
 
 ROOT = Path(__file__).resolve().parents[1]
-
-
-def case_scenario(case: str, body: str) -> Scenario:
-    """The scenario of a case ``MAP:N`` (module docstring), run by ``pibt`` with the local synchronizer."""
-    name, count = case.split(":")
-    robots = int(count)
-    if name == "causal-32":
-        loaded = load_scenario(ROOT / "examples" / "causal-32.yaml")
-        loaded = loaded.with_changes(robots=loaded.robots[:robots])
-    else:
-        loaded = load_movingai_scenario(ROOT / "maps" / f"{name}.map", ROOT / "maps" / f"{name}-random-1.scen", robots)
-    policy = PolicyOptions(name="pibt", synchronizer="local", body=body, swap=body == "omni")
-    return loaded.with_changes(policy=policy, max_ticks=5000)
 
 
 def steps_over(scenario: Scenario, loss: float, seeds: int) -> tuple[list[int], dict[str, int]]:
@@ -88,7 +75,7 @@ def main() -> int:
     )
     for case in arguments.cases.split(","):
         for body in bodies:
-            scenario = case_scenario(case, body)
+            scenario = case_scenario(case, "local", body).with_changes(max_ticks=5000)
             perfect = None
             for loss in losses:
                 steps, counts = steps_over(scenario, loss, arguments.seeds)
