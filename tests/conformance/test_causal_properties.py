@@ -51,6 +51,7 @@ def test_reaches_every_goal_within_the_bound_on_biconnected_maps(examples, body)
     check()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("body", sorted(BODY_SLOWDOWN))
 def test_never_collides_on_any_map(body):
     """No collision, and for ``turning`` bodies no illegal action (the referee judges them in the body's model)."""

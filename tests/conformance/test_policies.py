@@ -85,6 +85,7 @@ def pairwise_violations(grid, paths):
     return found
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("policy", "body"), [(name, body) for name in policy_names() for body in policy_entry(name).bodies])
 def test_policy_conformance(policy, body):
     check_policy(policy, body=body)

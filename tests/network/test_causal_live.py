@@ -14,6 +14,7 @@ from mrmp.live.transport import LiveFaults
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("body", ["omni", "turning"])
 def test_four_robots_cross_over_lossy_udp(tmp_path, body):
     """Two head-on pairs on a 5x5 grid with a pillar, 20% of datagrams lost, late and duplicated; ``turning``

@@ -8,6 +8,8 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
+
 EXAMPLES = Path(__file__).resolve().parents[2] / "examples"
 
 
@@ -35,6 +37,7 @@ def fleet_started(results, robots):
     return True
 
 
+@pytest.mark.slow
 def test_ctrl_c_stops_everything_and_writes_results(tmp_path):
     results = tmp_path / "run"
     out = tmp_path / "result.json"

@@ -9,6 +9,8 @@ from __future__ import annotations
 import json
 from pathlib import Path
 
+import pytest
+
 from mrmp.api import run as simulate
 from mrmp.core.progress import LiveProgress
 from mrmp.io.lorr import lorr_scenario, read_lorr_problem
@@ -18,6 +20,7 @@ from mrmp.live.transport import LiveFaults
 PROBLEM = Path(__file__).resolve().parents[2] / "examples" / "lorr" / "warehouse-small_24.json"
 
 
+@pytest.mark.slow
 def test_a_lifelong_fleet_live_over_lossy_udp_reaches_real_errands(tmp_path: Path) -> None:
     scenario = lorr_scenario(read_lorr_problem(PROBLEM).with_team(8), steps=60)
     simulated = len(simulate(scenario).run.tasks.events)

@@ -15,6 +15,7 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
 from polling import PATIENCE
 from test_live_interrupt import fleet_started, processes_mentioning
 from test_orphans import children, kill, left_running, wait_for
@@ -60,6 +61,7 @@ def test_four_robots_cross_over_udp_without_collision(tmp_path):
     assert result.network["safety_granted"] == result.network["moves"]  # every move entered through the safety layer
 
 
+@pytest.mark.slow
 def test_five_robots_over_lossy_udp(tmp_path):
     """20% of the datagrams lost, some late and some duplicated: acknowledgements and timers repair it."""
     robots = (*CROSS, RobotSpec("e", (0, 0), (4, 4)))
@@ -69,6 +71,7 @@ def test_five_robots_over_lossy_udp(tmp_path):
     assert result.network["injected_lost"] > 0 and pibt_counts(result)["retransmissions"] > 0
 
 
+@pytest.mark.slow
 def test_robots_that_end_their_own_steps_cross_over_lossy_udp(tmp_path):
     """``synchronizer: local``: no common clock; 20% of the datagrams lost; no step ends undecided."""
     robots = (*CROSS, RobotSpec("e", (0, 0), (4, 4)))
@@ -83,6 +86,7 @@ def test_robots_that_end_their_own_steps_cross_over_lossy_udp(tmp_path):
     assert result.network["safety_granted"] == result.network["moves"]
 
 
+@pytest.mark.slow
 def test_robots_hosted_three_to_a_process_cross_over_lossy_udp_each_with_its_own_socket(tmp_path):
     """Six robots in two ``mrmp agent`` processes: each robot binds its own port and hears the others through the
     network only (its own datagrams lost as any), and the fleet is judged as one of a process per robot."""
@@ -106,6 +110,7 @@ def distinct(cells) -> list[tuple[int, int]]:
     return out
 
 
+@pytest.mark.slow
 def test_a_live_fleet_moves_as_the_simulator_running_the_same_brain(tmp_path):
     """Perfect network, a radius that covers the map (the calls run in priority order): the same moves.
 
@@ -125,6 +130,7 @@ def test_a_live_fleet_moves_as_the_simulator_running_the_same_brain(tmp_path):
         assert distinct(cell for _, cell in report["believed_path"]) == distinct(robot.path), robot.id
 
 
+@pytest.mark.slow
 def test_a_live_fleet_that_ends_its_own_steps_moves_as_the_simulator_running_the_same_brain(tmp_path):
     """``synchronizer: local``, perfect network, a radius that covers the map: the cells each robot enters, in order,
     are those of :class:`~mrmp.sim.synchronized_rounds.SynchronizedRoundsSimulator` (a held robot that gives up
@@ -141,6 +147,7 @@ def test_a_live_fleet_that_ends_its_own_steps_moves_as_the_simulator_running_the
         assert distinct(cell for _, cell in report["believed_path"]) == distinct(robot.path), robot.id
 
 
+@pytest.mark.slow
 def test_real_processes_and_the_virtual_clock_run_a_fleet_alike(tmp_path):
     """24 robots of ``causal-32`` at 10% loss, one process per robot over UDP, and the same drivers on a virtual clock
     (:mod:`mrmp.live.virtual_time`): both get every robot home without a collision, with about as many moves and
@@ -219,6 +226,7 @@ def test_ctrl_c_on_a_live_pibt_run_stops_everything_and_writes_results(tmp_path)
         assert json.loads((results / f"agent-{index}.json").read_text())["stop_reason"] == "interrupted", text
 
 
+@pytest.mark.slow
 def test_a_killed_live_pibt_launcher_leaves_nothing_running(tmp_path):
     results = tmp_path / "run"
     launcher = live_pibt_launcher(results)
@@ -238,6 +246,7 @@ def test_a_killed_live_pibt_launcher_leaves_nothing_running(tmp_path):
         time.sleep(0)  # nothing to wait for: every process is gone or killed
 
 
+@pytest.mark.slow
 def test_a_killed_robot_is_taken_for_crashed_and_the_robots_it_does_not_block_arrive(tmp_path):
     """``--kill``: robot c, far from the others' way, dies; a and b stop waiting for it and trade places."""
     robots = (RobotSpec("a", (0, 0), (0, 4)), RobotSpec("b", (0, 4), (0, 0)), RobotSpec("c", (4, 0), (4, 2)))
@@ -255,6 +264,7 @@ def turning_crossing(robots: tuple[RobotSpec, ...] = CROSS, **policy) -> Scenari
     return crossing(robots=headed).with_changes(policy=options)
 
 
+@pytest.mark.slow
 def test_robots_that_turn_in_place_cross_over_lossy_udp(tmp_path):
     """``body: turning``: the robots plan their quarter turns, and their bodies make exactly those, one at a time."""
     robots = (*CROSS, RobotSpec("e", (0, 0), (4, 4)))

@@ -25,6 +25,7 @@ def live(scenario, tmp_path, **options):
     return run_live(scenario, LiveOptions(results=tmp_path / "run", **options))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["thesis-swap", "thesis-cross"])
 def test_thesis_scenarios_over_udp(name, tmp_path):
     result = live(load_scenario(EXAMPLES / f"{name}.yaml"), tmp_path, time_scale=20)
@@ -34,6 +35,7 @@ def test_thesis_scenarios_over_udp(name, tmp_path):
     assert result.network["rejected_forged"] == 0 if "rejected_forged" in result.network else True
 
 
+@pytest.mark.slow
 def test_thesis_swap_over_zenoh(tmp_path):
     pytest.importorskip("zenoh")
     result = live(load_scenario(EXAMPLES / "thesis-swap.yaml"), tmp_path, time_scale=20, transport="zenoh")
@@ -45,6 +47,7 @@ def test_thesis_swap_over_multicast(tmp_path):
     assert result.collisions == [] and result.success, result.stop_reason
 
 
+@pytest.mark.slow
 def test_eight_robots_live(tmp_path):
     """Four thesis swaps at once: pairs of robots trade places head-on along four rows."""
     east = [RobotSpec(f"a{i}", (2 * i + 1, 0), (2 * i + 1, 9)) for i in range(4)]
@@ -54,6 +57,7 @@ def test_eight_robots_live(tmp_path):
     assert result.collisions == [] and result.success, result.stop_reason
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("policy", ["thesis", "astar"])
 def test_turning_bodies_plan_and_drive_their_quarter_turns_live(policy, tmp_path):
     """The thesis's rule and reactive A* for ``turning`` bodies over lossy UDP: every robot arrives, none collides,
@@ -70,6 +74,7 @@ def test_turning_bodies_plan_and_drive_their_quarter_turns_live(policy, tmp_path
         assert len([line for line in trace if json.loads(line)["event"] == "heading"]) == report["turns"]
 
 
+@pytest.mark.slow
 def test_thirty_percent_loss_delay_and_duplication(tmp_path):
     scenario = load_scenario(EXAMPLES / "thesis-swap.yaml")
     faults = LiveFaults(loss=0.3, delay_min=0.0, delay_max=0.08, duplicate=0.2)
@@ -79,6 +84,7 @@ def test_thirty_percent_loss_delay_and_duplication(tmp_path):
     assert result.network.get("rejected_replayed", 0) > 0  # duplicates are caught as replays
 
 
+@pytest.mark.slow
 def test_thesis_race_collides_unsafe_and_not_guarded(tmp_path):
     """A 300 ms message delay: both robots decide on stale knowledge and walk into each other on their column.
 
@@ -95,6 +101,7 @@ def test_thesis_race_collides_unsafe_and_not_guarded(tmp_path):
     assert guarded.collisions == [] and guarded.success
 
 
+@pytest.mark.slow
 def test_killed_robot_is_an_obstacle_and_the_others_arrive(tmp_path):
     """Four robots (a majority is three): D is killed on its long way; A, B, C plan around its last cell and arrive."""
     robots = (
@@ -167,6 +174,7 @@ def test_forged_replayed_and_garbage_packets_change_nothing():
     assert report.safety["claims"] > 0 and report.safety["granted"] == 0
 
 
+@pytest.mark.slow
 def test_lacam_plan_for_sixteen_robots_with_delays_and_loss(tmp_path):
     """A central LaCAM plan executed live over UDP with random delays and 20% message loss."""
     from mrmp.centralized.registry import plan_with
@@ -183,6 +191,7 @@ def test_lacam_plan_for_sixteen_robots_with_delays_and_loss(tmp_path):
     assert result.network["injected_lost"] > 0
 
 
+@pytest.mark.slow
 def test_a_turning_plan_is_driven_live_by_turning_bodies_through_loss_and_jitter(tmp_path):
     """A LaCAM plan for turning bodies (LoRR's MAPF_T) executed live by bodies that turn in place: every robot
     arrives, none collides, and each makes exactly the quarter turns its plan's cells need, the shorter way."""
@@ -223,6 +232,7 @@ def followings(results: Path) -> int:
     return count
 
 
+@pytest.mark.slow
 def test_turning_bodies_follow_one_another_live_as_the_plan_has_them(tmp_path):
     """Bodies that turn in place, with no jitter, are followed while they drive (``docs/protocol.md``, "Following
     while driving"): executing a LaCAM plan for them over lossy UDP, robots start into cells their occupants are
@@ -245,6 +255,7 @@ def test_turning_bodies_follow_one_another_live_as_the_plan_has_them(tmp_path):
     assert followings(tmp_path / "jitters" / "run") == 0
 
 
+@pytest.mark.slow
 def test_killed_robot_in_a_live_plan_execution_blocks_only_the_goals_it_stands_on(tmp_path):
     """Sixteen robots execute a LaCAM plan; robot 3 is killed early. Robots waiting for it drop it or leave the
     plan (``mrmp.policies.plan_following``, crash rule): every robot whose goal the dead robot does not cut off

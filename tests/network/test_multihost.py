@@ -281,6 +281,7 @@ def stop_reason(reports: list[dict[str, Any] | None]) -> str:
     return ", ".join(sorted(reasons))
 
 
+@pytest.mark.slow
 def test_three_robots_in_three_namespaces_over_a_lossy_link(
     network: Network, processes: list[subprocess.Popen[bytes]], tmp_path: Path, request: pytest.FixtureRequest
 ) -> None:

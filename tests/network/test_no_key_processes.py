@@ -17,6 +17,7 @@ import sys
 import time
 from pathlib import Path
 
+import pytest
 from polling import PATIENCE
 
 from mrmp.live.transport_entry import free_ports
@@ -94,6 +95,7 @@ def report(results: Path, index: int) -> dict:
     return json.loads((results / f"agent-{index}.json").read_text())
 
 
+@pytest.mark.slow
 def test_a_keyless_zenoh_fleet_on_loopback_listens_on_loopback_only(tmp_path):
     first, second = free_ports(2)
     a = agent("A", tmp_path, "--transport=zenoh", f"--listen=tcp/127.0.0.1:{first}", f"--connect=tcp/127.0.0.1:{second}")
@@ -105,6 +107,7 @@ def test_a_keyless_zenoh_fleet_on_loopback_listens_on_loopback_only(tmp_path):
     assert report(tmp_path, 0)["stop_reason"] == "all arrived"
 
 
+@pytest.mark.slow
 def test_a_keyless_zenoh_robot_asked_to_listen_beyond_loopback_refuses_before_opening_anything(tmp_path):
     first, second = free_ports(2)
     for listen in (f"tcp/0.0.0.0:{first}?x=/", f"tcp/0.0.0.0:{first}#a/b", f"tcp/127.0.0.1:{first}#iface=eth0"):
@@ -117,6 +120,7 @@ def test_a_keyless_zenoh_robot_asked_to_listen_beyond_loopback_refuses_before_op
     assert not (tmp_path / "agent-0.json").exists()
 
 
+@pytest.mark.slow
 def test_a_keyless_multicast_robot_receives_only_its_group_on_loopback(tmp_path):
     port = free_ports(1)[0]
     group = f"239.255.77.{1 + port % 250}"
@@ -139,6 +143,7 @@ def test_a_keyless_multicast_robot_receives_only_its_group_on_loopback(tmp_path)
         assert "magic" not in rejected, rejected  # a datagram to the host's address never does
 
 
+@pytest.mark.slow
 def test_a_short_environment_key_does_not_open_a_robot_beyond_loopback(tmp_path):
     first, second = free_ports(2)
     for key in ("abc", " ", "x" * 15):

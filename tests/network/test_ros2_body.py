@@ -32,6 +32,7 @@ def dds_environment(tmp_path: Path) -> dict[str, str]:
     return loopback_environment(tmp_path, salt=1)
 
 
+@pytest.mark.slow
 def test_a_robot_driven_over_ros2_reaches_its_goal_cell_by_cell(tmp_path: Path, dds_environment: dict[str, str]) -> None:
     final = tmp_path / "final.json"
     node = subprocess.Popen(
@@ -60,6 +61,7 @@ def test_a_robot_driven_over_ros2_reaches_its_goal_cell_by_cell(tmp_path: Path, 
     assert yaw_heading(yaw) == Heading.EAST and pose["commands"] > 0
 
 
+@pytest.mark.slow
 def test_without_a_driver_the_agent_stops_in_one_line(tmp_path: Path, dds_environment: dict[str, str]) -> None:
     agent = subprocess.run(
         [sys.executable, "-m", "mrmp", "agent", str(ROOT / "examples" / "thesis-single.yaml"), "--robot", "A",

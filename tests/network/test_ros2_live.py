@@ -37,6 +37,7 @@ def cell_of(line: dict) -> tuple[int, int]:
     return (round(line["y"] - 0.5), round(line["x"] - 0.5))
 
 
+@pytest.mark.slow
 def test_every_robot_publishes_its_poses_and_states_during_a_live_run(tmp_path: Path, dds_environment: dict[str, str]) -> None:
     received = tmp_path / "received.jsonl"
     listener = subprocess.Popen(

@@ -53,6 +53,7 @@ def table():
     return outcome_table(Grid(5, 5))
 
 
+@pytest.mark.slow
 def test_three_hundred_pairs_per_column(table):
     assert len(trade_places_pairs(Grid(5, 5))) == 300
     assert list(table) == list(COLUMNS)

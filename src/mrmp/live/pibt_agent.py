@@ -132,7 +132,11 @@ class PibtTiming:
     pace: float = 0.0
     """With a local synchronizer, the least time from a step's start to the next's: one action of the body (a
     step of the simulator is one action; a robot whose steps are shorter only waits for its body, or spends
-    beacons on steps in which it stays)."""
+    beacons on steps in which it stays), but for :attr:`lead`."""
+    lead: float = 0.0
+    """With a local synchronizer, a robot off its goal may begin its next step sooner than :attr:`pace`, once
+    its body has at most this long left of the actions it was given (each counted as :attr:`pace`): the next
+    decision then comes as the body finishes, and a step whose decisions took long is caught up on."""
 
     @classmethod
     def for_body(
@@ -143,6 +147,7 @@ class PibtTiming:
         grace: float = 0.05,
         retry: float = 0.03,
         hold: float = 0.4,
+        lead: float = 0.5,
     ) -> PibtTiming:
         """Steps as long as a move with one right turn (the next step's decisions overlap it), or as ``decide``
         seconds of decisions and a ``grace`` for the grant when the moves are shorter.
@@ -152,16 +157,20 @@ class PibtTiming:
         the robots that decided and gives the others time. A held robot waits
         for its grant for the fraction ``hold`` of the decision phase. Steps
         ended by the robots last at least one action (``pace``: a move with
-        one right turn, or a cell time for a body that turns in place).
+        one right turn, or a cell time for a body that turns in place), unless
+        the robot is off its goal and its body is within the fraction ``lead``
+        of an action of running out of work (:attr:`lead`).
 
         >>> PibtTiming.for_body(0.5, 0.25)
-        PibtTiming(decide=0.7, step=0.75, retry=0.03, hold=0.28, pace=0.75)
+        PibtTiming(decide=0.7, step=0.75, retry=0.03, hold=0.28, pace=0.75, lead=0.375)
         >>> PibtTiming.for_body(0.1, 0.05)   # moves shorter than the decisions: the decisions set the clock's pace
-        PibtTiming(decide=0.3, step=0.35, retry=0.03, hold=0.12, pace=0.15)
+        PibtTiming(decide=0.3, step=0.35, retry=0.03, hold=0.12, pace=0.15, lead=0.075)
         """
         action = cell_seconds + turn_seconds
         phase = max(decide, action - grace)
-        return cls(round(phase, 6), round(phase + grace, 6), retry, round(phase * hold, 6), round(action, 6))
+        return cls(
+            round(phase, 6), round(phase + grace, 6), retry, round(phase * hold, 6), round(action, 6), round(action * lead, 6)
+        )
 
 
 def open_repeat(opener: Opener, data: bytes) -> Message | None:
@@ -278,6 +287,8 @@ class PibtBrain:
         self._act = False
         self._claimed_at = -math.inf
         self._began = 0.0
+        self._action_began = 0.0
+        """When the body began its current action (:meth:`work_left`)."""
         self.crash_after = crash_after
         self.tasks = TaskTaker(index, len(scenario.robots), TASK_RETRY) if scenario.lifelong else None
         """A lifelong robot's tasks, from the task desk (one past the last robot on the wire); None: one goal."""
@@ -334,7 +345,9 @@ class PibtBrain:
         Step 1 begins at ``t0``; step ``k + 1`` at once when step ``k`` is done
         (:attr:`~mrmp.robot.pibt_synchronized.SynchronizedPibtRobot.step_done`),
         held while the move decided in step ``k`` is not granted, and no sooner
-        than ``pace`` after step ``k`` began. A held robot that has not been
+        than ``pace`` after step ``k`` began, unless the robot is off its goal
+        and its body has no more than ``lead`` seconds of work left
+        (:meth:`work_left`). A held robot that has not been
         granted ``hold`` seconds after its step began gives up and, at its
         turn, stays, as on the clock; no step ends undecided.
         """
@@ -347,12 +360,34 @@ class PibtBrain:
             robot.give_up()
         self._crash_silent(now)
         self._run_brain(now, out)
-        if robot.step_done and now - self._began >= self.timing.pace:
+        if robot.step_done and self._may_begin_next_step(now):
             self._finish_step()
             self._begin_next_step(now, out)
             self._run_brain(now, out)
         out.extend(self._stamped(self.safety.expire(now)))
         return out
+
+    def _may_begin_next_step(self, now: float) -> bool:
+        """With a local synchronizer, the step done: ``pace`` has passed since it began, or the robot is off its
+        goal and its body is within ``lead`` of running out of work (a robot on its goal does not hurry)."""
+        timing, robot = self.timing, self.robot
+        if now - self._began >= timing.pace:
+            return True
+        return robot.present != robot.goal and self.work_left(now) <= timing.lead
+
+    def work_left(self, now: float) -> float:
+        """Seconds of work the body has left at ``now``: the rest of its action, and ``pace`` for each queued one.
+
+        >>> from mrmp.core import Grid, PolicyOptions, RobotSpec, Scenario
+        >>> scenario = Scenario(Grid(3, 1), [RobotSpec("A", (0, 0), (2, 0))], policy=PolicyOptions(name="pibt"))
+        >>> brain = PibtBrain(scenario, 0, PibtTiming(decide=0.3, step=0.35, retry=0.03, hold=0.1, pace=0.2))
+        >>> brain.queue.append((1, 0))
+        >>> brain.work_left(0.0)
+        0.2
+        """
+        pace = self.timing.pace
+        left = max(0.0, self._action_began + pace - now) if self.moving else 0.0
+        return left + pace * len(self.queue)
 
     def _begin_next_step(self, now: float, out: list[Outgoing]) -> None:
         """Begin the next step, held while a queued move is not granted; the brain acts on it at its next run."""
@@ -458,7 +493,7 @@ class PibtBrain:
         safety, cell = self.safety, self.queue[0]
         if isinstance(cell, Heading):
             self.queue.pop(0)
-            self.moving = True
+            self.moving, self._action_began = True, now
             return cell, []
         if safety.pending is None or safety.pending.cell != cell:
             if now - self._claimed_at < safety.retry_interval:
@@ -472,7 +507,7 @@ class PibtBrain:
             return None, []
         safety.begin_move(cell)
         self.queue.pop(0)
-        self.moving = True
+        self.moving, self._action_began = True, now
         if not self._move_queued():
             self.robot.release()
             self._act = True

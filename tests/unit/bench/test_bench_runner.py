@@ -92,6 +92,7 @@ def test_a_line_cut_short_by_a_kill_is_dropped_and_its_run_redone(tmp_path):
     assert [record["run_id"] for record in records] == [run.run_id for run in runs]
 
 
+@pytest.mark.slow
 def test_interrupted_bench_stops_at_once_keeps_finished_records_and_resumes(tmp_path):
     config = tmp_path / "bench.yaml"
     config.write_text(

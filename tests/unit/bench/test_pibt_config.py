@@ -12,6 +12,8 @@ import importlib.util
 from collections import defaultdict
 from pathlib import Path
 
+import pytest
+
 from mrmp.experiments.bench_config import load_bench_config
 from mrmp.experiments.records import build_scenario
 
@@ -30,6 +32,7 @@ def _robots(scenario) -> tuple:
     return tuple((robot.start, robot.goal) for robot in scenario.robots), scenario.seed, scenario.policy.name
 
 
+@pytest.mark.slow
 def test_the_bench_config_runs_the_scale_scripts_instances() -> None:
     pibt_scale = _pibt_scale()
     config = load_bench_config(ROOT / "bench" / "pibt.yaml")

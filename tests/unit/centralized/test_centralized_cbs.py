@@ -71,6 +71,7 @@ def corridor_instances(draw: st.DrawFn) -> tuple[Grid, list, list]:
     return Grid(2, length, blocked), starts, goals
 
 
+@pytest.mark.slow
 @settings(max_examples=200, derandomize=True, deadline=None)
 @given(st.one_of(instances(), corridor_instances()))
 def test_cbs_sum_of_costs_equals_brute_force(instance: tuple[Grid, list, list]) -> None:
@@ -99,6 +100,7 @@ def test_original_cbs_is_optimal_too(instance: tuple[Grid, list, list]) -> None:
         assert result.sum_of_costs() == optimum
 
 
+@pytest.mark.slow
 @settings(max_examples=40, derandomize=True, deadline=None)
 @given(instances(max_side=3, max_robots=2))
 def test_heading_aware_cbs_is_optimal_for_the_turn_model(instance: tuple[Grid, list, list]) -> None:

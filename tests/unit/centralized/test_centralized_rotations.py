@@ -188,6 +188,7 @@ def small_maps(draw: st.DrawFn) -> Scenario:
     return scenario_of(grid, rng.sample(free, count), rng.sample(free, count))
 
 
+@pytest.mark.slow
 @settings(max_examples=60, derandomize=True, deadline=None)
 @given(small_maps())
 def test_lacam_and_pp_plans_are_rotation_free_and_execute(scenario):

@@ -44,6 +44,7 @@ def settled(path):
         ("lacam", "warehouse-10-20-10-2-1", 40),
     ],
 )
+@pytest.mark.slow
 def test_the_executed_paths_are_the_planned_paths(planner, map_name, agents):
     scenario = instance(map_name, agents)
     plan = plan_with(planner, scenario, time_limit_s=60)

@@ -65,6 +65,7 @@ def test_an_omni_plan_driven_by_turning_bodies_takes_longer_but_never_collides()
     assert result.makespan > plan.makespan()
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", [0, 1])
 def test_over_a_faulty_network_a_turning_plan_is_late_not_colliding(seed: int) -> None:
     scenario = instance("random-32-32-20", 30).with_changes(

@@ -152,6 +152,7 @@ def test_a_radius_beyond_the_bound_is_refused():
 # -- 7. what was accepted silently --------------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_an_infinite_cell_time_is_refused(tmp_path):
     scenario = write(tmp_path, "forever.yaml", "map: {width: 5, height: 5}\n" + ONE_ROBOT + "timing: {cell_time: .inf}\n")
     assert_refused(mrmp("run", scenario), f"{scenario}:4", "timing.cell_time: must be at most 3600 seconds, got inf")
@@ -166,6 +167,7 @@ def test_a_device_as_the_map_file_is_named_as_a_device(tmp_path):
     assert_refused(mrmp("run", scenario), f"{scenario}:1", "map.file: map file /dev/zero is a device, not a file")
 
 
+@pytest.mark.slow
 def test_a_planner_replaces_the_scenarios_policy_and_its_limits():
     completed = mrmp("run", EXAMPLES / "causal-32.yaml", "--planner", "pp", "--unsafe")
     assert completed.returncode == 0, completed.stderr
@@ -177,6 +179,7 @@ def test_a_planner_replaces_the_scenarios_policy_and_its_limits():
 # -- 3. the key ---------------------------------------------------------------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("key", ["abc", " ", "fifteen bytes!!"])
 def test_a_fleet_key_shorter_than_16_bytes_is_refused(key):
     environment = {**without_key(), "MRMP_FLEET_KEY": key}
@@ -220,6 +223,7 @@ def test_an_agent_names_each_robot_once():
         (["--live", "--robots-per-process", "2", "--kill", "A@1"], "with --kill"),
     ],
 )
+@pytest.mark.slow
 def test_robots_per_process_is_refused_where_it_cannot_be_honoured(arguments, reason):
     assert_refused(mrmp("run", EXAMPLES / "thesis-swap.yaml", *arguments), "--robots-per-process", reason)
 

@@ -128,6 +128,7 @@ def test_referee_of_a_missing_folder_is_bad_input(tmp_path: Path) -> None:
     assert result.exit_code == 2 and "--results: no such folder" in result.output
 
 
+@pytest.mark.slow
 def test_shell_completion_completes_choices_from_the_tables() -> None:
     def complete(words: str) -> list[str]:
         env = {**os.environ, "_MRMP_COMPLETE": "complete_bash", "COMP_WORDS": words, "COMP_CWORD": str(len(words.split(" ")) - 1)}

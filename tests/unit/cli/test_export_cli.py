@@ -128,11 +128,13 @@ def saved(tmp_path_factory: pytest.TempPathFactory) -> Path:
     return path
 
 
+@pytest.mark.slow
 def test_a_missing_result_file_is_named(tmp_path) -> None:
     missing = tmp_path / "nothing.json"
     assert_refused(mrmp("export", missing, tmp_path / "out.mcap"), missing, "file not found")
 
 
+@pytest.mark.slow
 def test_malformed_json_names_its_line(tmp_path) -> None:
     bad = tmp_path / "bad.json"
     bad.write_text('{\n  "scenario": \n')

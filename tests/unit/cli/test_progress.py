@@ -8,6 +8,8 @@ import subprocess
 import sys
 from pathlib import Path
 
+import pytest
+
 ROOT = Path(__file__).resolve().parents[3]
 COMMAND = [sys.executable, "-m", "mrmp", "run", str(ROOT / "examples" / "thesis-swap.yaml"), "--max-ticks", "40"]
 
@@ -45,6 +47,7 @@ def test_a_pipe_sees_no_progress_line() -> None:
 LIVE = [sys.executable, "-m", "mrmp", "run", str(ROOT / "examples" / "thesis-swap.yaml"), "--live", "--time-scale", "10"]
 
 
+@pytest.mark.slow
 def test_a_terminal_sees_the_live_progress_line(tmp_path: Path) -> None:
     parent, child = pty.openpty()
     command = [*LIVE, "--results", str(tmp_path), "--loss", "0.2"]
@@ -57,6 +60,7 @@ def test_a_terminal_sees_the_live_progress_line(tmp_path: Path) -> None:
     assert " s: " in output and "of 2 robots arrived" in output and "success" in output
 
 
+@pytest.mark.slow
 def test_a_pipe_sees_no_live_progress_line(tmp_path: Path) -> None:
     finished = subprocess.run([*LIVE, "--results", str(tmp_path)], capture_output=True, text=True, check=False)
     assert finished.returncode == 0 and "success" in finished.stdout

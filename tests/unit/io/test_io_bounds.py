@@ -27,6 +27,7 @@ def test_a_device_is_refused_without_reading_it(device):
     assert problems(error) == [f"{device}: is a device, not a file"]
 
 
+@pytest.mark.slow
 def test_a_file_one_byte_over_the_bound_is_refused_and_one_at_the_bound_is_read(tmp_path):
     path = tmp_path / "long.yaml"
     with open(path, "wb") as handle:
@@ -65,6 +66,7 @@ def test_yaml_nesting_at_the_bound_is_composed():
     assert problems(error) == ["nested.yaml:4: description: expected a string, got a list"]
 
 
+@pytest.mark.slow
 def test_map_sizes_beyond_the_bound_are_refused_in_every_form(tmp_path):
     with pytest.raises(InputError) as error:
         scenario_from_text("map: {width: 100000, height: 100000}\n" + ONE_ROBOT, "huge.yaml")

@@ -124,6 +124,7 @@ def test_a_lifelong_brain_heads_for_the_errand_the_desk_gave_it_and_nobody_else(
 # -- a whole fleet on the virtual clock ---------------------------------------------------------
 
 
+@pytest.mark.slow
 def test_a_virtual_lifelong_fleet_finishes_what_the_simulator_does_and_its_errands_are_real(tmp_path: Path) -> None:
     scenario = lifelong(steps=120)
     simulated = simulate(scenario).run

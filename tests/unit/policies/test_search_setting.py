@@ -70,6 +70,7 @@ def test_yaml_unknown_search_is_one_line_naming_file_line_and_field():
     assert message.endswith("got 'bfs'")
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", list(SEARCH_TABLE))
 def test_flag_reaches_the_policy_table_and_changes_the_run(name, tmp_path, monkeypatch):
     scenario_file = tmp_path / "trap.yaml"
@@ -101,6 +102,7 @@ def test_flag_unknown_search_exits_2_with_one_line():
     )
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["dijkstra", "best-first", "astar"])
 def test_thesis_rule_with_a_search_trades_places_along_the_row(name):
     """The row swap livelocks with the update coordinate method; searches replanned at each step do not."""

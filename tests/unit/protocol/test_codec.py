@@ -43,18 +43,21 @@ messages = (
 )
 
 
+@pytest.mark.slow
 @settings(max_examples=500, derandomize=True)
 @given(messages)
 def test_round_trip(message):
     assert_round_trip(message)
 
 
+@pytest.mark.slow
 @settings(max_examples=500, derandomize=True)
 @given(st.binary(max_size=2 * MAX_MESSAGE_BYTES))
 def test_garbage_raises_only_decode_error(data):
     assert_exact_or_refused(data)
 
 
+@pytest.mark.slow
 @settings(max_examples=500, derandomize=True)
 @given(messages, st.data())
 def test_mutations_of_valid_messages_decode_to_valid_messages_or_raise(message, data):

@@ -157,18 +157,21 @@ def run(seed, robots, steps, oldest_first=False, waits=False):
     return adversarial_run(seed, robots, steps, make_node, act_once, assert_disjoint, oldest_first)
 
 
+@pytest.mark.slow
 @settings(max_examples=400, derandomize=True, deadline=None)
 @given(seed=st.integers(0, 10**9), robots=st.integers(2, 7))
 def test_no_two_robots_ever_cover_one_cell(seed, robots):
     run(seed, robots, steps=1500)
 
 
+@pytest.mark.slow
 def test_the_adversarial_runs_do_move():
     """The invariant is not bought by standing still: robots do complete moves, in small and larger fleets."""
     assert sum(run(seed, 4, 1500) for seed in range(10)) >= 20
     assert sum(run(seed, 6, 1500) for seed in range(10)) >= 20
 
 
+@pytest.mark.slow
 @settings(max_examples=300, derandomize=True, deadline=None)
 @given(seed=st.integers(0, 10**9), robots=st.integers(2, 7))
 def test_no_overlap_when_old_messages_come_first(seed, robots):
@@ -380,6 +383,7 @@ class GrantsOnAnyRelease(SafetyLayer):
         return acknowledgement
 
 
+@pytest.mark.slow
 @settings(max_examples=300, derandomize=True, deadline=None)
 @given(seed=st.integers(0, 10**9), robots=st.integers(2, 7))
 def test_no_overlap_when_refused_claims_wait_for_releases(seed, robots):

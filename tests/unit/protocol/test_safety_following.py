@@ -171,6 +171,7 @@ def run(seed, robots, ticks, crashes=True, keep_refused=False):
     return moves, follows
 
 
+@pytest.mark.slow
 @settings(max_examples=300, derandomize=True, deadline=None)
 @given(seed=st.integers(0, 10**9), robots=st.integers(2, 7))
 def test_no_collision_swap_or_rotation_under_the_lockstep_rule(seed, robots):
@@ -306,6 +307,7 @@ def test_the_adversary_catches_broken_following(variant, monkeypatch):
     assert caught(lambda seed: run(seed, 5, 150), range(30)) > 0
 
 
+@pytest.mark.slow
 def test_the_adversary_catches_a_replica_that_takes_stale_handoffs(monkeypatch):
     monkeypatch.setattr(sys.modules[__name__], "SafetyLayer", StaleHandoff)
     assert caught(lambda seed: run(seed, 5, 300), range(60)) > 0

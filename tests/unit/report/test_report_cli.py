@@ -2,6 +2,7 @@
 
 import json
 
+import pytest
 from PIL import Image
 from report_fixtures import make_record, unfinished, write_jsonl
 from typer.testing import CliRunner
@@ -73,6 +74,7 @@ def test_an_unwritable_out_exits_2(tmp_path):
     assert "Traceback" not in result.output
 
 
+@pytest.mark.slow
 def test_markdown_option_writes_the_headline_table(tmp_path):
     write_jsonl(tmp_path / "results.jsonl", [make_record(run_id="a"), make_record(run_id="b", seed=1, success=False)])
     result = invoke("report", tmp_path, "--out", tmp_path / "report.html", "--markdown", tmp_path / "table.md")

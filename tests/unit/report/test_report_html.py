@@ -3,6 +3,7 @@
 import base64
 import re
 
+import pytest
 from report_fixtures import NO_FAULTS, make_record, unfinished, write_jsonl
 
 from mrmp.bench.aggregate import summarize
@@ -10,6 +11,7 @@ from mrmp.io.report_input import read_bench_results
 from mrmp.viz.report_html import headline_html, write_report
 
 
+@pytest.mark.slow
 def test_report_of_real_runs_has_every_row_and_embeds_every_plot(tmp_path, simulated_records):
     results = read_bench_results(write_jsonl(tmp_path / "bench" / "results.jsonl", simulated_records))
     files = write_report(results, tmp_path / "out" / "report.html")

@@ -21,6 +21,7 @@ from mrmp.search.flat_map import FlatMap
 from mrmp.sim.live_rounds import LiveRoundsSimulator
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("faults", ["perfect", *FAULTS])
 @pytest.mark.parametrize("seed", range(8))
 def test_crowds_never_collide(seed, faults):
@@ -54,6 +55,7 @@ class Boastful(LivePibtRobot):
         return tuple((peer, cell, self.step) for peer, cell, _ in super()._fresh_news())
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("brain", [Forgetful, Boastful])
 def test_a_robot_that_forgets_that_peers_move_or_tells_old_news_as_new_collides(brain):
     class Simulator(LiveRoundsSimulator):

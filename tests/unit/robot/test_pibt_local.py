@@ -202,6 +202,7 @@ class Trusting(LocalPibtRobot):
         super()._continue(out)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("variant", [Hasty, Stubborn, Trusting])
 def test_each_broken_variant_collides(variant):
     seeds = range(60)
@@ -234,6 +235,7 @@ def test_without_waiting_for_higher_priorities_decisions_drift_from_central_pibt
     assert differing(Eager) > 3 * differing(LocalPibtRobot)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("swap", [False, True])
 @pytest.mark.parametrize("seed", range(40))
 def test_a_radius_that_covers_the_map_gives_central_pibt_exactly(seed, swap):
@@ -264,6 +266,7 @@ class Secretive(ReliablePibtRobot):
             self.target = target
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("variant", [Impatient, Secretive])
 def test_each_broken_variant_collides_over_a_faulty_network(variant):
     class Simulator(LocalRoundsSimulator):

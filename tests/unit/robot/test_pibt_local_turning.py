@@ -75,6 +75,7 @@ def test_a_fleet_on_a_standard_map_arrives_with_legal_actions_only(synchronizer:
     assert result.makespan <= 1.2 * driver.makespan  # the robots' own order costs little against the driver's
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("seed", range(12))
 def test_crowds_arrive_without_collision_on_perfect_and_faulty_networks(seed: int) -> None:
     for faults in (None, FAULTS):

@@ -29,6 +29,7 @@ def synchronized(scenario):
     return scenario.with_changes(policy=PolicyOptions(name="pibt", swap=scenario.policy.swap, synchronizer="local"))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("faults", ["perfect", *FAULTS])
 @pytest.mark.parametrize("seed", range(10))
 def test_crowds_arrive_and_no_cell_is_decided_twice(seed, faults):
@@ -132,6 +133,7 @@ def run_with(brain, scenario):
     return simulator.run(), min(robot.step for robot in simulator.robots)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("brain", [EndsAlone, IgnoresLaterSteps, AcknowledgesInThePast, StopsListeningOnceDecided])
 def test_without_any_one_rule_the_fleet_stops_advancing_over_a_lossy_network(brain):
     scenario = random_32(30, LOSSY, max_ticks=2000)
@@ -173,6 +175,7 @@ def causal_32_turning(seed):
     return scenario.with_changes(robots=scenario.robots[:24], policy=policy, network=LOSSY, seed=seed)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("brain", [JoinsAtOnce, WithdrawsForTheRobotItAsked])
 def test_over_a_lossy_network_turning_robots_decide_nearly_as_over_a_perfect_one(brain):
     """24 turning robots of causal-32 take 29 steps over a perfect network; at 20% loss, about as many
@@ -198,6 +201,7 @@ class DeafToNews(SynchronizedPibtRobot):
         pass
 
 
+@pytest.mark.slow
 def test_news_spares_robots_messages_to_and_waits_for_peers_that_cannot_be_near():
     scenario = random_32(100, NetworkFaults())
     told, _ = run_with(SynchronizedPibtRobot, scenario)
@@ -206,6 +210,7 @@ def test_news_spares_robots_messages_to_and_waits_for_peers_that_cannot_be_near(
     assert told.network["messages"] < 0.8 * deaf.network["messages"]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("brain", [ForgetfulSynchronized, BoastfulSynchronized])
 def test_a_robot_that_forgets_that_peers_move_or_tells_old_news_as_new_decides_cells_that_others_decided(brain):
     conflicts = 0
@@ -292,6 +297,7 @@ def test_local_step_ends_need_local_sequencing():
 # -- live: PibtBrain with the synchronizer, simulated bodies on an in-memory network ------------------------
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("paced", [True, False])
 def test_live_brains_that_end_their_own_steps_arrive_over_a_lossy_network_and_their_bodies_never_collide(paced):
     """Steps at least an action long (``PibtTiming.pace``, the default) keep this fleet's steps together; without
@@ -307,6 +313,23 @@ def test_live_brains_that_end_their_own_steps_arrive_over_a_lossy_network_and_th
         assert all(brain.synchronized for brain in fleet.brains)
         if not paced:
             assert sum(brain.robot.stats["ahead"] for brain in fleet.brains) > 0  # robots were in different steps
+
+
+@pytest.mark.parametrize("seed", [0, 3])
+def test_robots_off_their_goals_begin_their_next_step_as_their_bodies_run_out_of_work(seed):
+    """``PibtTiming.lead``: a robot off its goal begins its next step once its body has half an action of work
+    left, though a whole action has not passed since its step began; a step whose decisions took long is caught
+    up on. Without it (a broken variant, steps an action apart) the same fleet arrives much later."""
+    scenario = synchronized(crowd(seed, density=0.3, max_ticks=200))
+    timing = PibtTiming.for_body(scenario.timing.cell_time, scenario.timing.turn_time)
+    assert timing.lead == timing.pace / 2
+    arrivals = []
+    for lead in (timing.lead, 0.0):
+        fleet = BrainFleet(scenario, timing=dataclasses.replace(timing, lead=lead), loss=0.2, seed=seed, tick=0.01)
+        arrivals.append(fleet.run(until=120))
+        assert fleet.collisions() == [] and all(brain.settled for brain in fleet.brains)
+    leading, paced = arrivals
+    assert leading < 0.8 * paced
 
 
 CROSS = (

@@ -73,6 +73,7 @@ def state(simulator: RoundsSimulator) -> tuple[list[int], list[int]]:
     return [robot.present for robot in simulator.robots], [int(robot.heading) for robot in simulator.robots]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("radius", [2, 32])
 @pytest.mark.parametrize("seed", range(40))
 def test_decisions_equal_the_central_turning_generator(seed: int, radius: int) -> None:

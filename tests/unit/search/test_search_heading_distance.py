@@ -118,6 +118,7 @@ def dijkstra_table(grid: Grid, goal, turn_cost: float, both_ways: bool, lanes=No
     return table
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("threshold", [0, 64, 10**9])
 @pytest.mark.parametrize("seed", range(4))
 def test_large_maps_give_dijkstras_table_whether_waves_run_in_python_or_numpy(monkeypatch, seed, threshold):

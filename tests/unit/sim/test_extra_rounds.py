@@ -10,6 +10,8 @@ from __future__ import annotations
 
 from pathlib import Path
 
+import pytest
+
 from mrmp.centralized.execution import plan_policies
 from mrmp.centralized.registry import plan_with
 from mrmp.core import NetworkFaults
@@ -41,11 +43,13 @@ def test_a_perfect_network_gets_no_extra_rounds_and_a_lossy_one_does() -> None:
     assert LockstepSimulator(scenario.with_changes(network=NetworkFaults(loss=0.1))).extra_rounds == EXTRA_ROUNDS > 0
 
 
+@pytest.mark.slow
 def test_a_lossy_plan_execution_stays_within_five_percent_of_its_plan() -> None:
     planned, executed, _ = _lossy_execution(100, None)
     assert planned <= executed <= 1.05 * planned
 
 
+@pytest.mark.slow
 def test_without_the_extra_rounds_the_same_execution_falls_behind_its_plan() -> None:
     planned, executed, _ = _lossy_execution(100, 0)
     assert executed > 1.15 * planned

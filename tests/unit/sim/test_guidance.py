@@ -27,6 +27,7 @@ def test_a_guided_robot_leaves_a_row_whose_lane_runs_against_it(sequencing):
     assert rows == {"none": {1}, "crisscross": {0, 1}}
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize(("sequencing", "loss"), [("driver", 0.2), ("local", 0.0)])
 def test_a_guided_fleet_finishes_its_tasks_without_collision(sequencing, loss):
     scenario = load_lorr_scenario("examples/lorr/maze-example_40.json", 120)

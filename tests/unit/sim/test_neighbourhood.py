@@ -53,6 +53,7 @@ INSTANCES = [
 ]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("safety", [True, False], ids=["guarded", "unguarded"])
 @pytest.mark.parametrize(("scenario", "name"), INSTANCES, ids=[name for _, name in INSTANCES])
 def test_the_thesis_rule_decides_as_with_states_to_everyone(scenario, name, safety):
@@ -65,6 +66,7 @@ def test_the_thesis_rule_decides_as_with_states_to_everyone(scenario, name, safe
         assert local.messages < everyone.messages / 3
 
 
+@pytest.mark.slow
 def test_a_plan_executes_as_with_states_to_everyone():
     scenario = movingai("random-32-32-20", 60, max_ticks=300)
     plan = plan_with("lacam", scenario, time_limit_s=30.0)
@@ -121,6 +123,7 @@ def first_contacts(scenario, seeds):
     return known
 
 
+@pytest.mark.slow
 def test_a_robot_coming_near_is_known_before_it_is_within_the_radius_under_loss(monkeypatch):
     """30% loss: with the radius widened by twice the lease, a robot is known at first contact (all but 0.3^3).
 

@@ -46,6 +46,7 @@ def claims(result):
     ("name", "agents", "policy"),
     [("random-32-32-20", 100, "thesis"), ("random-32-32-20", 100, "astar"), ("empty-32-32", 100, "thesis")],
 )
+@pytest.mark.slow
 def test_a_quiet_fleet_makes_the_same_paths_for_fewer_messages(name, agents, policy):
     scenario = movingai(name, agents, max_ticks=60, policy=PolicyOptions(name=policy))
     quiet = LockstepSimulator(scenario, record_messages=True).run()

@@ -119,6 +119,7 @@ def test_single_robot_walks_a_shortest_path(policy):
     assert result.success and result.makespan == result.lower_bound == 11
 
 
+@pytest.mark.slow
 def test_per_link_faults_apply_to_one_direction_only():
     from mrmp.core.scenario import LinkFaults
 

@@ -122,6 +122,7 @@ def test_frame_times() -> None:
     assert frame_times(0, 4, 50) == [0.0]
 
 
+@pytest.mark.slow
 def test_large_fleet_stays_small_and_quick(crowd, tmp_path: Path) -> None:
     grid, result = crowd(200, 32, 20, seed=1)
     path = write_gif(grid, result, tmp_path / "crowd.gif")
