@@ -585,7 +585,7 @@ def run(
     kill: Annotated[list[str] | None, typer.Option(help="Kill robot ID's process S wall-clock seconds after the fleet's start (repeatable).", metavar="ID@S", show_default=False, rich_help_panel=LIVE)] = None,
     ros2: Annotated[bool, typer.Option("--ros2", help="Every robot process publishes its pose and state on ROS 2 topics (DDS, domain ROS_DOMAIN_ID; the ros2 extra; docs/ros2.md).", rich_help_panel=LIVE)] = False,
     virtual_clock: Annotated[bool, typer.Option("--virtual-clock", help="With --live: run every robot's live driver, brain and body in this process on a virtual clock, over a simulated network with a processor per robot (fleets larger than the machine; times in virtual seconds).", rich_help_panel=LIVE)] = False,
-    robots_per_process: Annotated[int, typer.Option(help="With --live: robots each mrmp agent process hosts, each with its own socket, brain and body (udp, multicast).", rich_help_panel=LIVE)] = 1,
+    robots_per_process: Annotated[int, typer.Option(help="With --live: robots each mrmp agent process hosts, each with its own socket, brain and body (udp, multicast, zenoh).", rich_help_panel=LIVE)] = 1,
 ) -> None:
     """Run a scenario (lockstep simulator, or --live processes) and report what happened."""
     # --resolve, --heading-aware, --radius, --swap and --search come from PolicyOptions' fields (with_policy_flags)
@@ -1112,7 +1112,7 @@ def agent(
     group: Annotated[str, typer.Option(help="Multicast: the group.", metavar="HOST:PORT")] = "239.255.77.1:47000",
     interface: Annotated[str, typer.Option(help="Multicast: IPv4 address of the interface to use.", metavar="IPV4")] = "127.0.0.1",
     listen: Annotated[str, typer.Option(help="Zenoh: this robot's endpoint, e.g. tcp/127.0.0.1:7447.", metavar="ENDPOINT", show_default="none")] = "",
-    connect: Annotated[list[str] | None, typer.Option(help="Zenoh: a peer's endpoint (repeat for each).", metavar="ENDPOINT", show_default=False)] = None,
+    connect: Annotated[list[str] | None, typer.Option(help="Zenoh: a peer's endpoint (repeat for each; hosting several robots: every robot's, in the scenario's order, and no --listen).", metavar="ENDPOINT", show_default=False)] = None,
     fleet: Annotated[str, typer.Option(help="Zenoh: key-expression prefix of the fleet.", metavar="PREFIX")] = "mrmp",
     key_file: Annotated[Path | None, typer.Option(help="Fleet key file.", show_default="MRMP_FLEET_KEY")] = None,
     session: Annotated[int, typer.Option(help="Run number shared by the fleet; other runs' messages are dropped.")] = 1,

@@ -101,6 +101,28 @@ def test_robots_hosted_three_to_a_process_cross_over_lossy_udp_each_with_its_own
     assert result.network["safety_granted"] == result.network["moves"]
 
 
+@pytest.mark.slow
+@pytest.mark.parametrize("transport", ["zenoh", "multicast"])
+def test_robots_hosted_three_to_a_process_cross_over_lossy_zenoh_or_multicast(tmp_path, transport):
+    """The same over Zenoh (each hosted robot listens on its own endpoint with a session of its own, and the
+    process's one thread is woken by each session's own socket, ``ZenohTransport.fileno``) and over UDP
+    multicast (each hosted robot joins the group with a socket of its own)."""
+    if transport == "zenoh":
+        pytest.importorskip("zenoh")
+    robots = (*CROSS, RobotSpec("e", (0, 0), (4, 4)), RobotSpec("f", (4, 4), (0, 0)))
+    said: list[str] = []
+    options = LiveOptions(
+        transport=transport, results=tmp_path / "run", time_scale=10, faults=LiveFaults(loss=0.2), seed=3,
+        robots_per_process=3,
+    )  # fmt: skip
+    result = run_live(crossing(robots=robots), options, say=said.append)
+    assert result.collisions == [] and result.success, result.stop_reason
+    assert said[0].startswith("live: 6 robots in 2 processes (3 robots per process)")
+    reports = [json.loads((tmp_path / "run" / f"agent-{index}.json").read_text()) for index in range(6)]
+    assert all(report["messages_received"] > 0 and report["faults"]["lost"] > 0 for report in reports)
+    assert result.network["safety_granted"] == result.network["moves"]
+
+
 def distinct(cells) -> list[tuple[int, int]]:
     """``cells`` without repeats of the cell before (a path's cells, in the order they were entered)."""
     out: list[tuple[int, int]] = []

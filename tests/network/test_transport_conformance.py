@@ -32,6 +32,7 @@ from polling import PATIENCE, receive_expected, receive_until, receive_while_clo
 
 from mrmp import cli
 from mrmp.core.errors import InputError
+from mrmp.live.launcher import check_hosting
 from mrmp.live.process import check_key_policy
 from mrmp.live.transport import ConnectedTransport, Transport
 from mrmp.live.transport_entry import FleetLayout, TransportEntry, TransportLayer
@@ -344,3 +345,10 @@ def test_a_transport_added_through_the_table_is_a_choice_until_it_is_taken_out()
     assert "queue" not in TRANSPORTS
     with pytest.raises(InputError, match="unknown transport 'queue'; known: udp, multicast, zenoh"):
         TRANSPORTS.entry("queue")
+
+
+def test_several_robots_to_a_process_are_refused_over_a_transport_that_carries_one():
+    with TRANSPORTS.added(QueueEntry()):
+        check_hosting(1, "queue", kill=False, planned=False, ros2=False)
+        with pytest.raises(InputError, match="--robots-per-process: one robot per process over queue"):
+            check_hosting(2, "queue", kill=False, planned=False, ros2=False)

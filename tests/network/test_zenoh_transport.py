@@ -3,6 +3,7 @@
 What every transport does is checked once for all of them in test_transport_conformance.py.
 """
 
+import select
 import socket
 import time
 import uuid
@@ -195,3 +196,38 @@ def test_a_taken_listen_endpoint_fails_to_open(mesh):
     taken = mesh[0].listen
     with pytest.raises(zenoh.ZError):
         ZenohTransport(0, "mrmp/other", taken, [], 2)
+
+
+def readable(transport, timeout):
+    """Whether ``transport``'s watched socket becomes readable within ``timeout`` seconds."""
+    ready, _, _ = select.select([transport.fileno()], [], [], timeout)
+    return bool(ready)
+
+
+def test_its_socket_is_readable_exactly_while_a_datagram_waits(mesh):
+    """What a process hosting several robots watches: readable once a datagram is queued, quiet once it is taken."""
+    a, b, _ = mesh
+    assert not readable(b, 0.0)
+    a.send(b"wake", recipient=1)
+    assert readable(b, PATIENCE)
+    assert b.receive(0.0) == b"wake"
+    assert b.receive(0.0) is None and not readable(b, 0.0)
+
+
+def test_a_datagram_queued_before_the_socket_was_asked_for_makes_it_readable(mesh):
+    a, b, _ = mesh
+    a.send(b"early", recipient=1)
+    assert received_within(b, 1)
+    assert readable(b, 0.0)
+    assert b.receive(0.0) == b"early"
+    b.close()
+    with pytest.raises(ValueError, match="closed"):
+        b.fileno()
+
+
+def received_within(transport, count):
+    """Wait (at most ``PATIENCE`` seconds, taking nothing) until ``transport`` has received ``count`` datagrams."""
+    deadline = time.monotonic() + PATIENCE
+    while transport.received < count and time.monotonic() < deadline:
+        time.sleep(0.005)
+    return transport.received >= count

@@ -124,9 +124,10 @@ def prepare_folder(path: PathLike) -> Path:
     return folder
 
 
-def write_json(path: PathLike, data: Any) -> None:
-    """Write ``data`` as JSON, atomically."""
-    atomic_write_text(path, json.dumps(data, indent=1) + "\n")
+def write_json(path: PathLike, data: Any, compact: bool = False) -> None:
+    """Write ``data`` as JSON, atomically; ``compact``: on one line, for a file written again and again (a live
+    robot's progress), which the C encoder writes several times faster than an indented one."""
+    atomic_write_text(path, json.dumps(data, indent=None if compact else 1) + "\n")
 
 
 def read_json(path: PathLike) -> Any:

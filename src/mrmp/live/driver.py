@@ -147,7 +147,8 @@ class Mailbox:
     def put(self, message: Any) -> None:
         """Queue ``message`` and wake a :meth:`wait` (from any thread)."""
         self._queue.put(message)
-        self._arrived.set()
+        if not self._arrived.is_set():  # set and not yet cleared: the waiter clears it before it takes, so takes this
+            self._arrived.set()
 
     def wake(self) -> None:
         """End a :meth:`wait` at once, with nothing queued (a stop request)."""

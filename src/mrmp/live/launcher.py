@@ -362,7 +362,8 @@ def _start_fleet(options: LiveOptions, files: _RunFiles, layout: FleetLayout, se
         if len(indices) == 1:
             transport = TRANSPORTS.fleet_spec(options.transport, layout, first).arguments(layout.ids)
         else:
-            transport = TRANSPORTS.entry(options.transport).hosting_arguments(layout, indices)
+            hosting = TRANSPORTS.entry(options.transport).hosting_arguments(layout, indices)
+            transport = [f"--transport={options.transport}", *hosting]
         plan = [f"--plan={files.shares[first]}"] if files.shares else []
         agents.append(_start([*_PYTHON, "agent", *robots, *common, *plan, *transport]))
         process_of.extend(len(agents) - 1 for _ in indices)

@@ -10,6 +10,7 @@ them ends, however it ends (:mod:`mrmp.io.lifetime`).
 from __future__ import annotations
 
 import contextlib
+import math
 import os
 import signal
 import sys
@@ -22,6 +23,7 @@ from pathlib import Path
 from mrmp.core.body import body_model
 from mrmp.core.cell import Cell
 from mrmp.core.errors import InputError, Problem
+from mrmp.core.result import Collision
 from mrmp.core.scenario import Scenario
 from mrmp.core.seeds import Stream, derive_seed, stream_random
 from mrmp.io.lifetime import STOP_SIGNALS, release_held_signals, watch_parent
@@ -357,7 +359,7 @@ class _HostedRobot:
         """Run the robot until it is done; what it gathered is kept, saying why it stopped, if it fails."""
         path = self.report_path
         try:
-            self.agent.run(on_progress=lambda report: write_json(path, report.as_dict()))
+            self.agent.run(on_progress=lambda report: write_json(path, report.as_dict(), compact=True))
         except Exception as error:
             self.agent.report.stop_reason = f"crashed: {type(error).__name__}: {error}"
             write_json(path, self.agent.report.as_dict())
@@ -369,7 +371,7 @@ class _HostedRobot:
         if not isinstance(self.opened, Selectable):
             raise InputError(Problem("--robot", "several robots to a process need transports with a socket each"))
         path = self.report_path
-        return Hosted(self.agent, self.opened, on_progress=lambda report: write_json(path, report.as_dict()))
+        return Hosted(self.agent, self.opened, on_progress=lambda report: write_json(path, report.as_dict(), compact=True))
 
 
 def simulated_body(
@@ -482,7 +484,12 @@ def _wait_for_peers(transport: ConnectedTransport, count: int, stop: threading.E
 
 
 REFEREE_PERIOD = 0.25
-"""Seconds between two readings of the traces by a referee following a run (a collision is reported this late at most)."""
+"""Seconds between two readings of the traces by a referee following a run."""
+
+REFEREE_LAG = 1.0
+"""How far behind the clock a referee following a run reports collisions: a collision at a moment at least this
+long before a reading of every trace began is reported then (at most this and :data:`REFEREE_PERIOD` late); a
+later one waits, since a robot's events of that moment may still be on their way to its trace."""
 
 
 def run_referee(
@@ -492,6 +499,7 @@ def run_referee(
     done_file: Path | None,
     report: Callable[[str], None],
     stop: threading.Event | None = None,
+    clock: Callable[[], float] = time.monotonic,
 ) -> list:
     """Follow the fleet's traces until ``done_file`` appears (or a signal, or the end of its parent), reporting collisions.
 
@@ -501,6 +509,14 @@ def run_referee(
     ground-truth intervals. Returns the collisions. ``stop``: the event of
     :func:`stop_on_signals`, when the caller installed it earlier (a signal
     that came meanwhile then finishes the verdict at once).
+
+    While it follows a run, a collision is reported once it lies
+    :data:`REFEREE_LAG` seconds before the ``clock`` reading taken as a
+    reading of the traces began: the traces are read one after the other, and
+    a robot writes an event a little after its moment, so a collision seen
+    nearer the clock may be undone by an event of the same moment not read
+    yet (a robot that had left the cell). What is left is reported once the
+    run is over; ``referee.json`` is the verdict.
     """
     if stop is None:
         stop = stop_on_signals()
@@ -516,11 +532,12 @@ def run_referee(
     actions = None
     if body.turns_in_place:  # its actions are judged too
         actions = TurningActions(ids, starts, [robot.heading for robot in scenario.robots], start_time)
-    reported = 0
+    reported: set[Collision] = set()
     finishing = False
     collisions = referee.collisions()
     while True:
         finishing = finishing or stop.is_set() or done_file is None or done_file.exists()
+        read_at = clock()
         for reader in readers:
             pending.extend(reader.read_new())
         if pending:  # the collisions change only with new events: no new events, no new judgement
@@ -532,9 +549,11 @@ def run_referee(
             collisions = referee.collisions()
             if actions is not None:
                 collisions = sorted(collisions + actions.collisions(), key=lambda collision: collision.tick)
-        for collision in collisions[reported:]:
-            report(f"referee: {collision.describe()} (tick = milliseconds since the start)")
-        reported = max(reported, len(collisions))
+        settled = math.inf if finishing else (read_at - REFEREE_LAG - start_time) * 1000  # in ticks
+        for collision in collisions:
+            if collision.tick <= settled and collision not in reported:
+                reported.add(collision)
+                report(f"referee: {collision.describe()} (tick = milliseconds since the start)")
         if finishing:
             break
         stop.wait(REFEREE_PERIOD)

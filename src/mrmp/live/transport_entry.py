@@ -205,9 +205,9 @@ class TransportEntry(ABC, Generic[OptionsT]):
         """Why this transport cannot be used here and how to fix it, or None when it can."""
         return None
 
-    def hosting(self, values: Mapping[str, Any], robots: Sequence[str]) -> list[Mapping[str, Any]]:
-        """The option values (as :meth:`parse` reads them) of each of several ``robots`` one ``mrmp agent``
-        hosts, each with a transport of its own, from the values its command line gave.
+    def hosting(self, values: Mapping[str, Any], ids: Sequence[str], robots: Sequence[str]) -> list[Mapping[str, Any]]:
+        """The option values (as :meth:`parse` reads them) of each of several ``robots`` (of the fleet's ``ids``)
+        one ``mrmp agent`` hosts, each with a transport of its own, from the values its command line gave.
 
         Raises
         ------

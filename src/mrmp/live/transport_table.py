@@ -121,10 +121,10 @@ class UdpEntry(TransportEntry[UdpOptions]):
 
     hosts_several = True
 
-    def hosting(self, values: Mapping[str, Any], robots: Sequence[str]) -> list[Mapping[str, Any]]:
+    def hosting(self, values: Mapping[str, Any], ids: Sequence[str], robots: Sequence[str]) -> list[Mapping[str, Any]]:
         """Each hosted robot binds the address its own ``--peer`` gives and sends to the others'.
 
-        >>> UdpEntry().hosting({"peer": ["A=127.0.0.1:9001", "B=127.0.0.1:9002"]}, ["B", "A"])
+        >>> UdpEntry().hosting({"peer": ["A=127.0.0.1:9001", "B=127.0.0.1:9002"]}, ["A", "B"], ["B", "A"])
         [{'peer': ['A=127.0.0.1:9001'], 'bind': '127.0.0.1:9002'}, {'peer': ['B=127.0.0.1:9002'], 'bind': '127.0.0.1:9001'}]
         """
         entries = [str(item) for item in values.get("peer") or ()]
@@ -202,7 +202,7 @@ class MulticastEntry(TransportEntry[MulticastOptions]):
 
     hosts_several = True
 
-    def hosting(self, values: Mapping[str, Any], robots: Sequence[str]) -> list[Mapping[str, Any]]:
+    def hosting(self, values: Mapping[str, Any], ids: Sequence[str], robots: Sequence[str]) -> list[Mapping[str, Any]]:
         """Every hosted robot joins the group with a socket of its own."""
         return [values for _ in robots]
 
@@ -294,6 +294,44 @@ class ZenohEntry(TransportEntry[ZenohOptions]):
     def arguments(self, options: ZenohOptions, ids: Sequence[str]) -> list[str]:
         connects = [f"--connect={endpoint}" for endpoint in options.connect]
         return [f"--listen={options.listen}", *connects, f"--fleet={options.fleet}"]
+
+    hosts_several = True
+
+    def hosting(self, values: Mapping[str, Any], ids: Sequence[str], robots: Sequence[str]) -> list[Mapping[str, Any]]:
+        """Every robot's endpoint is a ``--connect``, in the fleet's order; each hosted robot listens on its own
+        and dials the others' (a session of its own), so ``--listen`` is not given.
+
+        >>> for own in ZenohEntry().hosting({"connect": ["tcp/127.0.0.1:7447", "tcp/127.0.0.1:7448"]}, "AB", "BA"):
+        ...     print(own)
+        {'connect': ['tcp/127.0.0.1:7447'], 'listen': 'tcp/127.0.0.1:7448'}
+        {'connect': ['tcp/127.0.0.1:7448'], 'listen': 'tcp/127.0.0.1:7447'}
+        >>> ZenohEntry().hosting({"connect": ["tcp/127.0.0.1:7447"]}, ["A", "B"], ["B", "A"])  # doctest: +ELLIPSIS
+        Traceback (most recent call last):
+        ...
+        mrmp.core.errors.InputError: --connect: a process hosting several robots gives every robot's endpoint, ...
+        """
+        if values.get("listen"):
+            reason = "a process hosting several robots takes each one's endpoint from --connect (every robot's, in order)"
+            raise InputError(Problem("--listen", reason))
+        endpoints = [str(item) for item in values.get("connect") or ()]
+        if len(endpoints) != len(ids):
+            reason = f"{len(ids)} robots, {len(endpoints)} --connect"
+            every = "a process hosting several robots gives every robot's endpoint, in the scenario's order"
+            raise InputError(Problem("--connect", f"{every}: {reason}"))
+        hosted: list[Mapping[str, Any]] = []
+        for robot in robots:
+            own = ids.index(robot)
+            others = [endpoint for index, endpoint in enumerate(endpoints) if index != own]
+            hosted.append({**values, "connect": others, "listen": endpoints[own]})
+        return hosted
+
+    def hosting_arguments(self, layout: FleetLayout, indices: Sequence[int]) -> list[str]:
+        """Every robot's endpoint as a ``--connect``, in the fleet's order, the hosted ones' included.
+
+        >>> ZenohEntry().hosting_arguments(FleetLayout(("A", "B"), (7447, 7448), 7449, "mrmp/7"), [0, 1])
+        ['--connect=tcp/127.0.0.1:7447', '--connect=tcp/127.0.0.1:7448', '--fleet=mrmp/7']
+        """
+        return [*(f"--connect=tcp/{layout.host}:{port}" for port in layout.ports), f"--fleet={layout.fleet}"]
 
     def unavailable(self) -> str | None:
         return MISSING_ZENOH_PACKAGE if importlib.util.find_spec("zenoh") is None else None
@@ -442,7 +480,7 @@ class TransportTable:
             For a transport that carries one robot per process, or option values its entry cannot use.
         """
         entry = self.entry(name)
-        hosted = [values] if len(robots) == 1 else entry.hosting(values, robots)
+        hosted = [values] if len(robots) == 1 else entry.hosting(values, ids, robots)
         return [TransportSpec(name, entry.parse(own, ids, ids.index(robot))) for robot, own in zip(robots, hosted, strict=True)]
 
     def fleet_spec(self, name: str, layout: FleetLayout, index: int) -> TransportSpec:

@@ -67,6 +67,18 @@ datagrams sent back to back was lost in 7 of 13 runs of the conformance
 checks that send them (0 of 14 with 16 batches). Batches are allocated when
 first used (``allocation/mode: lazy``, the default).
 
+Several robots to a process
+---------------------------
+Zenoh hands each sample to a callback on one of its own threads, which queues
+it. A process that hosts several robots in one thread
+(:func:`mrmp.live.host_loop.run_hosted`) watches a socket per robot with one
+selector; :meth:`ZenohTransport.fileno` gives it one: the read end of a local
+socket pair to which the callback writes a byte after queueing a sample.
+:meth:`ZenohTransport.receive` empties that socket before it takes from the
+queue, so a sample queued while it looks is announced by a byte still unread
+(a wake-up at worst spurious, never missed). Each hosted robot opens a session
+of its own; a process's sessions share Zenoh's runtime threads.
+
 Readiness
 ---------
 A peer robot counts as *connected* (:meth:`ZenohTransport.peers`,
@@ -95,6 +107,7 @@ from __future__ import annotations
 
 import contextlib
 import json
+import socket
 import threading
 import time
 from collections import deque
@@ -381,6 +394,7 @@ class ZenohTransport:
         self._alive: set[int] = set()
         self._closed = False
         self._close_lock = threading.Lock()
+        self._wake: tuple[socket.socket, socket.socket] | None = None  # (read end, write end), once fileno is asked
 
         config = zenoh.Config()
         for path, value in session_config(listen, self.connect).items():
@@ -430,6 +444,9 @@ class ZenohTransport:
                 self.dropped += 1
             self._queue.append(data)
             self._ready.notify()
+            if self._wake is not None:
+                with contextlib.suppress(BlockingIOError):  # full: bytes unread already announce the queue
+                    self._wake[1].send(b"\0")
 
     def _on_liveliness(self, sample: zenoh.Sample) -> None:
         robot = _last_chunk_index(str(sample.key_expr))
@@ -470,6 +487,7 @@ class ZenohTransport:
     def receive(self, timeout: float) -> bytes | None:
         """The next datagram from a peer, or None after ``timeout`` seconds (at once once closed)."""
         deadline = time.monotonic() + max(timeout, 0.0)
+        self._empty_wake_socket()
         with self._ready:
             while not self._queue and not self._closed:
                 remaining = deadline - time.monotonic()
@@ -494,6 +512,42 @@ class ZenohTransport:
                     entity.undeclare()
             with contextlib.suppress(self._zenoh.ZError):
                 self._session.close()
+            with self._ready:
+                wake, self._wake = self._wake, None
+            for end in wake or ():
+                end.close()
+
+    # -- a socket to watch -------------------------------------------------------------
+
+    def fileno(self) -> int:
+        """A socket that is readable while a received datagram may wait for :meth:`receive` (module docstring,
+        "Several robots to a process"): for a selector that watches several robots' transports.
+
+        Raises
+        ------
+        ValueError
+            Once closed.
+        """
+        with self._ready:
+            if self._closed:
+                raise ValueError("the transport is closed")
+            if self._wake is None:
+                read_end, write_end = socket.socketpair()
+                read_end.setblocking(False)
+                write_end.setblocking(False)
+                self._wake = (read_end, write_end)
+                if self._queue:  # queued before anyone watched
+                    write_end.send(b"\0")
+            return self._wake[0].fileno()
+
+    def _empty_wake_socket(self) -> None:
+        """Read every byte the callback wrote to the watched socket (before the queue is looked at)."""
+        wake = self._wake
+        if wake is None:
+            return
+        with contextlib.suppress(BlockingIOError, OSError):
+            while wake[0].recv(4096):
+                pass
 
     # -- readiness ---------------------------------------------------------------------
 

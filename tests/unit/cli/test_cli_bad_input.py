@@ -195,10 +195,16 @@ def test_a_key_file_shorter_than_16_bytes_is_refused(tmp_path):
     assert_refused(completed, str(key), "a fleet key needs at least 16 bytes, this one has 3")
 
 
-def test_an_agent_hosting_several_robots_needs_a_transport_that_gives_each_its_own_socket():
+def test_an_agent_hosting_several_robots_over_zenoh_takes_their_endpoints_from_connect():
     completed = mrmp("agent", "--scenario", EXAMPLES / "thesis-swap.yaml", "--robot", "A", "--robot", "B", "--transport",
                      "zenoh", "--listen=tcp/127.0.0.1:7447", environment=without_key())  # fmt: skip
-    assert_refused(completed, "--robot", "one robot per process over zenoh")
+    assert_refused(completed, "--listen", "takes each one's endpoint from --connect")
+
+
+def test_an_agent_hosting_several_robots_over_zenoh_needs_every_robots_endpoint():
+    completed = mrmp("agent", "--scenario", EXAMPLES / "thesis-swap.yaml", "--robot", "A", "--robot", "B", "--transport",
+                     "zenoh", "--connect=tcp/127.0.0.1:7447", environment=without_key())  # fmt: skip
+    assert_refused(completed, "--connect", "every robot's endpoint, in the scenario's order: 2 robots, 1 --connect")
 
 
 def test_an_agent_hosting_several_robots_over_udp_needs_each_ones_address():
@@ -219,7 +225,6 @@ def test_an_agent_names_each_robot_once():
         (["--robots-per-process", "2"], "add --live"),
         (["--live", "--robots-per-process", "0"], "must be 1 to 256, got 0"),
         (["--live", "--robots-per-process", "2", "--virtual-clock"], "add --live (not --virtual-clock)"),
-        (["--live", "--robots-per-process", "2", "--transport", "zenoh"], "one robot per process over zenoh"),
         (["--live", "--robots-per-process", "2", "--kill", "A@1"], "with --kill"),
     ],
 )
