@@ -412,6 +412,10 @@ class LiveDriver:
         """The state to send every heartbeat while waiting for the fleet."""
         raise NotImplementedError
 
+    def _fleet_heartbeat(self, now: float) -> list[Outgoing]:
+        """What to send every ``fleet_heartbeat`` seconds of the run: by default the state, to every peer."""
+        return fleet_wide(self._state_messages(now))
+
     def _farewell_messages(self, now: float) -> list[Outgoing]:
         """What to send every peer as the run ends: by default the state, so that every peer's last news of this
         robot is fresh."""
@@ -643,7 +647,7 @@ class LiveDriver:
             loop.last_state = now
         self._send(self.robot.expire(now))
         if now - loop.last_fleet_state >= timing.fleet_heartbeat:
-            self._send(fleet_wide(self._state_messages(now)))
+            self._send(self._fleet_heartbeat(now))
             loop.last_state = loop.last_fleet_state = now
         elif now - loop.last_state >= timing.heartbeat:
             self._send(self._state_messages(now))

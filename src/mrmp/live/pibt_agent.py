@@ -113,7 +113,7 @@ TASK_RETRY = 0.1
 """Seconds between two sends of a lifelong robot's task report that the desk has not answered."""
 
 POLL = 0.01
-"""Seconds between two polls of a live ``pibt`` robot at least: a third of its retransmission interval
+"""Seconds between two polls of a live ``pibt`` robot at least: two thirds of its retransmission interval
 (a process per robot, many of them on a few cores: each poll costs CPU time the others wait for)."""
 
 CLAIM_RETRY = 0.02
@@ -132,7 +132,7 @@ class PibtTiming:
     step: float
     """The step's length (a step's decisions overlap the moves of the step before)."""
     retry: float
-    """How long the brain waits for an acknowledgement before it sends a message again."""
+    """How long the brain waits for an acknowledgement before it sends a message again (but the beacon)."""
     hold: float
     """How long, from the step's start, a held robot waits for its grant before it stays."""
     pace: float = 0.0
@@ -143,6 +143,9 @@ class PibtTiming:
     """With a local synchronizer, a robot off its goal may begin its next step sooner than :attr:`pace`, once
     its body has at most this long left of the actions it was given (each counted as :attr:`pace`): the next
     decision then comes as the body finishes, and a step whose decisions took long is caught up on (0: never)."""
+    beacon_retry: float | None = None
+    """How long the brain waits for the acknowledgements of its step's beacon before it sends it again (None:
+    :attr:`retry`; ``ReliablePibtRobot``'s ``beacon_retry`` says why it may be longer)."""
 
     @classmethod
     def for_body(
@@ -151,9 +154,10 @@ class PibtTiming:
         turn_seconds: float = 0.0,
         decide: float = 0.3,
         grace: float = 0.05,
-        retry: float = 0.03,
+        retry: float = 0.015,
         hold: float = 0.4,
         lead: float = 0.5,
+        beacon_retry: float = 0.03,
     ) -> PibtTiming:
         """Steps as long as a move with one right turn (the next step's decisions overlap it), or as ``decide``
         seconds of decisions and a ``grace`` for the grant when the moves are shorter.
@@ -165,18 +169,21 @@ class PibtTiming:
         ended by the robots last at least one action (``pace``: a move with
         one right turn, or a cell time for a body that turns in place), unless
         the robot is off its goal and its body is within the fraction ``lead``
-        of an action of running out of work (:attr:`lead`).
+        of an action of running out of work (:attr:`lead`). A call's messages are
+        sent again after 15 ms without an acknowledgement, the beacon after 30
+        (:attr:`beacon_retry`; ``docs/protocol.md``, "Sent again, and when").
 
         >>> PibtTiming.for_body(0.5, 0.25)
-        PibtTiming(decide=0.7, step=0.75, retry=0.03, hold=0.28, pace=0.75, lead=0.375)
+        PibtTiming(decide=0.7, step=0.75, retry=0.015, hold=0.28, pace=0.75, lead=0.375, beacon_retry=0.03)
         >>> PibtTiming.for_body(0.1, 0.05)   # moves shorter than the decisions: the decisions set the clock's pace
-        PibtTiming(decide=0.3, step=0.35, retry=0.03, hold=0.12, pace=0.15, lead=0.075)
+        PibtTiming(decide=0.3, step=0.35, retry=0.015, hold=0.12, pace=0.15, lead=0.075, beacon_retry=0.03)
         """
         action = cell_seconds + turn_seconds
         phase = max(decide, action - grace)
         return cls(
-            round(phase, 6), round(phase + grace, 6), retry, round(phase * hold, 6), round(action, 6), round(action * lead, 6)
-        )
+            round(phase, 6), round(phase + grace, 6), retry, round(phase * hold, 6), round(action, 6), round(action * lead, 6),
+            beacon_retry,
+        )  # fmt: skip
 
 
 def open_repeat(opener: Opener, data: bytes) -> Message | None:
@@ -264,6 +271,7 @@ class PibtBrain:
             turn_cost=scenario.timing.turn_time / scenario.timing.cell_time,
             rng=stream_random(scenario.seed, Stream.TIES, index),
             retry=max(1, round(timing.retry * 1000)),
+            beacon_retry=max(1, round((timing.retry if timing.beacon_retry is None else timing.beacon_retry) * 1000)),
             starts=[flat.index(robot.start) for robot in scenario.robots],
         )  # fmt: skip
         self.safety = SafetyLayer(
@@ -563,9 +571,9 @@ class PibtBrain:
         if isinstance(message, PibtMessage):
             if self.t0 is not None and message.step > self.step and not self.synchronized:
                 self.t0 = min(self.t0, now - (message.step - 1) * self.timing.step)  # a peer is ahead: catch it up
-            if isinstance(message, BeaconMessage):
+            if isinstance(message, BeaconMessage):  # alive; settled only if it was and still stands on its goal
                 old = self.heard.get(sender)
-                self.heard[sender] = (now, old[1] if old is not None else False)
+                self.heard[sender] = (now, old is not None and old[1] and message.present == message.goal)
             self._act = self.robot.receive(message) or self._act
             return []
         if isinstance(message, StateMessage):
@@ -669,6 +677,8 @@ class PibtAgent(LiveDriver):
             scenario, index, self.pibt_timing, claim_retry=min(timing.claim_retry, CLAIM_RETRY),
             crash_after=2 * timing.give_up_after, flat=flat, follows=body.follows,
         )  # fmt: skip
+        self._beaconed: set[int] = set()
+        """The peers sent a beacon since the last fleet heartbeat (:meth:`_fleet_heartbeat`)."""
 
     # -- what the driver reads of the brain --------------------------------------------------
 
@@ -689,6 +699,29 @@ class PibtAgent(LiveDriver):
 
     def _fleet_wait_messages(self) -> list[Outgoing]:
         return fleet_wide([Outgoing(self.robot.state())])
+
+    def _fleet_heartbeat(self, now: float) -> list[Outgoing]:
+        """The state to every peer not sent a beacon since the last fleet heartbeat, or to every peer once settled.
+
+        A beacon tells its recipient what the state would (where the robot
+        stands at the start of a step; and it is alive), but for whether it is
+        settled: a peer takes a beacon off its goal for "not settled"
+        (:meth:`PibtBrain.receive`), and only a state says "settled", so a
+        settled robot tells every peer every fleet heartbeat, as before
+        (``tests/unit/live/test_pibt_fleet_heartbeat.py``).
+        """
+        beaconed, self._beaconed = self._beaconed, set()
+        if self.robot.settled or not beaconed:
+            return fleet_wide([Outgoing(self.robot.state())])
+        others = tuple(peer for peer in range(len(self.scenario.robots)) if peer != self.index and peer not in beaconed)
+        return [Outgoing(self.robot.state(), others)] if others else []
+
+    def _send(self, outgoing: list[Outgoing]) -> None:
+        """Send as every driver does, noting to whom this robot's beacons went (:meth:`_fleet_heartbeat`)."""
+        for item in outgoing:
+            if isinstance(item.message, BeaconMessage) and item.recipients:
+                self._beaconed.update(item.recipients)
+        super()._send(outgoing)
 
     def _farewell_messages(self, now: float) -> list[Outgoing]:
         return fleet_wide([Outgoing(self.robot.farewell())])

@@ -165,13 +165,14 @@ class LivePibtRobot(ReliablePibtRobot):
         dead_end_bonus: int = 0,
         guidance: str = "none",
         retry: int = 1,
+        beacon_retry: int | None = None,
         starts: Sequence[int] = (),
         lookout: int = 2,
     ) -> None:
         super().__init__(
             index, start, goal, flat, tie=tie, heading=heading, radius=radius, swap=swap,
             heading_aware=heading_aware, turn_cost=turn_cost, rng=rng, tie_penalties=tie_penalties,
-            turning=turning, dead_end_bonus=dead_end_bonus, guidance=guidance, retry=retry,
+            turning=turning, dead_end_bonus=dead_end_bonus, guidance=guidance, retry=retry, beacon_retry=beacon_retry,
         )  # fmt: skip
         self.known: dict[int, tuple[int, int]] = {}
         """Per peer: the cell it was last heard of, and the step at whose start it stood there."""

@@ -110,6 +110,12 @@ class ReliablePibtRobot(LocalPibtRobot):
     retry:
         Ticks to wait for an acknowledgement before sending a message again
         (at least 1; ``2 * delay_max + 1`` covers a round trip).
+    beacon_retry:
+        The same for the step's beacon (by default ``retry``). A copy of a
+        beacon goes to every peer near that has not acknowledged it, and a peer
+        whose own beacon was not acknowledged answers it with that beacon
+        (:class:`~mrmp.robot.pibt_live.LivePibtRobot`), so a live robot sends
+        it again less eagerly than a call's messages, each to one peer.
     """
 
     rotations = False
@@ -142,15 +148,18 @@ class ReliablePibtRobot(LocalPibtRobot):
         dead_end_bonus: int = 0,
         guidance: str = "none",
         retry: int = 1,
+        beacon_retry: int | None = None,
     ) -> None:
         super().__init__(
             index, start, goal, flat, tie=tie, heading=heading, radius=radius, swap=swap,
             heading_aware=heading_aware, turn_cost=turn_cost, rng=rng, tie_penalties=tie_penalties,
             turning=turning, dead_end_bonus=dead_end_bonus, guidance=guidance,
         )  # fmt: skip
-        if retry < 1:
-            raise ValueError(f"retry {retry} is below 1 tick")
+        beacon_retry = retry if beacon_retry is None else beacon_retry
+        if min(retry, beacon_retry) < 1:
+            raise ValueError(f"retry {min(retry, beacon_retry)} is below 1 tick")
         self.retry = retry
+        self.beacon_retry = beacon_retry
         self._now = 0
         self._sensed: tuple[int, ...] = ()
         self._unacknowledged: dict[int, _Unacknowledged] = {}
@@ -182,10 +191,11 @@ class ReliablePibtRobot(LocalPibtRobot):
         return out
 
     def on_tick(self, now: int) -> list[Outgoing]:
-        """The robot's timers at tick ``now``: send again what was not acknowledged within ``retry`` ticks."""
+        """The robot's timers at tick ``now``: send again what was not acknowledged within ``retry`` ticks (the
+        beacon: ``beacon_retry``)."""
         self._now = now
         out: list[Outgoing] = []
-        if not self._beacon_heard() and now - self._beacon_sent_at >= self.retry:
+        if not self._beacon_heard() and now - self._beacon_sent_at >= self.beacon_retry:
             self._beacon_sent_at = now
             self.stats["retransmissions"] += 1
             out.append(Outgoing(self._beacon(), None, self.reach))

@@ -13,7 +13,7 @@ from mrmp.core.heading import Heading
 from mrmp.live.body import OccupancyRecorder, SimulatedBody
 from mrmp.live.pibt_agent import PibtBrain, PibtTiming
 from mrmp.protocol.messages import BeaconMessage, FarewellMessage, StateMessage
-from mrmp.protocol.pibt_local import CallInheritMessage, CallReserveMessage, NewsBeaconMessage
+from mrmp.protocol.pibt_local import CallAckMessage, CallInheritMessage, CallReserveMessage, NewsBeaconMessage
 from mrmp.robot.messaging import Outgoing
 from mrmp.robot.pibt_live import LivePibtRobot
 from mrmp.robot.pibt_synchronized import SynchronizedPibtRobot
@@ -295,6 +295,24 @@ def test_a_beacon_goes_again_only_to_the_peers_that_have_not_acknowledged_it_or_
     a.receive(b.begin_step(1)[0].message)
     resent = [item for item in a.on_tick(2 * a.retry) if isinstance(item.message, BeaconMessage)]
     assert [item.recipients for item in resent] == [(2,)] and c.index == 2  # b has a's beacon and a has b's
+
+
+def test_a_calls_message_goes_again_after_retry_and_the_beacon_only_after_beacon_retry():
+    """The live brain's two intervals (``PibtTiming.for_body``: 15 ms and 30 ms): a message of a call not
+    acknowledged goes again every ``retry``, the step's beacon every ``beacon_retry``. The broken variant
+    (the beacon on ``retry`` too) sends the beacon again at the first interval."""
+    flat, cells = line(8)
+    starts = [cells[2], cells[3]]
+    a, b = (LivePibtRobot(index, starts[index], cells[7 - 7 * index], flat, starts=starts, retry=15, beacon_retry=30)
+            for index in range(2))  # fmt: skip
+    a.begin_step(1, now=0)  # its beacon to b is lost
+    a.receive(b.begin_step(1, now=0)[0].message)  # a has b's beacon; b never acknowledges anything of a's
+    call = [item for item in a.act() if not isinstance(item.message, BeaconMessage | CallAckMessage)]
+    assert call and all(item.recipients == (1,) for item in call)  # a's call asks b to leave its cell
+    assert a.on_tick(14) == []
+    again = a.on_tick(15)
+    assert [item.message for item in again] == [item.message for item in call]  # the call's messages, not the beacon
+    assert [type(item.message) for item in a.on_tick(30)] == [NewsBeaconMessage, *(type(item.message) for item in call)]
 
 
 def test_a_peer_that_says_farewell_is_an_obstacle_for_good_and_done():
