@@ -549,9 +549,9 @@ def run_referee(
             collisions = referee.collisions()
             if actions is not None:
                 collisions = sorted(collisions + actions.collisions(), key=lambda collision: collision.tick)
-        settled = math.inf if finishing else (read_at - REFEREE_LAG - start_time) * 1000  # in ticks
+        judged_until = math.inf if finishing else (read_at - REFEREE_LAG - start_time) * 1000  # in ticks
         for collision in collisions:
-            if collision.tick <= settled and collision not in reported:
+            if collision.tick <= judged_until and collision not in reported:
                 reported.add(collision)
                 report(f"referee: {collision.describe()} (tick = milliseconds since the start)")
         if finishing:
