@@ -13,6 +13,7 @@ import pytest
 zenoh = pytest.importorskip("zenoh")
 
 from polling import PATIENCE, drain, receive_within  # noqa: E402 (after the skip when Zenoh is missing)
+from test_orphans import wait_for  # noqa: E402
 
 from mrmp.live.zenoh_transport import ZenohTransport, session_config  # noqa: E402
 
@@ -217,17 +218,9 @@ def test_its_socket_is_readable_exactly_while_a_datagram_waits(mesh):
 def test_a_datagram_queued_before_the_socket_was_asked_for_makes_it_readable(mesh):
     a, b, _ = mesh
     a.send(b"early", recipient=1)
-    assert received_within(b, 1)
+    assert wait_for(lambda: b.received >= 1)  # queued, not taken
     assert readable(b, 0.0)
     assert b.receive(0.0) == b"early"
     b.close()
     with pytest.raises(ValueError, match="closed"):
         b.fileno()
-
-
-def received_within(transport, count):
-    """Wait (at most ``PATIENCE`` seconds, taking nothing) until ``transport`` has received ``count`` datagrams."""
-    deadline = time.monotonic() + PATIENCE
-    while transport.received < count and time.monotonic() < deadline:
-        time.sleep(0.005)
-    return transport.received >= count
