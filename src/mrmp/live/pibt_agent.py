@@ -271,7 +271,7 @@ class PibtBrain:
             turn_cost=scenario.timing.turn_time / scenario.timing.cell_time,
             rng=stream_random(scenario.seed, Stream.TIES, index),
             retry=max(1, round(timing.retry * 1000)),
-            beacon_retry=max(1, round((timing.retry if timing.beacon_retry is None else timing.beacon_retry) * 1000)),
+            beacon_retry=None if timing.beacon_retry is None else max(1, round(timing.beacon_retry * 1000)),
             starts=[flat.index(robot.start) for robot in scenario.robots],
         )  # fmt: skip
         self.safety = SafetyLayer(
