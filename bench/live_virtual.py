@@ -20,13 +20,20 @@ Cases (``--cases``, comma-separated ``MAP:ROBOTS``): a map of ``maps/`` with
 its ``-random-1`` scenario's first ``ROBOTS`` agents, or ``causal-32:N`` for
 ``examples/causal-32.yaml``'s first ``N`` robots.
 
+``--seeds N`` runs each case with seeds ``--seed`` to ``--seed + N - 1`` and
+then prints the mean makespan over them, its range and standard error, and the
+mean datagrams per move (one run's makespan swings with the order in which a few
+messages come).
+
 Usage: python bench/live_virtual.py [--cases random-64-64-10:200,random-64-64-10:1000] [--loss 0.1]
        [--time-scale 5] [--synchronizer clock|local] [--body omni|turning] [--turn-us 50] [--datagram-us 30]
+       [--seed 0] [--seeds 1]
 """
 
 from __future__ import annotations
 
 import argparse
+import statistics
 import tempfile
 from pathlib import Path
 
@@ -73,12 +80,13 @@ def simulated_seconds(scenario: Scenario, time_scale: float) -> tuple[int, float
     return run.makespan, bound
 
 
-def row(case: str, arguments: argparse.Namespace) -> None:
+def row(case: str, arguments: argparse.Namespace, seed: int) -> tuple[float, float]:
+    """Run ``case`` with ``seed`` and print its row; return its makespan and datagrams per move."""
     scenario = case_scenario(case, arguments.synchronizer, arguments.body)
-    costs = ProcessingCosts(turn=arguments.turn_us * 1e-6, datagram=arguments.datagram_us * 1e-6)
+    costs = ProcessingCosts(turn=arguments.turn_us / 1e6, datagram=arguments.datagram_us / 1e6)  # the defaults exactly
     folder = Path(tempfile.mkdtemp(prefix=f"mrmp-virtual-{scenario.name}-"))
     options = VirtualOptions(
-        results=folder, time_scale=arguments.time_scale, faults=LiveFaults(loss=arguments.loss), seed=arguments.seed, costs=costs
+        results=folder, time_scale=arguments.time_scale, faults=LiveFaults(loss=arguments.loss), seed=seed, costs=costs
     )
     result = run_virtual(scenario, options)
     network = result.network
@@ -103,6 +111,7 @@ def row(case: str, arguments: argparse.Namespace) -> None:
         f"results in {folder}",
         flush=True,
     )
+    return makespan, result.messages / moves
 
 
 def fleet_parser(description: str, cases: str) -> argparse.ArgumentParser:
@@ -119,11 +128,24 @@ def fleet_parser(description: str, cases: str) -> argparse.ArgumentParser:
 
 def main() -> int:
     parser = fleet_parser(__doc__.splitlines()[0], "random-64-64-10:200,random-64-64-10:1000")
-    parser.add_argument("--turn-us", type=float, default=ProcessingCosts().turn * 1e6, help="processor time per turn")
-    parser.add_argument("--datagram-us", type=float, default=ProcessingCosts().datagram * 1e6, help="per datagram")
+    parser.add_argument("--turn-us", type=float, default=round(ProcessingCosts().turn * 1e6, 6), help="processor time per turn")
+    parser.add_argument("--datagram-us", type=float, default=round(ProcessingCosts().datagram * 1e6, 6), help="per datagram")
+    parser.add_argument("--seeds", type=int, default=1, help="runs of each case, with seeds --seed on")
     arguments = parser.parse_args()
+    if arguments.seeds < 1:
+        parser.error(f"--seeds: must be at least 1, got {arguments.seeds}")
+    seeds = range(arguments.seed, arguments.seed + arguments.seeds)
     for case in arguments.cases.split(","):
-        row(case, arguments)
+        runs = [row(case, arguments, seed) for seed in seeds]
+        if len(runs) > 1:
+            spans = [makespan for makespan, _ in runs]
+            error = statistics.stdev(spans) / len(spans) ** 0.5
+            print(
+                f"{case}: seeds {seeds.start} to {seeds.stop - 1}: makespan {statistics.mean(spans):.2f} s on average "
+                f"({min(spans):.2f} to {max(spans):.2f} s, standard error {error:.2f} s), "
+                f"messages/move {statistics.mean(per_move for _, per_move in runs):.1f}",
+                flush=True,
+            )
     return 0
 
 
