@@ -75,6 +75,7 @@ a robot 2, in the bay, that heard nothing else.
 from __future__ import annotations
 
 from collections.abc import Iterable
+from typing import Any
 
 from mrmp.protocol.messages import BeaconMessage, PibtMessage
 from mrmp.protocol.pibt_local import NO_CLAIM, CallAckMessage, CallReserveMessage
@@ -91,6 +92,10 @@ class SynchronizedPibtRobot(LivePibtRobot):
 
     Parameters are those of :class:`~mrmp.robot.pibt_live.LivePibtRobot`.
     """
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        super().__init__(*args, **kwargs)
+        self.stats.update(ahead=0, late_acks=0)  # reported even when none: they say which brain ran
 
     def begin_step(self, step: int, sensed: Iterable[int] = (), now: int = 0, held: bool = False) -> list[Outgoing]:
         """As the live brain; the messages kept for this step are taken in once each, those of later steps kept on."""
