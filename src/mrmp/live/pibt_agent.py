@@ -43,7 +43,10 @@ it with what a live robot adds, sans-IO (fed with the clock, never reading it):
   within 2 cells decided for good), held while its last move is not granted;
   a held robot gives up after ``hold`` seconds from its step's start, as on the
   clock, and no step ends undecided (``docs/protocol.md``, "Live", "Steps
-  ended by the robots");
+  ended by the robots"); a settled robot whose neighbours are all on their
+  goals *rests*, beginning no step until a peer's message of a later step
+  comes, and a settled robot behind its peers catches up at once
+  (:attr:`PibtBrain.resting`);
 * a peer silent for ``crash_after`` seconds is taken for crashed (an obstacle
   on its last known cell, no longer waited for), until it is heard again;
 * **lifelong**: a robot of a lifelong run takes its tasks from the task desk
@@ -308,6 +311,9 @@ class PibtBrain:
         """A lifelong robot's tasks, from the task desk (one past the last robot on the wire); None: one goal."""
         self.last_step = scenario.max_ticks if scenario.lifelong else None
         """A lifelong robot's last step: its run is done once it is over (it still takes part until its fleet's is)."""
+        self._goals = [flat.index(robot.goal) for robot in scenario.robots]
+        """Every robot's goal, as the scenario gives it (:attr:`resting`)."""
+        self._rested_after = 0
 
     # -- time -------------------------------------------------------------------------------
 
@@ -374,20 +380,64 @@ class PibtBrain:
             robot.give_up()
         self._crash_silent(now)
         self._run_brain(now, out)
-        if robot.step_done and self._may_begin_next_step(now):
+        if robot.step_done and self._may_begin_next_step(now) and not self._rests():
             self._finish_step()
             self._begin_next_step(now, out)
             self._run_brain(now, out)
         out.extend(self._stamped(self.safety.expire(now)))
         return out
 
+    @property
+    def resting(self) -> bool:
+        """With a local synchronizer, whether the robot begins no next step: it is settled, every peer that can
+        stand within its radius and lookout was last known on its own goal, and no peer is in a later step.
+
+        Nobody near would move in such a step unless a peer comes: its
+        beacons and their acknowledgements were most of what a fleet sent
+        once its robots had arrived. A message of a later step ends the rest
+        (a peer steps on, coming near or pushed off its goal, and the robot
+        follows; rule 4 counts a robot that rests as decided for good, to stay,
+        in the steps it has not begun); a lifelong robot never rests
+        (``docs/protocol.md``, "Live", "Resting, and catching up").
+
+        >>> from mrmp.core import Grid, PolicyOptions, RobotSpec, Scenario
+        >>> robots = [RobotSpec("A", (0, 0), (0, 0)), RobotSpec("B", (2, 0), (3, 0))]
+        >>> scenario = Scenario(Grid(6, 1), robots, policy=PolicyOptions(name="pibt", synchronizer="local"))
+        >>> brain = PibtBrain(scenario, 0, PibtTiming.for_body(0.5))
+        >>> brain.resting  # robot B, 2 cells away, is not on its goal
+        False
+        >>> brain.robot.learn(1, brain.flat.index((3, 0)), 1)
+        >>> brain.resting
+        True
+        """
+        if not self.settled or self.tasks is not None or self.robot.heard_later_step:
+            return False
+        robot, goals = self.robot, self._goals
+        known = robot.known
+        return all(known[peer][0] == goals[peer] for peer in robot.possibly_within(robot.radius + robot.lookout))
+
+    def _rests(self) -> bool:
+        """:attr:`resting`, counting the steps after which the robot rested (``rested``)."""
+        if not self.resting:
+            return False
+        if self._rested_after != self.step:
+            self._rested_after = self.step
+            self.robot.stats["rested"] += 1
+        return True
+
     def _may_begin_next_step(self, now: float) -> bool:
-        """With a local synchronizer, the step done: ``pace`` has passed since it began, or the robot is off its
-        goal and its body is within ``lead`` of running out of work (a robot on its goal does not hurry)."""
+        """With a local synchronizer, the step done: ``pace`` has passed since it began, the robot is settled and
+        behind its peers (:meth:`_behind`), or it is off its goal and its body is within ``lead`` of running out
+        of work (a robot on its goal does not hurry, unless a peer waits for it)."""
         timing, robot = self.timing, self.robot
-        if now - self._began >= timing.pace:
+        if now - self._began >= timing.pace or self._behind():
             return True
         return timing.lead > 0 and robot.present != robot.goal and self.work_left(now) <= timing.lead
+
+    def _behind(self) -> bool:
+        """Settled, and a peer is in a later step: the robot catches up at once, without the pace (it stays in
+        every step, and a peer coming near waits for it in each)."""
+        return self.settled and self.robot.heard_later_step
 
     def work_left(self, now: float) -> float:
         """Seconds of work the body has left at ``now``: the rest of its action, and ``pace`` for each queued one.

@@ -254,6 +254,11 @@ class LivePibtRobot(ReliablePibtRobot):
         """Whether this step's beacon of every peer that can be within the radio radius has arrived."""
         return self._complete()
 
+    @property
+    def heard_later_step(self) -> bool:
+        """Whether a message of a later step than this one waits for its step (a peer is ahead)."""
+        return bool(self._early)
+
     # -- the step ------------------------------------------------------------------
 
     def begin_step(self, step: int, sensed: Iterable[int] = (), now: int = 0, held: bool = False) -> list[Outgoing]:

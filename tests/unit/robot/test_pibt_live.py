@@ -439,8 +439,12 @@ def test_on_a_perfect_network_live_brains_make_the_simulators_decisions():
 def test_robots_ending_their_own_steps_take_no_step_shorter_than_an_action_of_their_bodies():
     """``PibtTiming.pace``: robots settled on their goals, side by side, end their steps as soon as they have heard
     each other; they begin one an action apart (a step of the simulator is one action), not as fast as their
-    messages go, each step costing beacons. Without the pace (a broken variant) they run many more steps."""
+    messages go, each step costing beacons. Without the pace (a broken variant) they run many more steps. (They
+    do not rest here, as robots all settled would: ``PibtBrain.resting``.)"""
     import dataclasses
+
+    class Restless(PibtBrain):
+        resting = False
 
     robots = (RobotSpec("a", (0, 0), (0, 0)), RobotSpec("b", (0, 1), (0, 1)), RobotSpec("c", (1, 0), (1, 0)))
     scenario = Scenario(Grid(5, 5), robots, timing=Timing(1.0, 0.5), policy=PolicyOptions(name="pibt", synchronizer="local"))
@@ -448,7 +452,7 @@ def test_robots_ending_their_own_steps_take_no_step_shorter_than_an_action_of_th
     assert paced.pace == 0.75
 
     def steps_in_three_seconds(timing):
-        fleet = BrainFleet(scenario, timing)
+        fleet = BrainFleet(scenario, timing, brain_type=Restless)
         for brain in fleet.brains:
             brain.start(0.0)
         while fleet.now < 3.0:

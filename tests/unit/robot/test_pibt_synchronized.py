@@ -9,6 +9,7 @@ from test_pibt_local import FAULTS, crowd
 
 from mrmp.core import Grid, NetworkFaults, PolicyOptions, RobotSpec, Scenario, Timing
 from mrmp.core.errors import InputError
+from mrmp.core.heading import Heading
 from mrmp.io import load_movingai_scenario, load_scenario
 from mrmp.live.pibt_agent import PibtBrain, PibtTiming
 from mrmp.protocol.messages import BeaconMessage
@@ -382,3 +383,44 @@ def test_a_held_robot_that_never_gives_up_makes_a_convoy_move_one_body_at_a_time
     waiting = BrainFleet(convoy, brain_type=NeverGivesUp)
     assert giving_up.run() < waiting.run()
     assert giving_up.collisions() == waiting.collisions() == []
+
+
+
+def strip():
+    """Robot ``a`` on its goal in a strip two cells wide; ``b``, far to the west, goes to the strip's east end
+    through ``a``'s cell (``a`` steps aside and back)."""
+    robots = (RobotSpec("a", (8, 0), (8, 0), Heading.EAST), RobotSpec("b", (0, 0), (12, 0), Heading.EAST))
+    return Scenario(Grid(13, 2), robots, timing=Timing(0.5, 0.25), policy=PolicyOptions(name="pibt", synchronizer="local"))
+
+
+class Sleepy(PibtBrain):
+    """Broken: rests on its goal whatever its peers send (a message of a later step does not end the rest)."""
+
+    @property
+    def resting(self):
+        return self.settled
+
+
+class Dawdling(PibtBrain):
+    """Broken: a settled robot behind its peers catches up a step per pace, as a robot on its goal otherwise steps."""
+
+    def _behind(self):
+        return False
+
+
+@pytest.mark.parametrize("loss", [0.0, 0.2])
+def test_a_robot_resting_on_its_goal_wakes_for_a_peer_that_comes_and_gives_way(loss):
+    """``PibtBrain.resting``: ``a`` begins no step while ``b`` is far; ``b``'s beacons end the rest, ``a`` catches
+    up at once, steps aside and back, and both arrive; a robot that sleeps through them stalls ``b`` for good,
+    and one that catches up a step per pace holds ``b`` up."""
+    fleet = BrainFleet(strip(), loss=loss, seed=3, tick=0.005)
+    fleet.run(until=60)
+    a, b = fleet.brains
+    assert fleet.collisions() == [] and a.settled and b.settled
+    assert a.robot.stats["rested"] >= 1 and [cell for _, cell in a.moves] == [(8, 1), (8, 0)]
+    dawdling = BrainFleet(strip(), brain_type=Dawdling, loss=loss, seed=3, tick=0.005)
+    dawdling.run(until=60)
+    assert dawdling.brains[1].settled and dawdling.arrivals[1] > fleet.arrivals[1] + 1.0  # measured: 9.2 s and 7.5 s
+    sleepy = BrainFleet(strip(), brain_type=Sleepy, loss=loss, seed=3, tick=0.005)
+    sleepy.run(until=60)
+    assert not sleepy.brains[1].settled
