@@ -65,7 +65,7 @@ __all__ = [
     "unregister",
 ]
 
-PROTOCOL_VERSION = 6
+PROTOCOL_VERSION = 7
 """Version byte of every datagram; a receiver drops other versions."""
 MAX_MESSAGE_BYTES = 512
 """Upper bound on the size of any encoded message."""

@@ -15,7 +15,9 @@ hear of it before either claim is confirmed.
 A robot that senses no body (the live brain, :mod:`mrmp.robot.pibt_live`)
 sends :class:`NewsBeaconMessage`: a beacon that also says where the sender
 last heard some peers stood, so that its neighbours learn of the robots around
-it without hearing each of them.
+it without hearing each of them, and whether it *asks* for the recipient's
+beacon (a copy sent again to a peer whose beacon it still waits for). Such a
+beacon is not acknowledged: the robot that waits for a beacon asks for it.
 
 A call of higher priority that meets a robot busy in a call of lower
 priority takes it over (wound-wait): :class:`CallWoundMessage` asks the
@@ -38,7 +40,9 @@ Examples
 (CallAbortMessage(sender=5, seq=12, step=12, root=7), 14)
 >>> beacon = NewsBeaconMessage(3, 11, 12, (4, 5), (9, 9), 2, 30, news=((7, (4, 8), 11), (8, (2, 5), 12)))
 >>> decode(encode(beacon)) == beacon, len(encode(beacon))
-(True, 72)
+(True, 73)
+>>> decode(encode(NewsBeaconMessage(3, 11, 12, (4, 5), (9, 9), 2, 30, asks=True))).asks
+True
 """
 
 from __future__ import annotations
@@ -173,10 +177,13 @@ class NewsBeaconMessage(BeaconMessage):
     Every entry is a fact its sender learnt first hand or was told:
     ``(peer, cell, step)``, robot ``peer`` stood on ``cell`` at the start of
     step ``step``; at most :data:`MAX_NEWS` of them. On the wire each entry
-    is two cells: ``(peer, step)``, then ``cell``.
+    is two cells: ``(peer, step)``, then ``cell``. ``asks``: the sender
+    still waits for this step's beacon of the recipient, which answers with
+    it.
     """
 
     news: tuple[News, ...] = ()
+    asks: bool = False
 
 
 def _news_cells(message: NewsBeaconMessage) -> tuple[Cell, ...]:
@@ -191,10 +198,14 @@ def _unpack_news_beacon(sender: int, seq: int, fields: Any, cells: tuple[Cell, .
     news = tuple((peer, place, step) for (peer, step), place in zip(cells[::2], cells[1::2], strict=True))
     if any(peer < 0 or step < 0 for peer, _, step in news):
         raise DecodeError("malformed", "news of a negative robot or step")
-    beacon = BEACON.unpack(sender, seq, fields, ())
+    *fixed, asks = fields
+    if asks > 1:
+        raise DecodeError("malformed", f"news beacon with asks={asks}")
+    beacon = BEACON.unpack(sender, seq, tuple(fixed), ())
     return NewsBeaconMessage(
-        sender, seq, beacon.step, beacon.present, beacon.goal, beacon.elapsed, beacon.tie, beacon.heading, news
-    )
+        sender, seq, beacon.step, beacon.present, beacon.goal, beacon.elapsed, beacon.tie, beacon.heading, news,
+        bool(asks),
+    )  # fmt: skip
 
 
 def _unpack_reserve(sender: int, seq: int, fields: Any, _: tuple[Cell, ...]) -> CallReserveMessage:
@@ -239,7 +250,14 @@ CALL_ACK = register(
     )
 )
 NEWS_BEACON = register(
-    WireFormat(43, NewsBeaconMessage, BEACON.layout + "B", BEACON.pack, _unpack_news_beacon, cells=_news_cells)
+    WireFormat(
+        43,
+        NewsBeaconMessage,
+        BEACON.layout + "BB",  # the beacon's fields, asks, the count of news cells
+        lambda m: (*BEACON.pack(m), int(m.asks)),
+        _unpack_news_beacon,
+        cells=_news_cells,
+    )
 )
 CALL_WOUND = register(
     WireFormat(44, CallWoundMessage, "!I", lambda m: (m.step,), lambda sender, seq, f, _: CallWoundMessage(sender, seq, *f))

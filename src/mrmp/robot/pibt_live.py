@@ -17,10 +17,12 @@ it knows instead (``docs/protocol.md``, "Local sequencing", "Live"):
   for this step's beacon of every peer that can be within its radio radius
   before it starts or joins a call; the cells within 2 of those beacons are
   what a sensor would have seen;
-* it answers a beacon of this step from a peer it did not send its own to
-  (or a second copy of one, from a peer that has not acknowledged its own)
-  with its beacon, so a peer that addressed it on older news still learns
-  where it stands (*pulling*);
+* beacons are not acknowledged: a robot that waits for a peer's beacon sends
+  its own to that peer again, every ``beacon_retry``, marked as *asking*
+  for the peer's; a robot answers such a beacon of this step, or one from a
+  peer it did not send its own to, with its beacon (*pulling*). So the robot
+  that needs a beacon keeps asking until it has it, and a peer that has this
+  robot's beacon is sent nothing more;
 * messages of a later step (a peer whose clock runs a little ahead) are kept
   until the robot's own step begins;
 * its beacon tells *news* (:class:`~mrmp.protocol.pibt_local.NewsBeaconMessage`):
@@ -235,12 +237,13 @@ class LivePibtRobot(ReliablePibtRobot):
         fresh.sort()
         return tuple((peer, cells[cell], heard) for _, peer, cell, heard in fresh[:MAX_NEWS])
 
-    def _beacon(self) -> NewsBeaconMessage:
-        """This step's beacon, with the news it tells (:meth:`_fresh_news`, chosen when the step began)."""
+    def _beacon(self, asks: bool = False) -> NewsBeaconMessage:
+        """This step's beacon, with the news it tells (:meth:`_fresh_news`, chosen when the step began);
+        ``asks``: for the beacons of the peers it goes to (sent again to the peers waited for)."""
         beacon = super()._beacon()
         return NewsBeaconMessage(
             beacon.sender, beacon.seq, beacon.step, beacon.present, beacon.goal, beacon.elapsed, beacon.tie,
-            beacon.heading, self._news,
+            beacon.heading, self._news, asks,
         )  # fmt: skip
 
     def possibly_within(self, radius: int) -> list[int]:
@@ -341,18 +344,19 @@ class LivePibtRobot(ReliablePibtRobot):
 
     def on_tick(self, now: int) -> list[Outgoing]:
         """:meth:`ReliablePibtRobot.on_tick`, its broadcasts addressed to the peers that can be near; the beacon
-        sent again only to those of them that have not acknowledged it, and to the peers whose beacon it waits for.
+        sent again only to the peers whose beacon it waits for, and asking for theirs.
 
-        A peer that acknowledged the beacon has it; a peer whose beacon has not
-        come answers a second copy with its own (:meth:`_take_step_beacon`).
+        Beacons are not acknowledged (:attr:`acknowledges_beacons`): a peer
+        that needs this robot's beacon waits for it and asks for it in turn, so
+        the robot that waits does the asking, and a peer that has the beacon
+        is sent nothing more.
         """
         out = self._address(super().on_tick(now))
         for index, item in enumerate(out):
             if isinstance(item.message, BeaconMessage):
-                acked = self._beacon_acks
-                recipients = {peer for peer in item.recipients or () if peer not in acked} | self._unknown
-                out[index] = Outgoing(item.message, tuple(sorted(recipients)))
-                self._beacon_to.update(recipients)
+                awaited = tuple(sorted(self._unknown))
+                out[index] = Outgoing(self._beacon(asks=True), awaited)
+                self._beacon_to.update(awaited)
         return [item for item in out if item.recipients != ()]
 
     def _address(self, out: list[Outgoing]) -> list[Outgoing]:
@@ -378,7 +382,7 @@ class LivePibtRobot(ReliablePibtRobot):
             if isinstance(message, NewsBeaconMessage):
                 self._take_news(message.news)
             if message.step == self.step:
-                self._take_step_beacon(sender, cell, repeated=(sender, message.seq) in self._seen)
+                self._take_step_beacon(sender, cell, asks=isinstance(message, NewsBeaconMessage) and message.asks)
         return super().receive(message)
 
     def _take_news(self, news: tuple[News, ...]) -> None:
@@ -399,11 +403,11 @@ class LivePibtRobot(ReliablePibtRobot):
                 continue
             self.learn(peer, cell, heard)
 
-    def _take_step_beacon(self, sender: int, cell: int, repeated: bool) -> None:
+    def _take_step_beacon(self, sender: int, cell: int, asks: bool) -> None:
         """This step's beacon of ``sender``: one peer fewer to wait for, a body within 2 if it is.
 
         Answered with this robot's beacon when ``sender`` was not sent it, or
-        sends its own again (``repeated``: it still waits for ours).
+        ``asks`` for it (it still waits for ours).
         """
         if sender in self._unknown:
             self._unknown.discard(sender)
@@ -411,7 +415,7 @@ class LivePibtRobot(ReliablePibtRobot):
             px, py = self.flat.cells[cell]
             if abs(px - x) + abs(py - y) <= RESERVE_RADIUS and cell not in self._sensed:
                 self._sensed = (*self._sensed, cell)
-        if sender not in self._beacon_to or (repeated and sender not in self._beacon_acks):
+        if sender not in self._beacon_to or asks:
             self.stats["pulled"] += 1
             self._beacon_to.add(sender)
             self._replies.append(Outgoing(self._beacon(), (sender,)))
@@ -431,8 +435,11 @@ class LivePibtRobot(ReliablePibtRobot):
     def _complete(self) -> bool:
         return not self._unknown and super()._complete()
 
+    acknowledges_beacons = False  # a robot asks for the beacon it waits for instead (on_tick)
+
     def _beacon_heard(self) -> bool:
-        return not self._unknown and super()._beacon_heard()
+        """Every beacon it waits for has come: its own is sent again only to ask for those (:meth:`on_tick`)."""
+        return not self._unknown
 
     # -- a held robot waits for its grant, then stays -----------------------------
 

@@ -232,13 +232,8 @@ class ReliablePibtRobot(LocalPibtRobot):
             return False
         if isinstance(message, CallAckMessage):
             return self._take_ack(message)
-        claim = self.target
-        cell = self.flat.cells[claim] if claim is not None else NO_CLAIM
-        root, (elapsed, tie, _) = self._root, self._rank
-        self.seq += 1
-        ack = CallAckMessage(self.index, self.seq, self.step, message.seq, cell, root, elapsed, tie, self._confirmed)
-        self._replies.append(Outgoing(ack, (message.sender,)))
-        self.stats["acks"] += 1
+        if self.acknowledges_beacons or not isinstance(message, BeaconMessage):
+            self._acknowledge(message)
         key = (message.sender, message.seq)
         if key in self._seen:
             self.dropped["duplicate"] += 1
@@ -251,6 +246,20 @@ class ReliablePibtRobot(LocalPibtRobot):
             self._latest[message.sender] = message.seq
         self.receive_once(message)
         return True
+
+    acknowledges_beacons = True
+    """Whether a beacon is acknowledged like any other message; the live brain asks for a missing beacon instead
+    (:class:`~mrmp.robot.pibt_live.LivePibtRobot`)."""
+
+    def _acknowledge(self, message: PibtMessage) -> None:
+        """Queue the acknowledgement of ``message``, with this robot's reservation (sent in :meth:`act`)."""
+        claim = self.target
+        cell = self.flat.cells[claim] if claim is not None else NO_CLAIM
+        root, (elapsed, tie, _) = self._root, self._rank
+        self.seq += 1
+        ack = CallAckMessage(self.index, self.seq, self.step, message.seq, cell, root, elapsed, tie, self._confirmed)
+        self._replies.append(Outgoing(ack, (message.sender,)))
+        self.stats["acks"] += 1
 
     def _take_ack(self, message: CallAckMessage) -> bool:
         """An acknowledgement: its sender has the message; its claim, of higher rank, of the cell this robot claims

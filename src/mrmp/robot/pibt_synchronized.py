@@ -77,7 +77,7 @@ from __future__ import annotations
 from collections.abc import Iterable
 from typing import Any
 
-from mrmp.protocol.messages import BeaconMessage, PibtMessage
+from mrmp.protocol.messages import PibtMessage
 from mrmp.protocol.pibt_local import NO_CLAIM, CallAckMessage, CallReserveMessage
 from mrmp.robot.messaging import Outgoing
 from mrmp.robot.pibt_live import LivePibtRobot
@@ -112,26 +112,6 @@ class SynchronizedPibtRobot(LivePibtRobot):
             return False
         final = self._final
         return all(robot in final for robot in self._known_within(RESERVE_RADIUS))
-
-    def on_tick(self, now: int) -> list[Outgoing]:
-        """The live brain's timers, its beacon sent again only to the peers that have not acknowledged it, or
-        whose beacon it still waits for (a second copy asks for theirs: *pulling*).
-
-        A robot waits longer for its neighbours here than on a clock (a peer
-        can be a step behind for a while), and its beacon goes on being sent
-        again meanwhile: to every peer that can be near, it was most of the
-        messages over a lossy network.
-        """
-        acknowledged, awaited = self._beacon_acks, self._unknown
-        out = []
-        for item in super().on_tick(now):
-            if isinstance(item.message, BeaconMessage) and item.recipients is not None:
-                recipients = tuple(peer for peer in item.recipients if peer not in acknowledged or peer in awaited)
-                if not recipients:
-                    continue
-                item = Outgoing(item.message, recipients)
-            out.append(item)
-        return out
 
     def receive(self, message: PibtMessage) -> bool:
         """Rules 2 to 4 (module docstring), then as the live brain; True when :meth:`act` should run."""

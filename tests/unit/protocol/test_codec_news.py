@@ -27,6 +27,7 @@ beacons = st.builds(
     tie=u32,
     heading=st.sampled_from(list(Heading)),
     news=news,
+    asks=st.booleans(),
 )
 
 
@@ -45,17 +46,18 @@ def test_mutations_decode_to_exact_messages_or_raise(message, data):
 def test_the_fullest_beacon_fits_and_one_more_entry_is_refused():
     entries = tuple((peer, (peer, -peer), 7) for peer in range(MAX_NEWS))
     full = NewsBeaconMessage(1, 2, 7, (0, 0), (3, 3), 4, 5, news=entries)
-    assert len(encode(full)) == 40 + 16 * MAX_NEWS <= MAX_MESSAGE_BYTES
-    assert len(encode(NewsBeaconMessage(1, 2, 7, (0, 0), (3, 3), 4, 5))) == 40
+    assert len(encode(full)) == 41 + 16 * MAX_NEWS <= MAX_MESSAGE_BYTES
+    assert len(encode(NewsBeaconMessage(1, 2, 7, (0, 0), (3, 3), 4, 5))) == 41
     with pytest.raises(ValueError, match="news entries"):
         encode(NewsBeaconMessage(1, 2, 7, (0, 0), (3, 3), 4, 5, news=(*entries, (99, (1, 1), 7))))
 
 
-def test_an_odd_cell_or_a_negative_robot_is_malformed():
+def test_an_odd_cell_a_negative_robot_or_an_asks_beyond_one_is_malformed():
     data = encode(NewsBeaconMessage(1, 2, 7, (0, 0), (3, 3), 4, 5, news=((9, (1, 1), 6),)))
-    odd = data[:39] + bytes([1]) + data[40:48]  # one cell, not a pair
-    negative = data[:40] + struct.pack("!ii", -9, 6) + data[48:]
-    for garbage in (odd, negative):
+    odd = data[:40] + bytes([1]) + data[41:49]  # one cell, not a pair
+    negative = data[:41] + struct.pack("!ii", -9, 6) + data[49:]
+    asks_two = data[:39] + bytes([2]) + data[40:]
+    for garbage in (odd, negative, asks_two):
         with pytest.raises(DecodeError) as caught:
             decode(garbage)
         assert caught.value.reason == "malformed"

@@ -281,26 +281,61 @@ class BrainFleet:
         ]
 
 
-def test_a_beacon_goes_again_only_to_the_peers_that_have_not_acknowledged_it_or_whose_beacon_is_missing():
+def test_a_beacon_is_not_acknowledged_and_goes_again_only_to_ask_the_peers_whose_beacon_is_missing():
     flat, cells = line(8)
     starts = [cells[2], cells[0], cells[4]]  # b and c both within the radio radius of a
     a, b, c = (LivePibtRobot(index, starts[index], cells[7], flat, starts=starts) for index in range(3))
     sent = a.begin_step(1)
     assert [item.recipients for item in sent] == [(1, 2)]
-    b.begin_step(1)
-    b.receive(sent[0].message)  # b acknowledges a's beacon; c's copy was lost
-    a.receive(next(item.message for item in b.act() if item.recipients == (0,) and not isinstance(item.message, BeaconMessage)))
-    resent = [item for item in a.on_tick(a.retry) if isinstance(item.message, BeaconMessage)]
-    assert [item.recipients for item in resent] == [(1, 2)]  # b's own beacon has not come: a's second copy pulls it
-    a.receive(b.begin_step(1)[0].message)
-    resent = [item for item in a.on_tick(2 * a.retry) if isinstance(item.message, BeaconMessage)]
-    assert [item.recipients for item in resent] == [(2,)] and c.index == 2  # b has a's beacon and a has b's
+    b.begin_step(1)  # b's beacon to a is lost
+    b.receive(sent[0].message)  # c's copy of a's beacon is lost
+    assert b.act() == []  # a beacon is not acknowledged
+    resent = [item for item in a.on_tick(a.beacon_retry) if isinstance(item.message, BeaconMessage)]
+    assert [(item.recipients, item.message.asks) for item in resent] == [((1, 2), True)]
+    b.receive(resent[0].message)  # a second copy, but it asks: b answers with its beacon
+    answer = b.act()
+    assert [(item.recipients, type(item.message)) for item in answer] == [((0,), NewsBeaconMessage)]
+    a.receive(answer[0].message)
+    resent = [item for item in a.on_tick(2 * a.beacon_retry) if isinstance(item.message, BeaconMessage)]
+    assert [item.recipients for item in resent] == [(2,)] and c.index == 2  # only c's beacon is still missing
+
+
+class DeafToAsking(LivePibtRobot):
+    """Broken: answers a beacon only when it did not send its own to that peer, never because the beacon asks."""
+
+    def _take_step_beacon(self, sender, cell, asks):
+        super()._take_step_beacon(sender, cell, asks=False)
+
+
+@pytest.mark.parametrize("brain", [LivePibtRobot, DeafToAsking])
+def test_a_robot_whose_peers_beacon_was_lost_asks_for_it_and_is_answered(brain):
+    """The robot that waits for a beacon asks for it until it comes (``docs/protocol.md``, "A beacon is not
+    acknowledged"): ``b`` has ``a``'s beacon and nothing tells it that ``a`` lacks its own but ``a``'s asking.
+    A robot deaf to the asking leaves its peer waiting for good."""
+    flat, cells = line(8)
+    starts = [cells[2], cells[3]]
+    a, b = (brain(index, starts[index], cells[7 - 7 * index], flat, starts=starts, retry=15, beacon_retry=30)
+            for index in range(2))  # fmt: skip
+    b.begin_step(1, now=0)  # lost
+    b.receive(a.begin_step(1, now=0)[0].message)
+    robots = (a, b)
+    for now in range(30, 30 * 20, 30):
+        out = [item for robot in robots for item in robot.on_tick(now)]
+        while out:
+            for item in out:
+                for recipient in item.recipients:
+                    robots[recipient].receive(item.message)
+            out = [item for robot in robots for item in robot.act()]
+        if a.complete:
+            break
+    assert b.complete and a.complete == (brain is LivePibtRobot)
+    assert now == 30 or brain is DeafToAsking  # answered at the first asking
 
 
 def test_a_calls_message_goes_again_after_retry_and_the_beacon_only_after_beacon_retry():
     """The live brain's two intervals (``PibtTiming.for_body``: 15 ms and 30 ms): a message of a call not
-    acknowledged goes again every ``retry``, the step's beacon every ``beacon_retry``. The broken variant
-    (the beacon on ``retry`` too) sends the beacon again at the first interval."""
+    acknowledged goes again every ``retry``; a beacon that asks for a missing one every ``beacon_retry``. The
+    broken variant (the beacon on ``retry`` too) sends the beacon again at the first interval."""
     flat, cells = line(8)
     starts = [cells[2], cells[3]]
     a, b = (LivePibtRobot(index, starts[index], cells[7 - 7 * index], flat, starts=starts, retry=15, beacon_retry=30)
@@ -312,7 +347,10 @@ def test_a_calls_message_goes_again_after_retry_and_the_beacon_only_after_beacon
     assert a.on_tick(14) == []
     again = a.on_tick(15)
     assert [item.message for item in again] == [item.message for item in call]  # the call's messages, not the beacon
-    assert [type(item.message) for item in a.on_tick(30)] == [NewsBeaconMessage, *(type(item.message) for item in call)]
+    assert [item.message for item in a.on_tick(30)] == [item.message for item in call]  # b asks for a's beacon itself
+    assert b.on_tick(15) == []
+    asking = b.on_tick(30)
+    assert [(type(item.message), item.recipients, item.message.asks) for item in asking] == [(NewsBeaconMessage, (0,), True)]
 
 
 def test_a_peer_that_says_farewell_is_an_obstacle_for_good_and_done():
