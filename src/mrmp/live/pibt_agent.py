@@ -147,8 +147,8 @@ class PibtTiming:
     its body has at most this long left of the actions it was given (each counted as :attr:`pace`): the next
     decision then comes as the body finishes, and a step whose decisions took long is caught up on (0: never)."""
     beacon_retry: float | None = None
-    """How long the brain waits for the acknowledgements of its step's beacon before it sends it again (None:
-    :attr:`retry`; ``ReliablePibtRobot``'s ``beacon_retry`` says why it may be longer)."""
+    """How long the brain waits for a beacon it still misses before it sends its own again, asking for it (None:
+    :attr:`retry`; ``ReliablePibtRobot``'s ``beacon_retry`` says why it may differ)."""
 
     @classmethod
     def for_body(
@@ -160,7 +160,7 @@ class PibtTiming:
         retry: float = 0.015,
         hold: float = 0.4,
         lead: float = 0.5,
-        beacon_retry: float = 0.03,
+        beacon_retry: float = 0.015,
     ) -> PibtTiming:
         """Steps as long as a move with one right turn (the next step's decisions overlap it), or as ``decide``
         seconds of decisions and a ``grace`` for the grant when the moves are shorter.
@@ -173,13 +173,14 @@ class PibtTiming:
         one right turn, or a cell time for a body that turns in place), unless
         the robot is off its goal and its body is within the fraction ``lead``
         of an action of running out of work (:attr:`lead`). A call's messages are
-        sent again after 15 ms without an acknowledgement, the beacon after 30
-        (:attr:`beacon_retry`; ``docs/protocol.md``, "Sent again, and when").
+        sent again after 15 ms without an acknowledgement, and the beacon, to ask
+        for a beacon still missing, after 15 ms too (:attr:`beacon_retry`;
+        ``docs/protocol.md``, "Sent again, and when").
 
         >>> PibtTiming.for_body(0.5, 0.25)
-        PibtTiming(decide=0.7, step=0.75, retry=0.015, hold=0.28, pace=0.75, lead=0.375, beacon_retry=0.03)
+        PibtTiming(decide=0.7, step=0.75, retry=0.015, hold=0.28, pace=0.75, lead=0.375, beacon_retry=0.015)
         >>> PibtTiming.for_body(0.1, 0.05)   # moves shorter than the decisions: the decisions set the clock's pace
-        PibtTiming(decide=0.3, step=0.35, retry=0.015, hold=0.12, pace=0.15, lead=0.075, beacon_retry=0.03)
+        PibtTiming(decide=0.3, step=0.35, retry=0.015, hold=0.12, pace=0.15, lead=0.075, beacon_retry=0.015)
         """
         action = cell_seconds + turn_seconds
         phase = max(decide, action - grace)
