@@ -226,7 +226,8 @@ class ReliablePibtRobot(LocalPibtRobot):
     # -- receiving -----------------------------------------------------------------
 
     def receive(self, message: PibtMessage) -> bool:
-        """Take in a message of this step (acknowledging it, second copies too); True when :meth:`act` should run."""
+        """Take in a message of this step (acknowledging it, second copies too, a beacon only if
+        :attr:`acknowledges_beacons`); True when :meth:`act` should run."""
         if message.step != self.step:
             self.dropped["stale"] += 1
             return False
