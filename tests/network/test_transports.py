@@ -10,15 +10,18 @@ import sys
 import threading
 import time
 import types
+from collections import Counter
 
 import pytest
-from polling import PATIENCE, drain, receive_within
+from polling import PATIENCE, drain, receive_expected, receive_within
 
 from mrmp.live.transport import (
     FaultyTransport,
     LiveFaults,
+    UdpMulticastTransport,
     UdpTransport,
 )
+from mrmp.live.transport_entry import free_ports
 
 LOOPBACK = "127.0.0.1"
 
@@ -51,6 +54,39 @@ class RecordingTransport:
 
     def close(self):
         self.closed = True
+
+
+# -- UdpMulticastTransport ---------------------------------------------------------------------
+
+
+class TakesEverything(UdpMulticastTransport):
+    """Broken: takes in every datagram of the group, whoever it is headed for."""
+
+    def receive(self, timeout):
+        data = self._receive_datagram(timeout, 4 + 2048)
+        return None if data is None else data[4:]
+
+
+@pytest.mark.parametrize("broken", [False, True])
+def test_a_multicast_robot_takes_in_only_what_is_sent_to_it_or_to_every_robot(broken):
+    """Every datagram reaches the whole group; one headed for another robot is dropped on receipt (a robot
+    that took it in could take another's acknowledgement or answer for its own: ``docs/protocol.md``, "A
+    multicast datagram says whom it is for")."""
+    port = free_ports(1)[0]
+    group = (f"239.255.77.{1 + port % 250}", port)
+    kind = TakesEverything if broken else UdpMulticastTransport
+    robots = [kind(group, LOOPBACK, index) for index in range(3)]
+    try:
+        robots[0].send(b"0 to 2", recipient=2)
+        robots[0].send(b"0 to all")
+        received = [receive_expected(robot, [b"0 to all"]) for robot in robots[1:]]
+    finally:
+        for robot in robots:
+            robot.close()
+    if broken:
+        assert received[0][b"0 to 2"] == 1
+    else:
+        assert received == [Counter([b"0 to all"]), Counter([b"0 to 2", b"0 to all"])]
 
 
 # -- UdpTransport ----------------------------------------------------------------------------

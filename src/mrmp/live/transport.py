@@ -159,11 +159,15 @@ class _UdpSocket:
 
     def receive(self, timeout: float) -> bytes | None:
         """The next datagram (read up to one byte past the bound, so oversized ones show), or None."""
+        return self._receive_datagram(timeout, MAX_DATAGRAM_BYTES + 1)
+
+    def _receive_datagram(self, timeout: float, size: int) -> bytes | None:
+        """The next datagram on the socket, read up to ``size`` bytes, or None."""
         if self._closed:
             return None
         try:
             self._socket.settimeout(timeout)
-            data, _ = self._socket.recvfrom(MAX_DATAGRAM_BYTES + 1)
+            data, _ = self._socket.recvfrom(size)
         except (TimeoutError, OSError):
             return None
         return None if self._closed else data
@@ -220,14 +224,22 @@ IP_MULTICAST_ALL = getattr(socket, "IP_MULTICAST_ALL", 49)
 """Linux's socket option (``<linux/in.h>``) that, set to 0, limits a socket to the groups it joined itself."""
 
 
+RECIPIENT = struct.Struct("!I")
+"""The head of every multicast datagram: whom it is for (0: every robot; otherwise the robot's index + 1)."""
+
+
 class UdpMulticastTransport(_UdpSocket):
     """UDP multicast: every robot joins one group; every datagram goes to all of them.
 
     The sending and receiving interface is always set explicitly
     (``IP_MULTICAST_IF`` and the membership's interface), never left to the
-    routing table. Datagrams addressed to one robot are sent to the group too;
-    receivers ignore what is not for them (a robot also hears its own datagrams
-    and drops them).
+    routing table. Datagrams addressed to one robot are sent to the group too,
+    headed by their recipient (:data:`RECIPIENT`), and a receiver drops those
+    headed for another robot: as over unicast, a robot takes in only what was
+    sent to it or to every robot (it also hears its own datagrams to every
+    robot, and drops them). Without it, a robot would take a message meant for
+    another (an acknowledgement of a sequence number that happens to be one of
+    its own, a request to leave another robot's cell) for its own.
 
     The socket is bound to the group's address, not to every address: on Linux
     it then receives only datagrams sent to the group, never one sent to any
@@ -242,11 +254,15 @@ class UdpMulticastTransport(_UdpSocket):
         Multicast group and port, e.g. ``("239.255.77.1", 47000)``.
     interface:
         IPv4 address of the interface to use (``"127.0.0.1"`` on loopback).
+    index:
+        The robot's index: datagrams headed for another robot are dropped
+        (None: none is, as for a listener that is no robot).
     """
 
-    def __init__(self, group: Address, interface: str) -> None:
+    def __init__(self, group: Address, interface: str, index: int | None = None) -> None:
         self.group = group
         self.interface = interface
+        self.index = index
         sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
         try:
             sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
@@ -268,8 +284,25 @@ class UdpMulticastTransport(_UdpSocket):
         self._closed = False
 
     def send(self, data: bytes, recipient: int | None = None) -> None:
+        head = RECIPIENT.pack(0 if recipient is None else recipient + 1)
         with contextlib.suppress(OSError):
-            self._socket.sendto(data, self.group)
+            self._socket.sendto(head + data, self.group)
+
+    def receive(self, timeout: float) -> bytes | None:
+        """The next datagram for this robot or for every robot, its head removed, or None.
+
+        A datagram for another robot is dropped, and what else waits is looked
+        at without waiting further (None when nothing does). One too short for
+        a head is handed on whole: the opener rejects it, and counts it.
+        """
+        while True:
+            data = self._receive_datagram(timeout, RECIPIENT.size + MAX_DATAGRAM_BYTES + 1)
+            if data is None or len(data) < RECIPIENT.size:
+                return data
+            (recipient,) = RECIPIENT.unpack_from(data)
+            if recipient == 0 or self.index is None or recipient == self.index + 1:
+                return data[RECIPIENT.size :]
+            timeout = 0.0
 
 
 @dataclass(frozen=True)

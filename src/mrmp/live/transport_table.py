@@ -175,7 +175,7 @@ class MulticastEntry(TransportEntry[MulticastOptions]):
 
     name = "multicast"
     summary = "one UDP multicast group for the fleet, on an explicit interface"
-    delivery = Delivery(echoes=True, addressed_to_all=True, longest=MAX_DATAGRAM_BYTES + 1)
+    delivery = Delivery(echoes=True, longest=MAX_DATAGRAM_BYTES + 1)
 
     def parse(self, values: Mapping[str, Any], ids: Sequence[str], index: int) -> MulticastOptions:
         try:
@@ -192,7 +192,7 @@ class MulticastEntry(TransportEntry[MulticastOptions]):
         return [options.interface]
 
     def open(self, options: MulticastOptions, index: int, fleet_size: int) -> Transport:
-        return UdpMulticastTransport(options.group, options.interface)
+        return UdpMulticastTransport(options.group, options.interface, index)
 
     def fleet_options(self, layout: FleetLayout, index: int) -> MulticastOptions:
         return MulticastOptions((f"239.255.77.{1 + layout.group_port % 250}", layout.group_port), layout.host)

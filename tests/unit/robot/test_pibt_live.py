@@ -234,11 +234,10 @@ class BrainFleet:
                 _, _, peer, message = heapq.heappop(self.inbox)
                 self.send(peer, self.brains[peer].receive(message, self.now))
             for index, (brain, body) in enumerate(zip(self.brains, self.bodies, strict=True)):
-                if body.moving:
-                    if body.poll(self.now):
-                        brain.arrived_at(body.cell)
-                        self.arrivals[index] = self.now
-                else:
+                if body.moving and body.poll(self.now):
+                    brain.arrived_at(body.cell)
+                    self.arrivals[index] = self.now
+                if not body.moving:  # in the turn the body arrives too, as the driver does
                     target, out = brain.motion(self.now)
                     self.send(index, out)
                     if target is not None:
