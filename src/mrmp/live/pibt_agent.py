@@ -291,8 +291,6 @@ class PibtBrain:
         """Actions decided and not yet begun, in order: a cell to enter (claimed first, once the body stands
         still) or, for a body that turns in place, a heading to turn to."""
         self.moving = False
-        self._standing_since: float | None = -math.inf
-        """When the body was first seen standing still since its last action (None: it is performing one)."""
         self.moves: list[tuple[int, Cell]] = []
         """Every step's decided cell, as ``(step, cell)`` (the brain's path)."""
         self.heard: dict[int, tuple[float, bool]] = {}
@@ -371,16 +369,15 @@ class PibtBrain:
         than ``pace`` after step ``k`` began, unless the robot is off its goal
         and its body has no more than ``lead`` seconds of work left
         (:meth:`work_left`). A held robot that has not been
-        granted ``hold`` seconds after its step began and its body stood
-        still (:meth:`_waited_for_grant`) gives up and, at its turn, stays, as
-        on the clock; no step ends undecided.
+        granted ``hold`` seconds after its step began gives up and, at its
+        turn, stays, as on the clock; no step ends undecided.
         """
         robot = self.robot
         assert isinstance(robot, SynchronizedPibtRobot)
         out: list[Outgoing] = []
         if self.step == 0:
             self._begin_next_step(now, out)
-        if self._waited_for_grant(now) >= self.timing.hold:
+        if now - self._began >= self.timing.hold:
             robot.give_up()
         self._crash_silent(now)
         self._run_brain(now, out)
@@ -495,15 +492,6 @@ class PibtBrain:
         reports = tasks.due(now, self.flat.cells[self.robot.present], self.step)
         return [Outgoing(self._stamp(report), (tasks.desk,)) for report in reports]
 
-    def _waited_for_grant(self, now: float) -> float:
-        """How long a robot ending its own steps has waited for the grant of its next move: since its step
-        began or, if later, since its body stood still (while the body performs an earlier action, the next
-        move cannot have been claimed yet). So a held robot gives up only when its move's claim was refused
-        or went unanswered for ``hold`` seconds, not because its body was still busy."""
-        if self.moving or self._standing_since is None:
-            return 0.0
-        return now - max(self._began, self._standing_since)
-
     def _crash_silent(self, now: float) -> None:
         """Take every peer silent for ``crash_after`` seconds for crashed.
 
@@ -565,14 +553,12 @@ class PibtBrain:
         A cell to enter, once its claim won; or a heading to turn to in place,
         at once (the body stays on the cell it owns).
         """
-        if not self.moving and self._standing_since is None:
-            self._standing_since = now
         if self.moving or not self.queue:
             return None, []
         safety, cell = self.safety, self.queue[0]
         if isinstance(cell, Heading):
             self.queue.pop(0)
-            self.moving, self._action_began, self._standing_since = True, now, None
+            self.moving, self._action_began = True, now
             return cell, []
         if safety.pending is None or safety.pending.cell != cell:
             if now - self._claimed_at < safety.retry_interval:
@@ -586,7 +572,7 @@ class PibtBrain:
             return None, []
         safety.begin_move(cell)
         self.queue.pop(0)
-        self.moving, self._action_began, self._standing_since = True, now, None
+        self.moving, self._action_began = True, now
         if not self._move_queued():
             self.robot.release()
             self._act = True

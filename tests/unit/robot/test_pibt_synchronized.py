@@ -424,34 +424,3 @@ def test_a_robot_resting_on_its_goal_wakes_for_a_peer_that_comes_and_gives_way(l
     sleepy.run(until=60)
     assert not sleepy.brains[1].settled
 
-
-class GivesUpWhileItsBodyIsBusy(PibtBrain):
-    """Broken: counts the wait for the grant from the step's start, while the body still performs the action before."""
-
-    def _waited_for_grant(self, now):
-        return now - self._began
-
-
-@pytest.mark.parametrize("brain_type", [PibtBrain, GivesUpWhileItsBodyIsBusy])
-def test_a_held_robot_gives_up_only_hold_seconds_after_its_body_stood_still(brain_type):
-    """``PibtBrain._waited_for_grant``: while its body finishes the action before, a held robot's next move
-    cannot have been claimed, so it waits; ``hold`` seconds after the body stood still, it gives up. A robot
-    that counted from its step's start gave up under loss where its grant came in time on a perfect network,
-    and stayed, and its neighbours' decisions parted from the perfect network's (``docs/protocol.md``,
-    "Waiting for a grant once the body stands still")."""
-    brain = brain_type(strip(), 0, PibtTiming.for_body(0.5, 0.25))
-    hold = brain.timing.hold
-    brain.start(0.0)
-    brain.expire(0.0)  # step 1 begins
-    brain.robot.held = True  # its last move is not granted yet
-    brain.moving, brain._standing_since = True, None  # and its body performs an action, as ``motion`` starts one
-    brain.expire(hold + 0.01)
-    assert brain.robot._gave_up == (brain_type is GivesUpWhileItsBodyIsBusy)
-    if brain_type is GivesUpWhileItsBodyIsBusy:
-        return
-    brain.moving = False
-    brain.motion(1.0)  # the body stands still: its claim goes out
-    brain.expire(1.0 + hold - 0.01)
-    assert not brain.robot._gave_up
-    brain.expire(1.0 + hold)
-    assert brain.robot._gave_up
