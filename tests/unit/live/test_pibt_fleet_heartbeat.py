@@ -27,11 +27,13 @@ class Silent:
         pass
 
 
-def agent(index: int = 0, starts=((0, 0), (1, 0), (2, 0), (3, 0)), goals=((0, 0), (3, 0), (2, 0), (1, 0))) -> PibtAgent:
+def agent(
+    index: int = 0, starts=((0, 0), (1, 0), (2, 0), (3, 0)), goals=((0, 0), (3, 0), (2, 0), (1, 0)), kind=PibtAgent
+) -> PibtAgent:
     robots = tuple(RobotSpec(f"r{i}", start, goal) for i, (start, goal) in enumerate(zip(starts, goals, strict=True)))
     scenario = Scenario(Grid(4, 2), robots, policy=PolicyOptions(name="pibt"))
     body = SimulatedBody(robots[index].start, robots[index].heading, scenario.grid, scenario.timing)
-    return PibtAgent(scenario, index, Silent(), body, Sealer(b"k", 1), Opener(b"k", 1))
+    return kind(scenario, index, Silent(), body, Sealer(b"k", 1), Opener(b"k", 1))
 
 
 def heartbeat_recipients(robot: PibtAgent) -> list[tuple[int, ...] | None]:
@@ -63,3 +65,4 @@ def test_a_beacon_off_its_goal_takes_a_settled_peer_for_under_way_and_only_a_sta
     assert brain.heard[0] == (3.0, False)
     brain.receive(BeaconMessage(0, 4, 3, (0, 0), (0, 0), 0, 1), now=4.0)  # back on it: a beacon does not say settled
     assert brain.heard[0] == (4.0, False)
+
