@@ -423,4 +423,3 @@ def test_a_robot_resting_on_its_goal_wakes_for_a_peer_that_comes_and_gives_way(l
     sleepy = BrainFleet(strip(), brain_type=Sleepy, loss=loss, seed=3, tick=0.005)
     sleepy.run(until=60)
     assert not sleepy.brains[1].settled
-
