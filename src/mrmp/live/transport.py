@@ -257,12 +257,17 @@ class UdpMulticastTransport(_UdpSocket):
     index:
         The robot's index: datagrams headed for another robot are dropped
         (None: none is, as for a listener that is no robot).
+    fleet_size:
+        How many robots the fleet has: a datagram whose head names none of
+        them is no robot's, and is handed on whole, for the opener to reject
+        and count (None: every head names a robot).
     """
 
-    def __init__(self, group: Address, interface: str, index: int | None = None) -> None:
+    def __init__(self, group: Address, interface: str, index: int | None = None, fleet_size: int | None = None) -> None:
         self.group = group
         self.interface = interface
         self.index = index
+        self.fleet_size = fleet_size
         sock = socket.socket(socket.AF_INET, socket.SOCK_DGRAM, socket.IPPROTO_UDP)
         try:
             sock.setsockopt(socket.SOL_SOCKET, socket.SO_REUSEADDR, 1)
@@ -291,15 +296,19 @@ class UdpMulticastTransport(_UdpSocket):
     def receive(self, timeout: float) -> bytes | None:
         """The next datagram for this robot or for every robot, its head removed, or None.
 
-        A datagram for another robot is dropped, and what else waits is looked
-        at without waiting further (None when nothing does). One too short for
-        a head is handed on whole: the opener rejects it, and counts it.
+        A datagram for another robot of the fleet is dropped (that robot takes
+        it in, or rejects and counts it), and what else waits is looked at
+        without waiting further (None when nothing does). One too short for a
+        head, or whose head names no robot of the fleet, is no robot's: it is
+        handed on whole, and the opener rejects it and counts it.
         """
         while True:
             data = self._receive_datagram(timeout, RECIPIENT.size + MAX_DATAGRAM_BYTES + 1)
             if data is None or len(data) < RECIPIENT.size:
                 return data
             (recipient,) = RECIPIENT.unpack_from(data)
+            if self.fleet_size is not None and recipient > self.fleet_size:
+                return data
             if recipient == 0 or self.index is None or recipient == self.index + 1:
                 return data[RECIPIENT.size :]
             timeout = 0.0

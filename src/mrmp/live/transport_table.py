@@ -192,7 +192,7 @@ class MulticastEntry(TransportEntry[MulticastOptions]):
         return [options.interface]
 
     def open(self, options: MulticastOptions, index: int, fleet_size: int) -> Transport:
-        return UdpMulticastTransport(options.group, options.interface, index)
+        return UdpMulticastTransport(options.group, options.interface, index, fleet_size)
 
     def fleet_options(self, layout: FleetLayout, index: int) -> MulticastOptions:
         return MulticastOptions((f"239.255.77.{1 + layout.group_port % 250}", layout.group_port), layout.host)
