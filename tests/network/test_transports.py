@@ -16,12 +16,14 @@ import pytest
 from polling import PATIENCE, drain, receive_expected, receive_within
 
 from mrmp.live.transport import (
+    RECIPIENT,
     FaultyTransport,
     LiveFaults,
     UdpMulticastTransport,
     UdpTransport,
 )
 from mrmp.live.transport_entry import free_ports
+from mrmp.protocol.auth import MAX_DATAGRAM_BYTES
 
 LOOPBACK = "127.0.0.1"
 
@@ -63,8 +65,8 @@ class TakesEverything(UdpMulticastTransport):
     """Broken: takes in every datagram of the group, whoever it is headed for."""
 
     def receive(self, timeout):
-        data = self._receive_datagram(timeout, 4 + 2048)
-        return None if data is None else data[4:]
+        data = self._receive_datagram(timeout, RECIPIENT.size + MAX_DATAGRAM_BYTES + 1)
+        return None if data is None else data[RECIPIENT.size :]
 
 
 @pytest.mark.parametrize("broken", [False, True])

@@ -148,7 +148,6 @@ class SynchronizedPibtRobot(LivePibtRobot):
         self._final.add(peer)
         self._calls.pop(peer, None)
         self._unknown.discard(peer)
-        self._beacon_acks.add(peer)
         for entry in self._unacknowledged.values():
             entry.pending.discard(peer)
         self.wake = True

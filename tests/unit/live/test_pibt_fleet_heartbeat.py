@@ -65,4 +65,3 @@ def test_a_beacon_off_its_goal_takes_a_settled_peer_for_under_way_and_only_a_sta
     assert brain.heard[0] == (3.0, False)
     brain.receive(BeaconMessage(0, 4, 3, (0, 0), (0, 0), 0, 1), now=4.0)  # back on it: a beacon does not say settled
     assert brain.heard[0] == (4.0, False)
-
