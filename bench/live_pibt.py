@@ -7,7 +7,9 @@ the cell time (at the run's time scale) and their ratio (the target: at most
 1.5), the execution bound (:func:`execution_bound`: the simulator's decisions
 carried out by live bodies, with no time for messages) and its ratio, the live
 run's ideal (the longest single-robot path at that speed), moves,
-messages per move, and the live robots' own counts (steps begun held, steps
+messages per move (each message counted once per robot it is for) and datagrams
+per move (what went on the wire: the same over UDP and Zenoh, one per message
+over multicast, which reaches several robots with one datagram), and the live robots' own counts (steps begun held, steps
 abandoned, retransmissions). The machine's load (1-minute load average before
 and after each run, and the number of cores) is printed with every row: times
 are only comparable side by side on one machine.
@@ -18,8 +20,10 @@ tick, each one cell time long.
 
 Cases (``--cases``, comma-separated):
 
-* ``udp24``, ``zenoh24``: 24 robots of ``examples/causal-32.yaml`` (16x16 map
-  with obstacles), 20% loss, over UDP or Zenoh;
+* ``udp24``, ``zenoh24``, ``multicast24``: 24 robots of ``examples/causal-32.yaml``
+  (16x16 map with obstacles), 20% loss, over UDP, Zenoh or UDP multicast (on
+  loopback; each robot misses each datagram on its own, as each receiver of a
+  multicast datagram does);
 * ``udp64``: 64 robots on the same map (starts and goals drawn with seed 0), 10% loss;
 * ``side``: ``examples/causal-32.yaml`` (32 robots, perfect network) live with ``pibt``
   and with ``causal``, side by side.
@@ -46,7 +50,7 @@ occupant has started out: "Following while driving" in ``docs/protocol.md``).
 so that a fleet larger than the machine's cores is not a fleet of starved
 processes. The rows say how the robots were hosted.
 
-Usage: python bench/live_pibt.py [--cases udp24,zenoh24,udp64,side] [--time-scale 2] [--before REV]
+Usage: python bench/live_pibt.py [--cases udp24,zenoh24,multicast24,udp64,side] [--time-scale 2] [--before REV]
        [--synchronizer clock|local] [--body omni|turning] [--robots-per-process K]
 """
 
@@ -248,7 +252,8 @@ def row(label: str, scenario: Scenario, transport: str, loss: float, time_scale:
         f"collisions {len(result.collisions)}, wall makespan {result.time_makespan_s:.2f} s, "
         f"simulator {sim_text}, ratio {ratio}, ideal {result.ideal_makespan_s or 0:.2f} s "
         f"(x{result.time_makespan_s / (result.ideal_makespan_s or 1):.2f}), moves {moves}, "
-        f"messages/move {result.messages / moves:.1f}, held {network.get('safety_pibt_held', 0)}, "
+        f"messages/move {result.messages / moves:.1f}, datagrams/move {network.get('datagrams_sent', 0) / moves:.1f}, "
+        f"held {network.get('safety_pibt_held', 0)}, "
         f"abandoned {network.get('safety_pibt_abandoned', 0)}, "
         f"retransmissions {network.get('safety_pibt_retransmissions', 0)}, stop: {result.stop_reason}; "
         f"load {load_before:.1f} -> {load_after:.1f} on {os.cpu_count()} cores",
@@ -283,6 +288,8 @@ def main() -> int:
             row(case, example(24), "udp", 0.2, scale)
         elif name == "zenoh24":
             row(case, example(24), "zenoh", 0.2, scale)
+        elif name == "multicast24":
+            row(case, example(24), "multicast", 0.2, scale)
         elif name == "udp64":
             row(case, drawn(64), "udp", 0.1, scale)
         elif name == "side":

@@ -11,7 +11,7 @@ and the execution bound (those decisions carried out by live bodies, with no
 time for messages: :func:`mrmp.centralized.body_time.execution_seconds`; a
 thesis body enters a cell once its occupant has arrived elsewhere, a turning one
 once its occupant has started out) with the ratio
-to each, moves, datagrams per move, the robots' own counts (steps begun held,
+to each, moves, messages and datagrams per move, the robots' own counts (steps begun held,
 held robots that gave up, abandoned steps, retransmissions), and what the
 harness cost: its CPU seconds and microseconds per datagram handled (the same
 code a robot process runs, without sockets and threads).
@@ -22,12 +22,18 @@ its ``-random-1`` scenario's first ``ROBOTS`` agents, or ``causal-32:N`` for
 
 ``--seeds N`` runs each case with seeds ``--seed`` to ``--seed + N - 1`` and
 then prints the mean makespan over them, its range and standard error, and the
-mean datagrams per move (one run's makespan swings with the order in which a few
+mean messages and datagrams per move (one run's makespan swings with the order in which a few
 messages come).
+
+``--network multicast`` runs the fleet over a network on which one datagram
+reaches several named peers, as over ``UdpMulticastTransport``: a message for
+several peers is one datagram on the wire (each peer still misses it or not on
+its own), where unicast (UDP, Zenoh) sends one per peer. Messages per move count
+each message once per peer either way; datagrams per move count what goes on the wire.
 
 Usage: python bench/live_virtual.py [--cases random-64-64-10:200,random-64-64-10:1000] [--loss 0.1]
        [--time-scale 5] [--synchronizer clock|local] [--body omni|turning] [--turn-us 50] [--datagram-us 30]
-       [--seed 0] [--seeds 1]
+       [--seed 0] [--seeds 1] [--network unicast|multicast]
 """
 
 from __future__ import annotations
@@ -80,14 +86,15 @@ def simulated_seconds(scenario: Scenario, time_scale: float) -> tuple[int, float
     return run.makespan, bound
 
 
-def row(case: str, arguments: argparse.Namespace, seed: int) -> tuple[float, float]:
-    """Run ``case`` with ``seed`` and print its row; return its makespan and datagrams per move."""
+def row(case: str, arguments: argparse.Namespace, seed: int) -> tuple[float, float, float]:
+    """Run ``case`` with ``seed`` and print its row; return its makespan, messages and datagrams per move."""
     scenario = case_scenario(case, arguments.synchronizer, arguments.body)
     costs = ProcessingCosts(turn=arguments.turn_us / 1e6, datagram=arguments.datagram_us / 1e6)  # the defaults exactly
     folder = Path(tempfile.mkdtemp(prefix=f"mrmp-virtual-{scenario.name}-"))
     options = VirtualOptions(
-        results=folder, time_scale=arguments.time_scale, faults=LiveFaults(loss=arguments.loss), seed=seed, costs=costs
-    )
+        results=folder, time_scale=arguments.time_scale, faults=LiveFaults(loss=arguments.loss), seed=seed, costs=costs,
+        multicast=arguments.network == "multicast",
+    )  # fmt: skip
     result = run_virtual(scenario, options)
     network = result.network
     moves = max(1, network.get("moves", 0))
@@ -99,10 +106,11 @@ def row(case: str, arguments: argparse.Namespace, seed: int) -> tuple[float, flo
     arrived = sum(robot.arrived for robot in result.robots)
     print(
         f"{scenario.name}: live pibt (steps end by {arguments.synchronizer}), {scenario.policy.body} bodies, "
-        f"loss {arguments.loss:.0%}, time scale {arguments.time_scale:g}, virtual time: arrived "
+        f"{arguments.network} network, loss {arguments.loss:.0%}, time scale {arguments.time_scale:g}, virtual time: arrived "
         f"{arrived}/{len(scenario.robots)}, collisions {len(result.collisions)}, makespan {makespan:.2f} s; "
         f"simulator {ticks} ticks = {simulated:.2f} s (x{makespan / simulated:.2f}), execution bound {bound_text}; "
         f"moves {moves}, messages/move {result.messages / moves:.1f}, "
+        f"datagrams/move {network.get('datagrams_sent', 0) / moves:.1f}, "
         f"held {network.get('safety_pibt_held', 0)}, gave up {network.get('safety_pibt_gave_up', 0)}, "
         f"abandoned {network.get('safety_pibt_abandoned', 0)}, "
         f"retransmissions {network.get('safety_pibt_retransmissions', 0)}; stop: {result.stop_reason}; "
@@ -111,7 +119,7 @@ def row(case: str, arguments: argparse.Namespace, seed: int) -> tuple[float, flo
         f"results in {folder}",
         flush=True,
     )
-    return makespan, result.messages / moves
+    return makespan, result.messages / moves, network.get("datagrams_sent", 0) / moves
 
 
 def fleet_parser(description: str, cases: str) -> argparse.ArgumentParser:
@@ -131,6 +139,10 @@ def main() -> int:
     parser.add_argument("--turn-us", type=float, default=round(ProcessingCosts().turn * 1e6, 6), help="processor time per turn")
     parser.add_argument("--datagram-us", type=float, default=round(ProcessingCosts().datagram * 1e6, 6), help="per datagram")
     parser.add_argument("--seeds", type=int, default=1, help="runs of each case, with seeds --seed on")
+    parser.add_argument(
+        "--network", choices=("unicast", "multicast"), default="unicast",
+        help="multicast: one datagram reaches several named peers (as UdpMulticastTransport)",
+    )  # fmt: skip
     arguments = parser.parse_args()
     if arguments.seeds < 1:
         parser.error(f"--seeds: must be at least 1, got {arguments.seeds}")
@@ -138,12 +150,13 @@ def main() -> int:
     for case in arguments.cases.split(","):
         runs = [row(case, arguments, seed) for seed in seeds]
         if len(runs) > 1:
-            spans = [makespan for makespan, _ in runs]
+            spans = [makespan for makespan, _, _ in runs]
             error = statistics.stdev(spans) / len(spans) ** 0.5
             print(
                 f"{case}: seeds {seeds.start} to {seeds.stop - 1}: makespan {statistics.mean(spans):.2f} s on average "
                 f"({min(spans):.2f} to {max(spans):.2f} s, standard error {error:.2f} s), "
-                f"messages/move {statistics.mean(per_move for _, per_move in runs):.1f}",
+                f"messages/move {statistics.mean(messages for _, messages, _ in runs):.1f}, "
+                f"datagrams/move {statistics.mean(datagrams for _, _, datagrams in runs):.1f}",
                 flush=True,
             )
     return 0

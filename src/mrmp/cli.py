@@ -450,12 +450,14 @@ def print_result(result: RunResult, console: Console) -> None:
         arrivals = sum(robot.time_s for robot in result.robots if robot.arrived)
         virtual = "virtual_turns" in network  # a fleet on a virtual clock: its times are virtual, its wall time CPU
         clock, spent = ("virtual", "CPU time") if virtual else ("wall-clock", "wall time")
+        datagrams = int(network.get("datagrams_sent", result.messages))
+        on_the_wire = f" in {datagrams} datagrams" if datagrams != result.messages else ""  # multicast: fewer
         console.print(
             f"{verdict} ({result.stop_reason}): {clock} makespan {result.time_makespan_s:.2f} s "
             f"(ideal {result.ideal_makespan_s or 0:.2f} s: the longest single-robot path at this speed), "
             f"sum of arrival times {arrivals:.2f} s, "
             f"{moves_said} (lower bound {result.lower_bound}), collisions: {len(result.collisions)}, "
-            f"messages {result.messages}, {spent} {result.wall_time_s:.1f} s"
+            f"messages {result.messages}{on_the_wire}, {spent} {result.wall_time_s:.1f} s"
         )
         console.print(f"  dropped by robots: {rejected}; injected faults: {injected}", markup=False)
         if result.tasks is not None:
@@ -584,7 +586,7 @@ def run(
     results: Annotated[Path | None, typer.Option(help="Folder for the robots' traces and reports (mrmp agent's --results, for the whole fleet).", show_default="a new temporary folder", rich_help_panel=LIVE)] = None,
     kill: Annotated[list[str] | None, typer.Option(help="Kill robot ID's process S wall-clock seconds after the fleet's start (repeatable).", metavar="ID@S", show_default=False, rich_help_panel=LIVE)] = None,
     ros2: Annotated[bool, typer.Option("--ros2", help="Every robot process publishes its pose and state on ROS 2 topics (DDS, domain ROS_DOMAIN_ID; the ros2 extra; docs/ros2.md).", rich_help_panel=LIVE)] = False,
-    virtual_clock: Annotated[bool, typer.Option("--virtual-clock", help="With --live: run every robot's live driver, brain and body in this process on a virtual clock, over a simulated network with a processor per robot (fleets larger than the machine; times in virtual seconds).", rich_help_panel=LIVE)] = False,
+    virtual_clock: Annotated[bool, typer.Option("--virtual-clock", help="With --live: run every robot's live driver, brain and body in this process on a virtual clock, over a simulated network with a processor per robot (fleets larger than the machine; times in virtual seconds); with --transport multicast one datagram reaches several robots, as over multicast.", rich_help_panel=LIVE)] = False,
     robots_per_process: Annotated[int, typer.Option(help="With --live: robots each mrmp agent process hosts, each with its own socket, brain and body (udp, multicast, zenoh).", rich_help_panel=LIVE)] = 1,
 ) -> None:
     """Run a scenario (lockstep simulator, or --live processes) and report what happened."""
@@ -738,15 +740,13 @@ def _validate_live(scenario: Scenario, request: RunRequest) -> None:
 
 
 def _validate_virtual_clock(scenario: Scenario, request: RunRequest) -> None:
-    """Refuse what a live fleet on a virtual clock cannot do: processes to kill, ROS 2, a plan, another transport."""
+    """Refuse what a live fleet on a virtual clock cannot do: processes to kill, ROS 2, a plan."""
     if len(scenario.robots) > MAX_VIRTUAL_ROBOTS:
         reason = f"runs at most {MAX_VIRTUAL_ROBOTS} robots in one process; this scenario has {len(scenario.robots)}"
         raise InputError(Problem("--virtual-clock", reason))
     for given, flag in ((request.kill, "--kill"), (request.ros2, "--ros2"), (request.planner, "--planner")):
         if given:
             raise InputError(Problem("--virtual-clock", f"runs the fleet's own policy with no processes: not with {flag}"))
-    if request.transport != "udp":
-        raise InputError(Problem("--virtual-clock", "has its own simulated network: not with --transport"))
 
 
 def _simulated_run(
@@ -834,6 +834,7 @@ def _virtual_run(scenario: Scenario, request: RunRequest, console: Console) -> R
         faults=live_faults(scenario, request.time_scale, request.delay_ms),
         jitter=_fraction(request.jitter, "--jitter"),
         seed=scenario.seed,
+        multicast=TRANSPORTS.entry(request.transport).delivery.reaches_several,  # the simulated network delivers as it does
     )
     console.print(f"live: {len(scenario.robots)} robots on a virtual clock in this process; results in {results}", markup=False)
     return run_virtual(scenario, options)

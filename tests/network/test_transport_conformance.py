@@ -34,7 +34,7 @@ from mrmp import cli
 from mrmp.core.errors import InputError
 from mrmp.live.launcher import check_hosting
 from mrmp.live.process import check_key_policy
-from mrmp.live.transport import ConnectedTransport, Transport
+from mrmp.live.transport import ConnectedTransport, SeveralAtOnce, Transport
 from mrmp.live.transport_entry import FleetLayout, TransportEntry, TransportLayer
 from mrmp.live.transport_table import LAYERS, TRANSPORTS, TransportSpec
 from mrmp.protocol.auth import MAX_DATAGRAM_BYTES, Opener, Sealer
@@ -128,6 +128,19 @@ class TransportConformance:
         for index, robot in enumerate(robots):
             expected = [data for sender, recipient, data in ((0, 2, b"0 to 2"), (2, 1, b"2 to 1"))
                         if index in delivery.receivers(sender, recipient, len(robots))]
+            assert receive_expected(robot, expected) == Counter(expected), f"robot {index}"
+
+    def test_one_datagram_reaches_several_robots_where_the_entry_says_it_does(self, stack, fleet):
+        """A transport that reaches several named robots with one datagram says so in its entry, and each named
+        robot, and no other, takes it in; the others do not offer it (a live robot then sends one per robot)."""
+        robots = fleet()
+        several = stack.entry.delivery.reaches_several
+        assert all(isinstance(robot, SeveralAtOnce) == several for robot in robots)
+        if not several:
+            return
+        robots[1].send_to_several(b"1 to 0 and 2", (0, 2))
+        for index, robot in enumerate(robots):
+            expected = [b"1 to 0 and 2"] if index != 1 else []
             assert receive_expected(robot, expected) == Counter(expected), f"robot {index}"
 
     def test_a_burst_to_one_peer_arrives_whole(self, stack, fleet):

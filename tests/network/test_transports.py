@@ -16,11 +16,15 @@ import pytest
 from polling import PATIENCE, drain, receive_expected, receive_within
 
 from mrmp.live.transport import (
-    RECIPIENT,
+    COUNT,
+    MAX_NAMED,
     FaultyTransport,
     LiveFaults,
+    SeveralAtOnce,
     UdpMulticastTransport,
     UdpTransport,
+    read_head,
+    with_faults,
 )
 from mrmp.live.transport_entry import free_ports
 from mrmp.protocol.auth import MAX_DATAGRAM_BYTES
@@ -61,25 +65,32 @@ class RecordingTransport:
 # -- UdpMulticastTransport ---------------------------------------------------------------------
 
 
+def free_group():
+    port = free_ports(1)[0]
+    return (f"239.255.77.{1 + port % 250}", port)
+
+
 class TakesEverything(UdpMulticastTransport):
     """Broken: takes in every datagram of the group, whoever it is headed for."""
 
     def receive(self, timeout):
-        data = self._receive_datagram(timeout, RECIPIENT.size + MAX_DATAGRAM_BYTES + 1)
-        return None if data is None else data[RECIPIENT.size :]
+        data = self._receive_datagram(timeout, COUNT.size * (1 + MAX_NAMED) + MAX_DATAGRAM_BYTES + 1)
+        if data is None:
+            return None
+        return data[read_head(data, None)[1] :]
 
 
 @pytest.mark.parametrize("broken", [False, True])
 def test_a_multicast_robot_takes_in_only_what_is_sent_to_it_or_to_every_robot(broken):
-    """Every datagram reaches the whole group; one headed for another robot is dropped on receipt (a robot
+    """Every datagram reaches the whole group; one headed for other robots is dropped on receipt (a robot
     that took it in could take another's acknowledgement or answer for its own: ``docs/protocol.md``, "A
     multicast datagram says whom it is for")."""
-    port = free_ports(1)[0]
-    group = (f"239.255.77.{1 + port % 250}", port)
+    group = free_group()
     kind = TakesEverything if broken else UdpMulticastTransport
-    robots = [kind(group, LOOPBACK, index) for index in range(3)]
+    robots = [kind(group, LOOPBACK, index, fleet_size=4) for index in range(4)]
     try:
         robots[0].send(b"0 to 2", recipient=2)
+        robots[0].send_to_several(b"0 to 1 and 3", (1, 3))
         robots[0].send(b"0 to all")
         received = [receive_expected(robot, [b"0 to all"]) for robot in robots[1:]]
     finally:
@@ -88,7 +99,85 @@ def test_a_multicast_robot_takes_in_only_what_is_sent_to_it_or_to_every_robot(br
     if broken:
         assert received[0][b"0 to 2"] == 1
     else:
-        assert received == [Counter([b"0 to all"]), Counter([b"0 to 2", b"0 to all"])]
+        assert received == [
+            Counter([b"0 to 1 and 3", b"0 to all"]),
+            Counter([b"0 to 2", b"0 to all"]),
+            Counter([b"0 to 1 and 3", b"0 to all"]),
+        ]
+
+
+class OneDatagramEach(UdpMulticastTransport):
+    """Broken: sends a message for several robots as one datagram per robot, as unicast does."""
+
+    def send_to_several(self, data, recipients):
+        for recipient in recipients:
+            self.send(data, recipient)
+
+
+@pytest.mark.parametrize("broken", [False, True])
+def test_a_multicast_message_for_several_robots_is_one_datagram_on_the_wire(broken):
+    """What a robot counts as one datagram (``AgentReport.datagrams_sent``) is one: a listener of the group
+    that is no robot hears one datagram, naming both robots."""
+    group = free_group()
+    sender = (OneDatagramEach if broken else UdpMulticastTransport)(group, LOOPBACK, 0, fleet_size=3)
+    listener = UdpMulticastTransport(group, LOOPBACK)  # no robot: keeps every datagram, head and all
+    try:
+        sender.send_to_several(b"to 1 and 2", (1, 2))
+        heard = receive_expected(listener, [b"to 1 and 2"])
+    finally:
+        sender.close()
+        listener.close()
+    assert heard == (Counter([b"to 1 and 2", b"to 1 and 2"]) if broken else Counter([b"to 1 and 2"]))
+
+
+def test_a_multicast_message_for_more_robots_than_a_head_names_goes_in_as_few_datagrams_as_it_can():
+    group = free_group()
+    fleet = 2 * MAX_NAMED + 3
+    sender = UdpMulticastTransport(group, LOOPBACK, 0, fleet_size=fleet)
+    last = UdpMulticastTransport(group, LOOPBACK, fleet - 1, fleet_size=fleet)
+    listener = ListenerOfHeads(group)
+    try:
+        sender.send_to_several(b"to everyone else", tuple(range(1, fleet)))
+        assert receive_expected(last, [b"to everyone else"]) == Counter([b"to everyone else"])
+        heads = [listener.receive(PATIENCE) for _ in range(3)]
+    finally:
+        for transport in (sender, last, listener):
+            transport.close()
+    assert [named for named, _ in heads] == [
+        tuple(range(1, MAX_NAMED + 1)), tuple(range(MAX_NAMED + 1, 2 * MAX_NAMED + 1)), (2 * MAX_NAMED + 1, 2 * MAX_NAMED + 2)
+    ]
+
+
+class ListenerOfHeads(UdpMulticastTransport):
+    """A listener of the group that reads each datagram's head: the robots it names, and where its payload starts."""
+
+    def __init__(self, group):
+        super().__init__(group, LOOPBACK)
+
+    def receive(self, timeout):
+        data = self._receive_datagram(timeout, COUNT.size * (1 + MAX_NAMED) + MAX_DATAGRAM_BYTES + 1)
+        return None if data is None else read_head(data, None)
+
+
+def test_faults_on_multicast_give_each_named_robot_its_own_fate_and_still_send_one_datagram():
+    group = free_group()
+    inner = UdpMulticastTransport(group, LOOPBACK, 0, fleet_size=3)
+    listener = ListenerOfHeads(group)
+    faulty = with_faults(inner, LiveFaults(duplicate=1.0), seed=3)
+    try:
+        assert isinstance(faulty, SeveralAtOnce)
+        faulty.send_to_several(b"twice to 1 and 2", (1, 2))
+        heads = [listener.receive(PATIENCE) for _ in range(2)]
+    finally:
+        faulty.close()
+        listener.close()
+    assert [named for named, _ in heads] == [(1, 2), (1, 2)]  # two copies, each one datagram naming both
+    assert (faulty.counts.sent, faulty.counts.duplicated) == (2, 2)  # a fate per named robot
+    lossy = with_faults(UdpMulticastTransport(group, LOOPBACK, 0, fleet_size=3), LiveFaults(loss=1.0), seed=3)
+    lossy.send_to_several(b"lost", (1, 2))
+    assert (lossy.counts.sent, lossy.counts.lost) == (2, 2)
+    lossy.close()
+    assert not isinstance(with_faults(UdpTransport((LOOPBACK, 0), {}), LiveFaults(loss=0.5)), SeveralAtOnce)
 
 
 # -- UdpTransport ----------------------------------------------------------------------------

@@ -37,6 +37,8 @@ import queue
 import threading
 from typing import Protocol
 
+from mrmp.live.transport import SeveralAtOnce
+
 
 class Sending(Protocol):
     """The part of a :class:`~mrmp.live.transport.Transport` the client thread uses."""
@@ -59,7 +61,8 @@ class ClientThread:
 
     def __init__(self, transport: Sending, name: str) -> None:
         self.transport = transport
-        self._queue: queue.SimpleQueue[tuple[bytes, int | None] | None] = queue.SimpleQueue()
+        self._several = transport if isinstance(transport, SeveralAtOnce) else None
+        self._queue: queue.SimpleQueue[tuple[bytes, int | tuple[int, ...] | None] | None] = queue.SimpleQueue()
         self._thread = threading.Thread(target=self._run, name=name, daemon=True)
         self._failure: Exception | None = None
         self._closed = False
@@ -68,6 +71,11 @@ class ClientThread:
     def name(self) -> str:
         """The thread's name."""
         return self._thread.name
+
+    @property
+    def reaches_several(self) -> bool:
+        """Whether one datagram reaches several peers (:meth:`send_to_several`): the transport's can."""
+        return self._several is not None
 
     def start(self) -> None:
         """Start the client thread; datagrams queued before are sent first."""
@@ -83,6 +91,15 @@ class ClientThread:
         RuntimeError
             If the client is closed.
         """
+        self._queue_datagram(data, recipient)
+
+    def send_to_several(self, data: bytes, recipients: tuple[int, ...]) -> None:
+        """Queue ``data`` for ``recipients``, one datagram for all (only when :attr:`reaches_several`), and return."""
+        if not self.reaches_several:
+            raise TypeError(f"{self.name}'s transport does not reach several peers with one datagram")
+        self._queue_datagram(data, recipients)
+
+    def _queue_datagram(self, data: bytes, recipient: int | tuple[int, ...] | None) -> None:
         self._raise_failure()
         if self._closed:
             raise RuntimeError(f"{self.name} is closed")
@@ -109,7 +126,11 @@ class ClientThread:
                 return
             data, recipient = item
             try:
-                self.transport.send(data, recipient)
+                if isinstance(recipient, tuple):
+                    assert self._several is not None  # send_to_several queues only then
+                    self._several.send_to_several(data, recipient)
+                else:
+                    self.transport.send(data, recipient)
             except Exception as error:  # handed to the main loop, which ends the run with it
                 self._failure = error
                 return

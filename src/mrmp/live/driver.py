@@ -243,8 +243,17 @@ class Sending(Protocol):
         """Begin sending."""
         ...
 
+    @property
+    def reaches_several(self) -> bool:
+        """Whether one datagram reaches several named peers (multicast), and :meth:`send_to_several` may be called."""
+        ...
+
     def send(self, data: bytes, recipient: int | None) -> None:
         """Send ``data`` to ``recipient`` (every peer when None)."""
+        ...
+
+    def send_to_several(self, data: bytes, recipients: tuple[int, ...]) -> None:
+        """Send ``data`` to ``recipients`` in one datagram."""
         ...
 
     def close(self) -> None:
@@ -275,8 +284,8 @@ class AgentReport:
     """Messages sent (per recipient) by message type (``StateMessage``, ``ClaimMessage``...)."""
     bytes_sent: int = 0
     datagrams_sent: int = 0
-    """Sends handed to the transport: a message to every peer counts once (one datagram on the wire over
-    multicast, one per peer over unicast), a message to named peers once per peer."""
+    """Datagrams the robot put on the wire: one per recipient over unicast (as :attr:`messages_sent`), one per
+    message over multicast, which reaches every peer or several named ones with one datagram."""
     messages_received: int = 0
     rejected: dict[str, int] = field(default_factory=dict)
     faults: dict[str, int] = field(default_factory=dict)
@@ -569,17 +578,18 @@ class LiveDriver:
                 item = item._replace(recipients=(*near, *(peer for peer in item.recipients or () if peer not in near)))
             if item.recipients is None:
                 client.send(data, None)
-                report.messages_sent += self._peers
-                by_kind[kind] = by_kind.get(kind, 0) + self._peers
-                report.bytes_sent += len(data) * self._peers
-                report.datagrams_sent += 1
+                messages, datagrams = self._peers, 1 if client.reaches_several else self._peers
+            elif len(item.recipients) > 1 and client.reaches_several:
+                client.send_to_several(data, item.recipients)
+                messages, datagrams = len(item.recipients), 1
             else:
                 for recipient in item.recipients:
                     client.send(data, recipient)
-                    report.messages_sent += 1
-                    report.bytes_sent += len(data)
-                    report.datagrams_sent += 1
-                by_kind[kind] = by_kind.get(kind, 0) + len(item.recipients)
+                messages = datagrams = len(item.recipients)
+            report.messages_sent += messages
+            by_kind[kind] = by_kind.get(kind, 0) + messages
+            report.datagrams_sent += datagrams
+            report.bytes_sent += len(data) * messages
 
     # -- the main loop ---------------------------------------------------------------------
 

@@ -28,7 +28,7 @@ from dataclasses import dataclass, field
 from typing import Protocol, runtime_checkable
 
 from mrmp.live.driver import AgentReport, LiveDriver
-from mrmp.live.transport import Transport
+from mrmp.live.transport import SeveralAtOnce, Transport
 
 __all__ = ["STOP_LATENCY", "Hosted", "Selectable", "run_hosted"]
 
@@ -64,12 +64,22 @@ class _Direct:
 
     def __init__(self, transport: Transport) -> None:
         self.transport = transport
+        self._several = transport if isinstance(transport, SeveralAtOnce) else None
+
+    @property
+    def reaches_several(self) -> bool:
+        return self._several is not None
 
     def start(self) -> None:
         """Nothing to start: each send goes out at once."""
 
     def send(self, data: bytes, recipient: int | None) -> None:
         self.transport.send(data, recipient)
+
+    def send_to_several(self, data: bytes, recipients: tuple[int, ...]) -> None:
+        if self._several is None:
+            raise TypeError(f"{type(self.transport).__name__} does not reach several peers with one datagram")
+        self._several.send_to_several(data, recipients)
 
     def close(self) -> None:
         """Nothing queued."""

@@ -55,6 +55,16 @@ class Transport(Protocol):
 
 
 @runtime_checkable
+class SeveralAtOnce(Protocol):
+    """A transport that reaches several named peers with one datagram (multicast: every robot of the group
+    hears it, and each named robot takes it in); a unicast transport sends one datagram per peer instead."""
+
+    def send_to_several(self, data: bytes, recipients: tuple[int, ...]) -> None:
+        """Send ``data`` to the peers ``recipients``, one datagram for all of them."""
+        ...
+
+
+@runtime_checkable
 class ConnectedTransport(Transport, Protocol):
     """A transport whose peers connect before datagrams reach them (Zenoh): it can wait for them.
 
@@ -224,8 +234,40 @@ IP_MULTICAST_ALL = getattr(socket, "IP_MULTICAST_ALL", 49)
 """Linux's socket option (``<linux/in.h>``) that, set to 0, limits a socket to the groups it joined itself."""
 
 
-RECIPIENT = struct.Struct("!I")
-"""The head of every multicast datagram: whom it is for (0: every robot; otherwise the robot's index + 1)."""
+COUNT = struct.Struct("!H")
+"""The head of every multicast datagram starts with how many robots it names (0: it is for every robot)."""
+MAX_NAMED = 128
+"""The most robots one multicast datagram names: a message for more goes as several datagrams."""
+
+
+def recipients_head(recipients: tuple[int, ...]) -> bytes:
+    """The head of a multicast datagram for ``recipients`` (none: every robot): their count, then each index.
+
+    >>> recipients_head(()).hex(), recipients_head((2, 5)).hex()
+    ('0000', '000200020005')
+    """
+    return struct.pack(f"!H{len(recipients)}H", len(recipients), *recipients)
+
+
+def read_head(data: bytes, fleet_size: int | None) -> tuple[tuple[int, ...], int] | None:
+    """The robots a multicast datagram names (none: every robot) and where its payload starts; None if its head
+    names no robot of the fleet (too short, more robots than the fleet has, or an index outside it).
+
+    >>> read_head(recipients_head((1, 3)) + b"payload", 4)
+    ((1, 3), 6)
+    >>> read_head(b"hello", 4) is None     # a stranger's datagram: "he" would name 26,725 robots
+    True
+    """
+    if len(data) < COUNT.size:
+        return None
+    (count,) = COUNT.unpack_from(data)
+    end = COUNT.size * (1 + count)
+    if len(data) < end or (fleet_size is not None and count > fleet_size):
+        return None
+    named = struct.unpack_from(f"!{count}H", data, COUNT.size)
+    if fleet_size is not None and any(index >= fleet_size for index in named):
+        return None
+    return named, end
 
 
 class UdpMulticastTransport(_UdpSocket):
@@ -233,13 +275,15 @@ class UdpMulticastTransport(_UdpSocket):
 
     The sending and receiving interface is always set explicitly
     (``IP_MULTICAST_IF`` and the membership's interface), never left to the
-    routing table. Datagrams addressed to one robot are sent to the group too,
-    headed by their recipient (:data:`RECIPIENT`), and a receiver drops those
-    headed for another robot: as over unicast, a robot takes in only what was
-    sent to it or to every robot (it also hears its own datagrams to every
+    routing table. Datagrams addressed to some robots are sent to the group too,
+    headed by the robots they are for (:func:`recipients_head`), and a receiver
+    drops those that do not name it: as over unicast, a robot takes in only what
+    was sent to it or to every robot (it also hears its own datagrams to every
     robot, and drops them). Without it, a robot would take a message meant for
     another (an acknowledgement of a sequence number that happens to be one of
-    its own, a request to leave another robot's cell) for its own.
+    its own, a request to leave another robot's cell) for its own. A message
+    for several robots is one datagram naming them all (:meth:`send_to_several`),
+    where unicast sends one per robot.
 
     The socket is bound to the group's address, not to every address: on Linux
     it then receives only datagrams sent to the group, never one sent to any
@@ -289,28 +333,36 @@ class UdpMulticastTransport(_UdpSocket):
         self._closed = False
 
     def send(self, data: bytes, recipient: int | None = None) -> None:
-        head = RECIPIENT.pack(0 if recipient is None else recipient + 1)
+        self._send_headed(data, () if recipient is None else (recipient,))
+
+    def send_to_several(self, data: bytes, recipients: tuple[int, ...]) -> None:
+        """Send ``data`` to ``recipients`` in one datagram (one per :data:`MAX_NAMED` of them); none: nothing."""
+        for first in range(0, len(recipients), MAX_NAMED):
+            self._send_headed(data, recipients[first : first + MAX_NAMED])
+
+    def _send_headed(self, data: bytes, recipients: tuple[int, ...]) -> None:
         with contextlib.suppress(OSError):
-            self._socket.sendto(head + data, self.group)
+            self._socket.sendto(recipients_head(recipients) + data, self.group)
 
     def receive(self, timeout: float) -> bytes | None:
         """The next datagram for this robot or for every robot, its head removed, or None.
 
-        A datagram for another robot of the fleet is dropped (that robot takes
-        it in, or rejects and counts it), and what else waits is looked at
-        without waiting further (None when nothing does). One too short for a
-        head, or whose head names no robot of the fleet, is no robot's: it is
-        handed on whole, and the opener rejects it and counts it.
+        A datagram for other robots of the fleet is dropped (they take it in,
+        or reject and count it), and what else waits is looked at without
+        waiting further (None when nothing does). One whose head names no robot
+        of the fleet (:func:`read_head`) is no robot's: it is handed on whole,
+        and the opener rejects it and counts it.
         """
         while True:
-            data = self._receive_datagram(timeout, RECIPIENT.size + MAX_DATAGRAM_BYTES + 1)
-            if data is None or len(data) < RECIPIENT.size:
+            data = self._receive_datagram(timeout, COUNT.size * (1 + MAX_NAMED) + MAX_DATAGRAM_BYTES + 1)
+            if data is None:
+                return None
+            head = read_head(data, self.fleet_size)
+            if head is None:
                 return data
-            (recipient,) = RECIPIENT.unpack_from(data)
-            if self.fleet_size is not None and recipient > self.fleet_size:
-                return data
-            if recipient == 0 or self.index is None or recipient == self.index + 1:
-                return data[RECIPIENT.size :]
+            named, payload = head
+            if not named or self.index is None or self.index in named:
+                return data[payload : payload + MAX_DATAGRAM_BYTES + 1]  # longer: cut, as unicast's reads cut it
             timeout = 0.0
 
 
@@ -362,6 +414,14 @@ class FaultyTransport:
         self._thread.start()
 
     def send(self, data: bytes, recipient: int | None = None) -> None:
+        for delay in self._fates():
+            if delay <= 0:
+                self.inner.send(data, recipient)
+            else:
+                self._send_later(data, recipient, delay)
+
+    def _fates(self) -> list[float]:
+        """Draw one datagram's fate: the delays of the copies delivered (none if it is lost), each counted."""
         faults = self.faults
         rng = self._random
         self.counts.sent += 1
@@ -374,19 +434,22 @@ class FaultyTransport:
         )
         self.counts.duplicated += fates.duplicated
         self.counts.lost += fates.lost
+        delays = []
         for copy in fates.delivered:
             delay = copy.delay
             if copy.reordered:
                 self.counts.reordered += 1
                 delay += copy.hold * max(faults.delay_max, 0.02)  # held back so that later ones overtake it
-            if delay <= 0:
-                self.inner.send(data, recipient)
-                continue
-            self.counts.delayed += 1
-            with self._wake:
-                self._order += 1
-                heapq.heappush(self._queue, (time.monotonic() + delay, self._order, data, recipient))
-                self._wake.notify()
+            if delay > 0:
+                self.counts.delayed += 1
+            delays.append(delay)
+        return delays
+
+    def _send_later(self, data: bytes, recipient: int | None, delay: float) -> None:
+        with self._wake:
+            self._order += 1
+            heapq.heappush(self._queue, (time.monotonic() + delay, self._order, data, recipient))
+            self._wake.notify()
 
     def _deliver_late(self) -> None:
         with self._wake:
@@ -410,3 +473,43 @@ class FaultyTransport:
             self._wake.notify()
         self._thread.join(timeout=1.0)
         self.inner.close()
+
+
+class FaultySeveralTransport(FaultyTransport):
+    """A :class:`FaultyTransport` around a transport that reaches several peers with one datagram (multicast).
+
+    Each named peer's copy meets its own fate, as each receiver of a
+    multicast datagram misses it or not on its own: the copies due at once go
+    as one datagram naming their peers, delayed ones each on its own.
+    """
+
+    def __init__(self, inner: Transport, faults: LiveFaults, seed: int = 0) -> None:
+        if not isinstance(inner, SeveralAtOnce):
+            raise TypeError(f"{type(inner).__name__} does not reach several peers with one datagram")
+        super().__init__(inner, faults, seed)
+        self.several: SeveralAtOnce = inner
+
+    def send_to_several(self, data: bytes, recipients: tuple[int, ...]) -> None:
+        now: list[list[int]] = [[], []]  # the first and second copies due at once (duplication makes two)
+        for recipient in recipients:
+            for copy, delay in enumerate(self._fates()):
+                if delay <= 0:
+                    now[copy].append(recipient)
+                else:
+                    self._send_later(data, recipient, delay)
+        for named in now:
+            if named:
+                self.several.send_to_several(data, tuple(named))
+
+
+def with_faults(transport: Transport, faults: LiveFaults, seed: int = 0) -> FaultyTransport:
+    """``transport`` wrapped to inject ``faults``, still reaching several peers at once if it did.
+
+    >>> faulty = with_faults(UdpTransport(("127.0.0.1", 0), {}), LiveFaults(loss=0.1))
+    >>> type(faulty).__name__, isinstance(faulty, SeveralAtOnce)
+    ('FaultyTransport', False)
+    >>> faulty.close()
+    """
+    if isinstance(transport, SeveralAtOnce):
+        return FaultySeveralTransport(transport, faults, seed)
+    return FaultyTransport(transport, faults, seed)

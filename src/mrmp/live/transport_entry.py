@@ -130,14 +130,20 @@ class Delivery:
         The longest datagram ``receive`` returns; longer ones arrive cut to
         this length (the opener then rejects them as oversized). None: every
         datagram arrives whole, whatever its size.
+    reaches_several:
+        Whether one datagram reaches several named robots (the transport is a
+        :class:`~mrmp.live.transport.SeveralAtOnce`), where unicast sends one
+        per robot: what a live robot counts as a datagram on the wire, and how
+        the virtual clock's network delivers (:mod:`mrmp.live.virtual_time`).
 
     >>> Delivery()
-    Delivery(echoes=False, addressed_to_all=False, longest=None)
+    Delivery(echoes=False, addressed_to_all=False, longest=None, reaches_several=False)
     """
 
     echoes: bool = False
     addressed_to_all: bool = False
     longest: int | None = None
+    reaches_several: bool = False
 
     def receivers(self, sender: int, recipient: int | None, fleet_size: int) -> set[int]:
         """The robots that receive what ``sender`` sends to ``recipient`` (None: to every peer).

@@ -32,7 +32,6 @@ from typing import Any
 from mrmp.core.errors import InputError, Problem
 from mrmp.live.transport import (
     Address,
-    FaultyTransport,
     LiveFaults,
     Transport,
     UdpMulticastTransport,
@@ -40,6 +39,7 @@ from mrmp.live.transport import (
     ipv4_interface,
     multicast_group,
     parse_address,
+    with_faults,
 )
 from mrmp.live.transport_entry import Delivery, FleetLayout, TransportEntry, TransportLayer
 from mrmp.live.zenoh_transport import ZenohEndpoint, fleet_keys
@@ -175,7 +175,7 @@ class MulticastEntry(TransportEntry[MulticastOptions]):
 
     name = "multicast"
     summary = "one UDP multicast group for the fleet, on an explicit interface"
-    delivery = Delivery(echoes=True, longest=MAX_DATAGRAM_BYTES + 1)
+    delivery = Delivery(echoes=True, longest=MAX_DATAGRAM_BYTES + 1, reaches_several=True)
 
     def parse(self, values: Mapping[str, Any], ids: Sequence[str], index: int) -> MulticastOptions:
         try:
@@ -506,7 +506,7 @@ class FaultLayer(TransportLayer[LiveFaults]):
     summary = "injected loss, delay, duplication and reordering of sent datagrams (seeded)"
 
     def wrap(self, transport: Transport, options: LiveFaults, seed: int) -> Transport:
-        return transport if options.is_perfect else FaultyTransport(transport, options, seed=seed)
+        return transport if options.is_perfect else with_faults(transport, options, seed=seed)
 
     def arguments(self, options: LiveFaults) -> list[str]:
         return [

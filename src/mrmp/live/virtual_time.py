@@ -17,7 +17,9 @@ What the harness adds is what a real fleet has and a single process does not:
 
 * **a network** (:class:`VirtualNetwork`): each datagram arrives after a
   ``latency`` plus a delay drawn from the faults' range, is lost or duplicated
-  with the faults' probabilities (seeded), and goes to one peer or every peer;
+  with the faults' probabilities (seeded), and goes to one peer or every peer,
+  or (with ``multicast``, as a multicast group) to several named peers at once,
+  each of whom misses it or not on its own;
 * **a computer per robot**: a turn of a robot's main loop takes
   ``costs.turn`` seconds plus ``costs.datagram`` per datagram it took in or sent
   (:class:`ProcessingCosts`); its datagrams leave when the turn ends, and the
@@ -119,6 +121,9 @@ class VirtualOptions:
     seed: int = 0
     latency: float = 200e-6
     """Seconds a datagram takes on a perfect network (loopback is about 50 microseconds, a wireless LAN a few ms)."""
+    multicast: bool = False
+    """Whether one datagram reaches several named peers, as over multicast (the robots then send one datagram
+    where unicast sends one per peer: :attr:`~mrmp.live.driver.AgentReport.datagrams_sent`)."""
     costs: ProcessingCosts = field(default_factory=ProcessingCosts)
     timing: AgentTiming = field(default_factory=AgentTiming)
     timeout: float | None = None
@@ -145,9 +150,10 @@ class VirtualNetwork:
         self._queue: list[tuple[float, int, int, bytes]] = []
         self._order = itertools.count()
 
-    def post(self, sender: int, data: bytes, recipient: int | None, at: float) -> None:
-        """``sender`` sends ``data`` at time ``at`` to ``recipient``, or to every other robot when None."""
-        recipients = range(self.robots) if recipient is None else (recipient,)
+    def post(self, sender: int, data: bytes, recipient: int | tuple[int, ...] | None, at: float) -> None:
+        """``sender`` sends ``data`` at time ``at`` to ``recipient`` (several, when a tuple), or to every other
+        robot when None; each recipient's copy meets its own fate."""
+        recipients = range(self.robots) if recipient is None else recipient if isinstance(recipient, tuple) else (recipient,)
         faults, rng, counts = self.faults, self.random, self.counts[sender]
         for peer in recipients:
             if peer == sender:
@@ -182,14 +188,24 @@ class VirtualNetwork:
 class _Outbox:
     """A virtual robot's datagrams of one turn, held until the turn's processing ends (:class:`~mrmp.live.driver.Sending`)."""
 
-    def __init__(self) -> None:
-        self.datagrams: list[tuple[bytes, int | None]] = []
+    def __init__(self, multicast: bool) -> None:
+        self.datagrams: list[tuple[bytes, int | tuple[int, ...] | None]] = []
+        self.multicast = multicast
+
+    @property
+    def reaches_several(self) -> bool:
+        return self.multicast
 
     def start(self) -> None:
         """Nothing to start: the harness sends."""
 
     def send(self, data: bytes, recipient: int | None) -> None:
         self.datagrams.append((data, recipient))
+
+    def send_to_several(self, data: bytes, recipients: tuple[int, ...]) -> None:
+        if not self.multicast:
+            raise TypeError("a unicast network does not reach several peers with one datagram")
+        self.datagrams.append((data, recipients))
 
     def close(self) -> None:
         """Nothing to flush: the harness sends after every turn."""
@@ -234,7 +250,7 @@ class _VirtualFleet:
             sealer, opener = Sealer(key, session), Opener(key, session, fleet_size=robots + desk)
             driver = kind(scenario, index, _NoSockets(), body, sealer, opener, shared, None)
             driver.clock = self.clock
-            outbox = _Outbox()
+            outbox = _Outbox(options.multicast)
             driver.send_through(outbox)
             self.robots.append(_Robot(driver, outbox, trace))
         self._wakes: list[tuple[float, int, int]] = [(0.0, index, 0) for index in range(robots)]

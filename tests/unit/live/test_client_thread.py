@@ -99,7 +99,7 @@ def test_a_live_robot_sends_only_through_its_client_thread():
     agent = single_robot_agent(transport)
     report = agent.run()
     assert report.arrived and report.stop_reason == "all arrived"
-    assert len(transport.sent) == report.datagrams_sent > 0
+    assert len(transport.sent) > 0 and report.datagrams_sent == 0  # alone: what it sends every peer reaches nobody
     assert {name for name, _, _ in transport.sent} == {"robot-0-client"}
 
 
@@ -122,4 +122,4 @@ def test_a_live_robot_keeps_moving_while_its_transport_blocks():
     report = agent.run()
     watcher.join()
     assert seen == {"steps": 2, "sent": 0}
-    assert report.arrived and len(transport.sent) == report.datagrams_sent
+    assert report.arrived and len(transport.sent) > 0  # what was queued while the transport blocked went out
