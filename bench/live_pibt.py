@@ -58,7 +58,6 @@ from __future__ import annotations
 
 import argparse
 import os
-import random
 import subprocess
 import sys
 import tarfile
@@ -68,8 +67,9 @@ import time
 from io import BytesIO
 from pathlib import Path
 
+from live_virtual import drawn_on_causal_32
 from mrmp.centralized.body_time import execution_seconds
-from mrmp.core import Cell, NetworkFaults, PolicyOptions, RobotSpec, Scenario
+from mrmp.core import Cell, NetworkFaults, PolicyOptions, Scenario
 from mrmp.core.body import DEFAULT_BODY, body_model
 from mrmp.core.heading import Heading, right_turns
 from mrmp.core.result import RunResult
@@ -109,13 +109,7 @@ def example(count: int | None = None, policy: str = "pibt") -> Scenario:
 
 def drawn(count: int, seed: int = 0) -> Scenario:
     """``count`` robots on the example's map, starts and goals drawn from its free cells with ``seed``."""
-    scenario = load_scenario(EXAMPLE)
-    grid = scenario.grid
-    free = [(x, y) for x in range(grid.x_size) for y in range(grid.y_size) if grid.is_free((x, y))]
-    rng = random.Random(seed)
-    starts, goals = rng.sample(free, count), rng.sample(free, count)
-    robots = tuple(RobotSpec(f"r{i}", start, goal) for i, (start, goal) in enumerate(zip(starts, goals, strict=True)))
-    return scenario.with_changes(robots=robots, policy=pibt_policy(), name=f"drawn-{count}")
+    return drawn_on_causal_32(count, seed).with_changes(policy=pibt_policy(), name=f"drawn-{count}")
 
 
 def simulated(scenario: Scenario) -> RunResult:

@@ -17,8 +17,9 @@ harness cost: its CPU seconds and microseconds per datagram handled (the same
 code a robot process runs, without sockets and threads).
 
 Cases (``--cases``, comma-separated ``MAP:ROBOTS``): a map of ``maps/`` with
-its ``-random-1`` scenario's first ``ROBOTS`` agents, or ``causal-32:N`` for
-``examples/causal-32.yaml``'s first ``N`` robots.
+its ``-random-1`` scenario's first ``ROBOTS`` agents, ``causal-32:N`` for
+``examples/causal-32.yaml``'s first ``N`` robots, or ``causal-32-drawn:N`` for
+``N`` robots drawn on its map (seed 0, as ``bench/live_pibt.py``'s ``udp64``).
 
 ``--seeds N`` runs each case with seeds ``--seed`` to ``--seed + N - 1`` and
 then prints the mean makespan over them, its range and standard error, and the
@@ -39,6 +40,7 @@ Usage: python bench/live_virtual.py [--cases random-64-64-10:200,random-64-64-10
 from __future__ import annotations
 
 import argparse
+import random
 import statistics
 import tempfile
 from pathlib import Path
@@ -47,13 +49,25 @@ from mrmp.centralized.body_time import execution_seconds
 from mrmp.centralized.dependencies import PlanDeadlockError
 from mrmp.core import NetworkFaults
 from mrmp.core.body import body_model
-from mrmp.core.scenario import PolicyOptions, Scenario
+from mrmp.core.scenario import PolicyOptions, RobotSpec, Scenario
 from mrmp.io import load_movingai_scenario, load_scenario
 from mrmp.live.transport import LiveFaults
 from mrmp.live.virtual_time import ProcessingCosts, VirtualOptions, run_virtual
 from mrmp.sim.local_rounds import LocalRoundsSimulator
 
 ROOT = Path(__file__).resolve().parents[1]
+
+
+def drawn_on_causal_32(count: int, seed: int = 0) -> Scenario:
+    """``count`` robots on ``examples/causal-32.yaml``'s map, starts and goals drawn from its free cells with ``seed``
+    (``bench/live_pibt.py``'s ``udp64`` case draws its 64 robots so)."""
+    scenario = load_scenario(ROOT / "examples" / "causal-32.yaml")
+    grid = scenario.grid
+    free = [(x, y) for x in range(grid.x_size) for y in range(grid.y_size) if grid.is_free((x, y))]
+    rng = random.Random(seed)
+    starts, goals = rng.sample(free, count), rng.sample(free, count)
+    robots = tuple(RobotSpec(f"r{i}", start, goal) for i, (start, goal) in enumerate(zip(starts, goals, strict=True)))
+    return scenario.with_changes(robots=robots)
 
 
 def case_scenario(case: str, synchronizer: str, body: str) -> Scenario:
@@ -63,6 +77,8 @@ def case_scenario(case: str, synchronizer: str, body: str) -> Scenario:
     if name == "causal-32":
         loaded = load_scenario(ROOT / "examples" / "causal-32.yaml")
         loaded = loaded.with_changes(robots=loaded.robots[:robots])
+    elif name == "causal-32-drawn":
+        loaded = drawn_on_causal_32(robots)
     else:
         loaded = load_movingai_scenario(ROOT / "maps" / f"{name}.map", ROOT / "maps" / f"{name}-random-1.scen", robots)
     policy = PolicyOptions(name="pibt", synchronizer=synchronizer, body=body, swap=body == "omni")
