@@ -16,7 +16,7 @@ import pytest
 from polling import PATIENCE, drain, receive_expected, receive_within
 
 from mrmp.live.transport import (
-    COUNT,
+    MAX_MULTICAST_DATAGRAM_BYTES,
     MAX_NAMED,
     FaultyTransport,
     LiveFaults,
@@ -27,7 +27,6 @@ from mrmp.live.transport import (
     with_faults,
 )
 from mrmp.live.transport_entry import free_ports
-from mrmp.protocol.auth import MAX_DATAGRAM_BYTES
 
 LOOPBACK = "127.0.0.1"
 
@@ -74,7 +73,7 @@ class TakesEverything(UdpMulticastTransport):
     """Broken: takes in every datagram of the group, whoever it is headed for."""
 
     def receive(self, timeout):
-        data = self._receive_datagram(timeout, COUNT.size * (1 + MAX_NAMED) + MAX_DATAGRAM_BYTES + 1)
+        data = self._receive_datagram(timeout, MAX_MULTICAST_DATAGRAM_BYTES + 1)
         if data is None:
             return None
         return data[read_head(data, None)[1] :]
@@ -155,7 +154,7 @@ class ListenerOfHeads(UdpMulticastTransport):
         super().__init__(group, LOOPBACK)
 
     def receive(self, timeout):
-        data = self._receive_datagram(timeout, COUNT.size * (1 + MAX_NAMED) + MAX_DATAGRAM_BYTES + 1)
+        data = self._receive_datagram(timeout, MAX_MULTICAST_DATAGRAM_BYTES + 1)
         return None if data is None else read_head(data, None)
 
 

@@ -238,6 +238,8 @@ COUNT = struct.Struct("!H")
 """The head of every multicast datagram starts with how many robots it names (0: it is for every robot)."""
 MAX_NAMED = 128
 """The most robots one multicast datagram names: a message for more goes as several datagrams."""
+MAX_MULTICAST_DATAGRAM_BYTES = COUNT.size * (1 + MAX_NAMED) + MAX_DATAGRAM_BYTES
+"""The longest multicast datagram a robot sends: the longest head, then the longest sealed message."""
 
 
 def recipients_head(recipients: tuple[int, ...]) -> bytes:
@@ -354,7 +356,7 @@ class UdpMulticastTransport(_UdpSocket):
         and the opener rejects it and counts it.
         """
         while True:
-            data = self._receive_datagram(timeout, COUNT.size * (1 + MAX_NAMED) + MAX_DATAGRAM_BYTES + 1)
+            data = self._receive_datagram(timeout, MAX_MULTICAST_DATAGRAM_BYTES + 1)  # one byte more: oversized shows
             if data is None:
                 return None
             head = read_head(data, self.fleet_size)
@@ -490,16 +492,15 @@ class FaultySeveralTransport(FaultyTransport):
         self.several: SeveralAtOnce = inner
 
     def send_to_several(self, data: bytes, recipients: tuple[int, ...]) -> None:
-        now: list[list[int]] = [[], []]  # the first and second copies due at once (duplication makes two)
+        due_now: dict[int, list[int]] = {}  # by copy (duplication makes a second): the robots it is due to at once
         for recipient in recipients:
             for copy, delay in enumerate(self._fates()):
                 if delay <= 0:
-                    now[copy].append(recipient)
+                    due_now.setdefault(copy, []).append(recipient)
                 else:
                     self._send_later(data, recipient, delay)
-        for named in now:
-            if named:
-                self.several.send_to_several(data, tuple(named))
+        for named in due_now.values():
+            self.several.send_to_several(data, tuple(named))
 
 
 def with_faults(transport: Transport, faults: LiveFaults, seed: int = 0) -> FaultyTransport:
