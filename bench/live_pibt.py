@@ -8,8 +8,9 @@ the cell time (at the run's time scale) and their ratio (the target: at most
 carried out by live bodies, with no time for messages) and its ratio, the live
 run's ideal (the longest single-robot path at that speed), moves,
 messages per move (each message counted once per robot it is for) and datagrams
-per move (what went on the wire: the same over UDP and Zenoh, one per message
-over multicast, which reaches several robots with one datagram), and the live robots' own counts (steps begun held, steps
+per move (what went on the wire: the same over UDP and Zenoh; over multicast,
+which reaches several robots with one datagram, one per message to every robot and
+one for the messages of a turn to named robots), and the live robots' own counts (steps begun held, steps
 abandoned, retransmissions). The machine's load (1-minute load average before
 and after each run, and the number of cores) is printed with every row: times
 are only comparable side by side on one machine.

@@ -27,10 +27,11 @@ mean messages and datagrams per move (one run's makespan swings with the order i
 messages come).
 
 ``--network multicast`` runs the fleet over a network on which one datagram
-reaches several named peers, as over ``UdpMulticastTransport``: a message for
-several peers is one datagram on the wire (each peer still misses it or not on
-its own), where unicast (UDP, Zenoh) sends one per peer. Messages per move count
-each message once per peer either way; datagrams per move count what goes on the wire.
+reaches several named peers, as over ``UdpMulticastTransport``: the messages a
+robot sends in one turn to named peers are one datagram on the wire (each peer
+still misses it or not on its own), where unicast (UDP, Zenoh) sends one per
+message and peer. Messages per move count each message once per peer either way;
+datagrams per move count what goes on the wire.
 
 Usage: python bench/live_virtual.py [--cases random-64-64-10:200,random-64-64-10:1000] [--loss 0.1]
        [--time-scale 5] [--synchronizer clock|local] [--body omni|turning] [--turn-us 50] [--datagram-us 30]

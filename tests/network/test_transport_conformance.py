@@ -138,9 +138,9 @@ class TransportConformance:
         assert all(isinstance(robot, SeveralAtOnce) == several for robot in robots)
         if not several:
             return
-        robots[1].send_to_several(b"1 to 0 and 2", (0, 2))
+        robots[1].send_together([(b"1 to 0 and 2", (0, 2)), (b"1 to 2", (2,))])
         for index, robot in enumerate(robots):
-            expected = [b"1 to 0 and 2"] if index != 1 else []
+            expected = {0: [b"1 to 0 and 2"], 1: [], 2: [b"1 to 0 and 2", b"1 to 2"]}[index]
             assert receive_expected(robot, expected) == Counter(expected), f"robot {index}"
 
     def test_a_burst_to_one_peer_arrives_whole(self, stack, fleet):

@@ -15,15 +15,13 @@ from collections import Counter
 import pytest
 from polling import PATIENCE, drain, receive_expected, receive_within
 
+from mrmp.live.multicast_wire import MAX_MULTICAST_DATAGRAM_BYTES, MAX_NAMED, read_head, read_sections
 from mrmp.live.transport import (
-    MAX_MULTICAST_DATAGRAM_BYTES,
-    MAX_NAMED,
     FaultyTransport,
     LiveFaults,
     SeveralAtOnce,
     UdpMulticastTransport,
     UdpTransport,
-    read_head,
     with_faults,
 )
 from mrmp.live.transport_entry import free_ports
@@ -70,13 +68,16 @@ def free_group():
 
 
 class TakesEverything(UdpMulticastTransport):
-    """Broken: takes in every datagram of the group, whoever it is headed for."""
+    """Broken: takes in every message of the group, whoever it is headed for."""
 
     def receive(self, timeout):
-        data = self._receive_datagram(timeout, MAX_MULTICAST_DATAGRAM_BYTES + 1)
-        if data is None:
-            return None
-        return data[read_head(data, None)[1] :]
+        while not self._taken:
+            data = self._receive_datagram(timeout, MAX_MULTICAST_DATAGRAM_BYTES + 1)
+            if data is None:
+                return None
+            sections = read_sections(data, None)
+            self._taken.extend([data[read_head(data, None)[1] :]] if sections is None else [message for _, message in sections])
+        return self._taken.popleft()
 
 
 @pytest.mark.parametrize("broken", [False, True])
@@ -89,44 +90,50 @@ def test_a_multicast_robot_takes_in_only_what_is_sent_to_it_or_to_every_robot(br
     robots = [kind(group, LOOPBACK, index, fleet_size=4) for index in range(4)]
     try:
         robots[0].send(b"0 to 2", recipient=2)
-        robots[0].send_to_several(b"0 to 1 and 3", (1, 3))
+        robots[0].send_together([(b"0 to 1 and 3", (1, 3))])
+        robots[0].send_together([(b"0 to 3", (3,)), (b"0 to 1 and 2", (1, 2))])  # one datagram, for all three
         robots[0].send(b"0 to all")
         received = [receive_expected(robot, [b"0 to all"]) for robot in robots[1:]]
     finally:
         for robot in robots:
             robot.close()
     if broken:
-        assert received[0][b"0 to 2"] == 1
+        assert received[0][b"0 to 2"] == 1 and received[0][b"0 to 3"] == 1
     else:
         assert received == [
-            Counter([b"0 to 1 and 3", b"0 to all"]),
-            Counter([b"0 to 2", b"0 to all"]),
-            Counter([b"0 to 1 and 3", b"0 to all"]),
+            Counter([b"0 to 1 and 3", b"0 to 1 and 2", b"0 to all"]),
+            Counter([b"0 to 2", b"0 to 1 and 2", b"0 to all"]),
+            Counter([b"0 to 1 and 3", b"0 to 3", b"0 to all"]),
         ]
 
 
 class OneDatagramEach(UdpMulticastTransport):
-    """Broken: sends a message for several robots as one datagram per robot, as unicast does."""
+    """Broken: sends each message for each robot as a datagram of its own, as unicast does."""
 
-    def send_to_several(self, data, recipients):
-        for recipient in recipients:
-            self.send(data, recipient)
+    def send_together(self, messages):
+        for data, recipients in messages:
+            for recipient in recipients:
+                self.send(data, recipient)
 
 
 @pytest.mark.parametrize("broken", [False, True])
-def test_a_multicast_message_for_several_robots_is_one_datagram_on_the_wire(broken):
+def test_multicast_messages_sent_together_are_one_datagram_on_the_wire(broken):
     """What a robot counts as one datagram (``AgentReport.datagrams_sent``) is one: a listener of the group
-    that is no robot hears one datagram, naming both robots."""
+    that is no robot hears one datagram, whose sections name the robots of each message."""
     group = free_group()
     sender = (OneDatagramEach if broken else UdpMulticastTransport)(group, LOOPBACK, 0, fleet_size=3)
-    listener = UdpMulticastTransport(group, LOOPBACK)  # no robot: keeps every datagram, head and all
+    listener = RawListener(group)
     try:
-        sender.send_to_several(b"to 1 and 2", (1, 2))
-        heard = receive_expected(listener, [b"to 1 and 2"])
+        sender.send_together([(b"to 1 and 2", (1, 2)), (b"to 2", (2,))])
+        heard = [listener.receive(PATIENCE) for _ in range(3 if broken else 1)]
+        assert listener.receive(0.2) is None
     finally:
         sender.close()
         listener.close()
-    assert heard == (Counter([b"to 1 and 2", b"to 1 and 2"]) if broken else Counter([b"to 1 and 2"]))
+    if broken:
+        assert [read_head(data, None)[0] for data in heard] == [(1,), (2,), (2,)]
+    else:
+        assert read_sections(heard[0], 3) == [((1, 2), b"to 1 and 2"), ((2,), b"to 2")]
 
 
 def test_a_multicast_message_for_more_robots_than_a_head_names_goes_in_as_few_datagrams_as_it_can():
@@ -134,27 +141,51 @@ def test_a_multicast_message_for_more_robots_than_a_head_names_goes_in_as_few_da
     fleet = 2 * MAX_NAMED + 3
     sender = UdpMulticastTransport(group, LOOPBACK, 0, fleet_size=fleet)
     last = UdpMulticastTransport(group, LOOPBACK, fleet - 1, fleet_size=fleet)
-    listener = ListenerOfHeads(group)
+    listener = RawListener(group)
     try:
-        sender.send_to_several(b"to everyone else", tuple(range(1, fleet)))
+        sender.send_together([(b"to everyone else", tuple(range(1, fleet)))])
         assert receive_expected(last, [b"to everyone else"]) == Counter([b"to everyone else"])
-        heads = [listener.receive(PATIENCE) for _ in range(3)]
+        heard = listener.receive(PATIENCE)
+        assert listener.receive(0.2) is None
     finally:
         for transport in (sender, last, listener):
             transport.close()
-    assert [named for named, _ in heads] == [
+    assert [named for named, _ in read_sections(heard, fleet)] == [  # one datagram: three heads
         tuple(range(1, MAX_NAMED + 1)), tuple(range(MAX_NAMED + 1, 2 * MAX_NAMED + 1)), (2 * MAX_NAMED + 1, 2 * MAX_NAMED + 2)
     ]
 
 
-class ListenerOfHeads(UdpMulticastTransport):
-    """A listener of the group that reads each datagram's head: the robots it names, and where its payload starts."""
+def test_multicast_messages_that_do_not_fit_in_one_datagram_go_in_more():
+    group = free_group()
+    sender = UdpMulticastTransport(group, LOOPBACK, 0, fleet_size=3)
+    robot = UdpMulticastTransport(group, LOOPBACK, 1, fleet_size=3)
+    listener = RawListener(group)
+    long = [bytes([number]) * 500 for number in range(3)]
+    try:
+        sender.send_together([(data, (1,)) for data in long])
+        assert receive_expected(robot, long) == Counter(long)
+        heard = [listener.receive(PATIENCE) for _ in range(3)]
+    finally:
+        for transport in (sender, robot, listener):
+            transport.close()
+    assert all(len(data) <= MAX_MULTICAST_DATAGRAM_BYTES for data in heard)
+
+
+class RawListener(UdpMulticastTransport):
+    """A listener of the group that keeps each datagram as it came, heads and all."""
 
     def __init__(self, group):
         super().__init__(group, LOOPBACK)
 
     def receive(self, timeout):
-        data = self._receive_datagram(timeout, MAX_MULTICAST_DATAGRAM_BYTES + 1)
+        return self._receive_datagram(timeout, MAX_MULTICAST_DATAGRAM_BYTES + 1)
+
+
+class ListenerOfHeads(RawListener):
+    """A listener of the group that reads each datagram's head: the robots it names, and where its payload starts."""
+
+    def receive(self, timeout):
+        data = super().receive(timeout)
         return None if data is None else read_head(data, None)
 
 
@@ -165,7 +196,7 @@ def test_faults_on_multicast_give_each_named_robot_its_own_fate_and_still_send_o
     faulty = with_faults(inner, LiveFaults(duplicate=1.0), seed=3)
     try:
         assert isinstance(faulty, SeveralAtOnce)
-        faulty.send_to_several(b"twice to 1 and 2", (1, 2))
+        faulty.send_together([(b"twice to 1 and 2", (1, 2))])
         heads = [listener.receive(PATIENCE) for _ in range(2)]
     finally:
         faulty.close()
@@ -173,7 +204,7 @@ def test_faults_on_multicast_give_each_named_robot_its_own_fate_and_still_send_o
     assert [named for named, _ in heads] == [(1, 2), (1, 2)]  # two copies, each one datagram naming both
     assert (faulty.counts.sent, faulty.counts.duplicated) == (2, 2)  # a fate per named robot
     lossy = with_faults(UdpMulticastTransport(group, LOOPBACK, 0, fleet_size=3), LiveFaults(loss=1.0), seed=3)
-    lossy.send_to_several(b"lost", (1, 2))
+    lossy.send_together([(b"lost", (1, 2))])
     assert (lossy.counts.sent, lossy.counts.lost) == (2, 2)
     lossy.close()
     assert not isinstance(with_faults(UdpTransport((LOOPBACK, 0), {}), LiveFaults(loss=0.5)), SeveralAtOnce)

@@ -33,10 +33,13 @@ Examples
 
 from __future__ import annotations
 
+import functools
 import queue
 import threading
+from collections.abc import Callable, Sequence
 from typing import Protocol
 
+from mrmp.live.multicast_wire import Addressed
 from mrmp.live.transport import SeveralAtOnce
 
 
@@ -62,7 +65,8 @@ class ClientThread:
     def __init__(self, transport: Sending, name: str) -> None:
         self.transport = transport
         self._several = transport if isinstance(transport, SeveralAtOnce) else None
-        self._queue: queue.SimpleQueue[tuple[bytes, int | tuple[int, ...] | None] | None] = queue.SimpleQueue()
+        self._queue: queue.SimpleQueue[Callable[[], None] | None] = queue.SimpleQueue()
+        """The sendings queued, in order; None ends the thread."""
         self._thread = threading.Thread(target=self._run, name=name, daemon=True)
         self._failure: Exception | None = None
         self._closed = False
@@ -74,7 +78,7 @@ class ClientThread:
 
     @property
     def reaches_several(self) -> bool:
-        """Whether one datagram reaches several peers (:meth:`send_to_several`): the transport's can."""
+        """Whether one datagram reaches several peers (:meth:`send_together`): the transport's can."""
         return self._several is not None
 
     def start(self) -> None:
@@ -91,19 +95,19 @@ class ClientThread:
         RuntimeError
             If the client is closed.
         """
-        self._queue_datagram(data, recipient)
+        self._queue_sending(functools.partial(self.transport.send, data, recipient))
 
-    def send_to_several(self, data: bytes, recipients: tuple[int, ...]) -> None:
-        """Queue ``data`` for ``recipients``, one datagram for all (only when :attr:`reaches_several`), and return."""
-        if not self.reaches_several:
+    def send_together(self, messages: Sequence[Addressed]) -> None:
+        """Queue ``messages``, each for the peers it names, to go together (only when :attr:`reaches_several`)."""
+        if self._several is None:
             raise TypeError(f"{self.name}'s transport does not reach several peers with one datagram")
-        self._queue_datagram(data, recipients)
+        self._queue_sending(functools.partial(self._several.send_together, list(messages)))
 
-    def _queue_datagram(self, data: bytes, recipient: int | tuple[int, ...] | None) -> None:
+    def _queue_sending(self, sending: Callable[[], None]) -> None:
         self._raise_failure()
         if self._closed:
             raise RuntimeError(f"{self.name} is closed")
-        self._queue.put((data, recipient))
+        self._queue.put(sending)
 
     def close(self, timeout: float = 2.0) -> None:
         """Send what is queued, end the thread (waiting at most ``timeout`` seconds), and raise its error if any."""
@@ -121,16 +125,11 @@ class ClientThread:
 
     def _run(self) -> None:
         while True:
-            item = self._queue.get()
-            if item is None:
+            sending = self._queue.get()
+            if sending is None:
                 return
-            data, recipient = item
             try:
-                if isinstance(recipient, tuple):
-                    assert self._several is not None  # send_to_several queues only then
-                    self._several.send_to_several(data, recipient)
-                else:
-                    self.transport.send(data, recipient)
+                sending()
             except Exception as error:  # handed to the main loop, which ends the run with it
                 self._failure = error
                 return

@@ -20,7 +20,8 @@ body has scheduled (``_due``), a heartbeat, the progress report or the end of
 the linger. A robot waiting, arrived or not, therefore costs little CPU time:
 dozens of robot processes share a few cores. UDP unicast has no radio, so a
 radius broadcast (an :class:`~mrmp.robot.messaging.Outgoing` with ``radius``)
-goes to the peers the brain believes within the radius; for discovery, the
+goes to the peers the brain believes within the radius; over multicast, the
+messages of one turn for named peers go together in one datagram (:meth:`LiveDriver._send`); for discovery, the
 state goes to every peer once every ``fleet_heartbeat`` seconds. A peer is
 believed within the radius when its last known cell is, widened by the cells it
 can have driven since it was heard (:func:`believed_near`), so a robot coming
@@ -47,14 +48,16 @@ silent for ``give_up_after`` seconds, on timeout, or on a stop request.
 
 from __future__ import annotations
 
+import contextlib
+import functools
 import math
 import queue
 import threading
 import time
 from collections import Counter
-from collections.abc import Callable, Iterable
+from collections.abc import Callable, Iterable, Iterator, Sequence
 from dataclasses import dataclass, field
-from typing import Any, Protocol
+from typing import Any, Concatenate, ParamSpec, Protocol, TypeVar
 
 from mrmp.core.cell import Cell
 from mrmp.core.errors import MrmpError
@@ -63,10 +66,27 @@ from mrmp.core.scenario import Scenario
 from mrmp.core.seeds import Stream, stream_random
 from mrmp.live.body import Body, TurnsInPlace
 from mrmp.live.client_thread import ClientThread
+from mrmp.live.multicast_wire import Addressed, count_together
 from mrmp.live.transport import FaultyTransport, Transport
 from mrmp.protocol.auth import Opener, Sealer
 from mrmp.protocol.messages import HelloMessage, Message
 from mrmp.robot.robot import Outgoing
+
+_Arguments = ParamSpec("_Arguments")
+_Returned = TypeVar("_Returned")
+
+
+def _one_turn(
+    method: Callable[Concatenate[LiveDriver, _Arguments], _Returned],
+) -> Callable[Concatenate[LiveDriver, _Arguments], _Returned]:
+    """A turn of a driver's main loop: its messages for named peers go together at its end (:meth:`LiveDriver._send`)."""
+
+    @functools.wraps(method)
+    def turn(driver: LiveDriver, *arguments: _Arguments.args, **keywords: _Arguments.kwargs) -> _Returned:
+        with driver._messages_together():
+            return method(driver, *arguments, **keywords)
+
+    return turn
 
 
 @dataclass(frozen=True)
@@ -245,15 +265,16 @@ class Sending(Protocol):
 
     @property
     def reaches_several(self) -> bool:
-        """Whether one datagram reaches several named peers (multicast), and :meth:`send_to_several` may be called."""
+        """Whether one datagram reaches several named peers (multicast), and :meth:`send_together` may be called."""
         ...
 
     def send(self, data: bytes, recipient: int | None) -> None:
         """Send ``data`` to ``recipient`` (every peer when None)."""
         ...
 
-    def send_to_several(self, data: bytes, recipients: tuple[int, ...]) -> None:
-        """Send ``data`` to ``recipients`` in one datagram."""
+    def send_together(self, messages: Sequence[Addressed]) -> None:
+        """Send ``messages``, each to the peers it names, in as few datagrams as they fit in
+        (:func:`~mrmp.live.multicast_wire.count_together` says how many)."""
         ...
 
     def close(self) -> None:
@@ -284,8 +305,9 @@ class AgentReport:
     """Messages sent (per recipient) by message type (``StateMessage``, ``ClaimMessage``...)."""
     bytes_sent: int = 0
     datagrams_sent: int = 0
-    """Datagrams the robot put on the wire: one per recipient over unicast (as :attr:`messages_sent`), one per
-    message over multicast, which reaches every peer or several named ones with one datagram."""
+    """Datagrams the robot put on the wire: one per recipient over unicast (as :attr:`messages_sent`); over
+    multicast, one per message to every peer, and one for the messages of a turn to named peers, which go
+    together (as many more as they need when they do not fit in one)."""
     messages_received: int = 0
     rejected: dict[str, int] = field(default_factory=dict)
     faults: dict[str, int] = field(default_factory=dict)
@@ -390,6 +412,10 @@ class LiveDriver:
         self._hellos = HelloSchedule((), 0.0, timing.heartbeat, timing.fleet_heartbeat)
         """While waiting for the fleet: when each peer not heard from is asked for its state."""
         self._turning = False  # the body's action in progress is a turn in place, not a move
+        self._together: list[Addressed] = []
+        """Over multicast, the messages for named peers sent in this turn so far: they go together at its end."""
+        self._turns_open = 0
+        """How many of :meth:`begin_run`, :meth:`turn` and :meth:`fleet_wait_turn` are running (one calls another)."""
 
     # -- what a policy's driver supplies ----------------------------------------------------
 
@@ -567,7 +593,14 @@ class LiveDriver:
     # -- sending ---------------------------------------------------------------------------
 
     def _send(self, outgoing: list[Outgoing]) -> None:
-        """Seal each message and queue it for the client thread, counting it as sent."""
+        """Seal each message and queue it for the client thread, counting it as sent.
+
+        Over a transport that reaches several peers with one datagram
+        (multicast), the messages for named peers wait for the end of the
+        turn and go together (:meth:`_send_together`); a message to every
+        peer goes at once, after those that wait, so that the order of
+        sending stays the order of the brain's messages.
+        """
         report, client = self.report, self._client
         by_kind = report.sent_by_kind
         for item in outgoing:
@@ -577,19 +610,42 @@ class LiveDriver:
                 near = self._believed_within(item.radius)
                 item = item._replace(recipients=(*near, *(peer for peer in item.recipients or () if peer not in near)))
             if item.recipients is None:
+                self._send_together()
                 client.send(data, None)
-                messages, datagrams = self._peers, 1 if client.reaches_several else self._peers
-            elif len(item.recipients) > 1 and client.reaches_several:
-                client.send_to_several(data, item.recipients)
-                messages, datagrams = len(item.recipients), 1
+                messages = self._peers
+                report.datagrams_sent += 1 if client.reaches_several else messages
+            elif client.reaches_several:
+                messages = len(item.recipients)
+                if messages:
+                    self._together.append((data, item.recipients))
             else:
                 for recipient in item.recipients:
                     client.send(data, recipient)
-                messages = datagrams = len(item.recipients)
+                messages = len(item.recipients)
+                report.datagrams_sent += messages
             report.messages_sent += messages
             by_kind[kind] = by_kind.get(kind, 0) + messages
-            report.datagrams_sent += datagrams
             report.bytes_sent += len(data) * messages
+        if not self._turns_open:
+            self._send_together()
+
+    def _send_together(self) -> None:
+        """Send the messages waiting to go together (:meth:`_send`), counting their datagrams."""
+        if self._together:
+            together, self._together = self._together, []
+            self._client.send_together(together)
+            self.report.datagrams_sent += count_together(together)
+
+    @contextlib.contextmanager
+    def _messages_together(self) -> Iterator[None]:
+        """While this is open, messages for named peers wait (:meth:`_send`); they go when the outermost closes."""
+        self._turns_open += 1
+        try:
+            yield
+        finally:
+            self._turns_open -= 1
+            if not self._turns_open:
+                self._send_together()
 
     # -- the main loop ---------------------------------------------------------------------
 
@@ -624,6 +680,7 @@ class LiveDriver:
                 self.fill_report(clock())
         return self.report
 
+    @_one_turn
     def begin_run(
         self, now: float, on_progress: Callable[[AgentReport], None] | None = None, progress_every: float = 1.0
     ) -> None:
@@ -641,6 +698,7 @@ class LiveDriver:
         self._loop = _RunTimes(now, now, now, now, linger, on_progress, progress_every)
         self._begin(now)
 
+    @_one_turn
     def turn(self, now: float) -> float | None:
         """One turn of the main loop at ``now``; when to wake for the next (:meth:`wake_rule`), or None: the run is over.
 
@@ -712,6 +770,7 @@ class LiveDriver:
         self._fleet_wait = _FleetWait(now + self.timing.start_wait, -math.inf, unheard)
         self._hellos = HelloSchedule(unheard, now, self.timing.heartbeat, self.timing.fleet_heartbeat)
 
+    @_one_turn
     def fleet_wait_turn(self, now: float) -> float | None:
         """One turn of the wait for the fleet: send the state, and answer, until every peer has been heard (or
         ``start_wait`` passes); when to wake for the next turn, or None: the wait is over.

@@ -28,6 +28,7 @@ from dataclasses import dataclass, field
 from typing import Protocol, runtime_checkable
 
 from mrmp.live.driver import AgentReport, LiveDriver
+from mrmp.live.multicast_wire import Addressed
 from mrmp.live.transport import SeveralAtOnce, Transport
 
 __all__ = ["STOP_LATENCY", "Hosted", "Selectable", "run_hosted"]
@@ -76,10 +77,10 @@ class _Direct:
     def send(self, data: bytes, recipient: int | None) -> None:
         self.transport.send(data, recipient)
 
-    def send_to_several(self, data: bytes, recipients: tuple[int, ...]) -> None:
+    def send_together(self, messages: Sequence[Addressed]) -> None:
         if self._several is None:
             raise TypeError(f"{type(self.transport).__name__} does not reach several peers with one datagram")
-        self._several.send_to_several(data, recipients)
+        self._several.send_together(messages)
 
     def close(self) -> None:
         """Nothing queued."""

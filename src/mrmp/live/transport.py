@@ -20,6 +20,7 @@ which says how to configure, open and launch it.
 from __future__ import annotations
 
 import contextlib
+import functools
 import heapq
 import ipaddress
 import random
@@ -28,11 +29,20 @@ import struct
 import sys
 import threading
 import time
-from collections.abc import Mapping
+from collections import deque
+from collections.abc import Callable, Mapping, Sequence
 from dataclasses import dataclass
 from typing import Protocol, runtime_checkable
 
 from mrmp.core.faults import message_fates
+from mrmp.live.multicast_wire import (
+    MAX_MULTICAST_DATAGRAM_BYTES,
+    Addressed,
+    datagrams_together,
+    groups_together,
+    payloads_for,
+    recipients_head,
+)
 from mrmp.protocol.auth import MAX_DATAGRAM_BYTES
 
 Address = tuple[str, int]
@@ -59,8 +69,9 @@ class SeveralAtOnce(Protocol):
     """A transport that reaches several named peers with one datagram (multicast: every robot of the group
     hears it, and each named robot takes it in); a unicast transport sends one datagram per peer instead."""
 
-    def send_to_several(self, data: bytes, recipients: tuple[int, ...]) -> None:
-        """Send ``data`` to the peers ``recipients``, one datagram for all of them."""
+    def send_together(self, messages: Sequence[Addressed]) -> None:
+        """Send ``messages``, each to the peers it names, in as few datagrams as they fit in
+        (:func:`~mrmp.live.multicast_wire.datagrams_together`): one, unless they are long or name very many."""
         ...
 
 
@@ -234,44 +245,6 @@ IP_MULTICAST_ALL = getattr(socket, "IP_MULTICAST_ALL", 49)
 """Linux's socket option (``<linux/in.h>``) that, set to 0, limits a socket to the groups it joined itself."""
 
 
-COUNT = struct.Struct("!H")
-"""The head of every multicast datagram starts with how many robots it names (0: it is for every robot)."""
-MAX_NAMED = 128
-"""The most robots one multicast datagram names: a message for more goes as several datagrams."""
-MAX_MULTICAST_DATAGRAM_BYTES = COUNT.size * (1 + MAX_NAMED) + MAX_DATAGRAM_BYTES
-"""The longest multicast datagram a robot sends: the longest head, then the longest sealed message."""
-
-
-def recipients_head(recipients: tuple[int, ...]) -> bytes:
-    """The head of a multicast datagram for ``recipients`` (none: every robot): their count, then each index.
-
-    >>> recipients_head(()).hex(), recipients_head((2, 5)).hex()
-    ('0000', '000200020005')
-    """
-    return struct.pack(f"!H{len(recipients)}H", len(recipients), *recipients)
-
-
-def read_head(data: bytes, fleet_size: int | None) -> tuple[tuple[int, ...], int] | None:
-    """The robots a multicast datagram names (none: every robot) and where its payload starts; None if its head
-    names no robot of the fleet (too short, more robots than the fleet has, or an index outside it).
-
-    >>> read_head(recipients_head((1, 3)) + b"payload", 4)
-    ((1, 3), 6)
-    >>> read_head(b"hello", 4) is None     # a stranger's datagram: "he" would name 26,725 robots
-    True
-    """
-    if len(data) < COUNT.size:
-        return None
-    (count,) = COUNT.unpack_from(data)
-    end = COUNT.size * (1 + count)
-    if len(data) < end or (fleet_size is not None and count > fleet_size):
-        return None
-    named = struct.unpack_from(f"!{count}H", data, COUNT.size)
-    if fleet_size is not None and any(index >= fleet_size for index in named):
-        return None
-    return named, end
-
-
 class UdpMulticastTransport(_UdpSocket):
     """UDP multicast: every robot joins one group; every datagram goes to all of them.
 
@@ -283,9 +256,10 @@ class UdpMulticastTransport(_UdpSocket):
     was sent to it or to every robot (it also hears its own datagrams to every
     robot, and drops them). Without it, a robot would take a message meant for
     another (an acknowledgement of a sequence number that happens to be one of
-    its own, a request to leave another robot's cell) for its own. A message
-    for several robots is one datagram naming them all (:meth:`send_to_several`),
-    where unicast sends one per robot.
+    its own, a request to leave another robot's cell) for its own. Messages
+    for several robots, sent together (:meth:`send_together`), are one datagram
+    naming them all, where unicast sends one per message and robot
+    (:mod:`mrmp.live.multicast_wire`).
 
     The socket is bound to the group's address, not to every address: on Linux
     it then receives only datagrams sent to the group, never one sent to any
@@ -333,39 +307,37 @@ class UdpMulticastTransport(_UdpSocket):
             raise
         self._socket = sock
         self._closed = False
+        self._taken: deque[bytes] = deque()
+        """Messages of a datagram received, not returned yet (a datagram may carry several for this robot)."""
 
     def send(self, data: bytes, recipient: int | None = None) -> None:
-        self._send_headed(data, () if recipient is None else (recipient,))
+        self._send_datagram(recipients_head(() if recipient is None else (recipient,)) + data)
 
-    def send_to_several(self, data: bytes, recipients: tuple[int, ...]) -> None:
-        """Send ``data`` to ``recipients`` in one datagram (one per :data:`MAX_NAMED` of them); none: nothing."""
-        for first in range(0, len(recipients), MAX_NAMED):
-            self._send_headed(data, recipients[first : first + MAX_NAMED])
+    def send_together(self, messages: Sequence[Addressed]) -> None:
+        for datagram, _ in datagrams_together(messages):
+            self._send_datagram(datagram)
 
-    def _send_headed(self, data: bytes, recipients: tuple[int, ...]) -> None:
+    def _send_datagram(self, datagram: bytes) -> None:
         with contextlib.suppress(OSError):
-            self._socket.sendto(recipients_head(recipients) + data, self.group)
+            self._socket.sendto(datagram, self.group)
 
     def receive(self, timeout: float) -> bytes | None:
-        """The next datagram for this robot or for every robot, its head removed, or None.
+        """The next message for this robot or for every robot, its head removed, or None.
 
-        A datagram for other robots of the fleet is dropped (they take it in,
-        or reject and count it), and what else waits is looked at without
-        waiting further (None when nothing does). One whose head names no robot
-        of the fleet (:func:`read_head`) is no robot's: it is handed on whole,
-        and the opener rejects it and counts it.
+        A datagram's messages for other robots of the fleet are dropped (they
+        take them in, or reject and count them), and when a datagram brings this
+        robot nothing, what else waits is looked at without waiting further
+        (None when nothing does). A datagram that names no robot of the fleet
+        is no robot's: it is handed on whole, and the opener rejects it and
+        counts it (:func:`~mrmp.live.multicast_wire.payloads_for`).
         """
-        while True:
+        while not self._taken:
             data = self._receive_datagram(timeout, MAX_MULTICAST_DATAGRAM_BYTES + 1)  # one byte more: oversized shows
             if data is None:
                 return None
-            head = read_head(data, self.fleet_size)
-            if head is None:
-                return data
-            named, payload = head
-            if not named or self.index is None or self.index in named:
-                return data[payload : payload + MAX_DATAGRAM_BYTES + 1]  # longer: cut, as unicast's reads cut it
+            self._taken.extend(payloads_for(data, self.index, self.fleet_size))
             timeout = 0.0
+        return self._taken.popleft()
 
 
 @dataclass(frozen=True)
@@ -408,7 +380,8 @@ class FaultyTransport:
         self.faults = faults
         self.counts = FaultCounts()
         self._random = random.Random(seed)
-        self._queue: list[tuple[float, int, bytes, int | None]] = []
+        self._queue: list[tuple[float, int, Callable[[], None]]] = []
+        """Sendings held back: when each is due, its order (ties keep it), and the sending."""
         self._order = 0
         self._wake = threading.Condition()
         self._closed = False
@@ -420,7 +393,7 @@ class FaultyTransport:
             if delay <= 0:
                 self.inner.send(data, recipient)
             else:
-                self._send_later(data, recipient, delay)
+                self._send_later(functools.partial(self.inner.send, data, recipient), delay)
 
     def _fates(self) -> list[float]:
         """Draw one datagram's fate: the delays of the copies delivered (none if it is lost), each counted."""
@@ -447,10 +420,11 @@ class FaultyTransport:
             delays.append(delay)
         return delays
 
-    def _send_later(self, data: bytes, recipient: int | None, delay: float) -> None:
+    def _send_later(self, sending: Callable[[], None], delay: float) -> None:
+        """Call ``sending`` from the background thread ``delay`` seconds from now."""
         with self._wake:
             self._order += 1
-            heapq.heappush(self._queue, (time.monotonic() + delay, self._order, data, recipient))
+            heapq.heappush(self._queue, (time.monotonic() + delay, self._order, sending))
             self._wake.notify()
 
     def _deliver_late(self) -> None:
@@ -463,8 +437,8 @@ class FaultyTransport:
                 if due > 0:
                     self._wake.wait(due)
                     continue
-                _, _, data, recipient = heapq.heappop(self._queue)
-                self.inner.send(data, recipient)
+                _, _, sending = heapq.heappop(self._queue)
+                sending()
 
     def receive(self, timeout: float) -> bytes | None:
         return self.inner.receive(timeout)
@@ -480,9 +454,10 @@ class FaultyTransport:
 class FaultySeveralTransport(FaultyTransport):
     """A :class:`FaultyTransport` around a transport that reaches several peers with one datagram (multicast).
 
-    Each named peer's copy meets its own fate, as each receiver of a
-    multicast datagram misses it or not on its own: the copies due at once go
-    as one datagram naming their peers, delayed ones each on its own.
+    Each named peer's copy of a datagram meets its own fate, as each receiver
+    of a multicast datagram misses it or not on its own: the copies due at
+    once go as one datagram naming their peers, with what it carries for them,
+    and delayed ones each on its own.
     """
 
     def __init__(self, inner: Transport, faults: LiveFaults, seed: int = 0) -> None:
@@ -491,16 +466,27 @@ class FaultySeveralTransport(FaultyTransport):
         super().__init__(inner, faults, seed)
         self.several: SeveralAtOnce = inner
 
-    def send_to_several(self, data: bytes, recipients: tuple[int, ...]) -> None:
-        due_now: dict[int, list[int]] = {}  # by copy (duplication makes a second): the robots it is due to at once
-        for recipient in recipients:
-            for copy, delay in enumerate(self._fates()):
-                if delay <= 0:
-                    due_now.setdefault(copy, []).append(recipient)
-                else:
-                    self._send_later(data, recipient, delay)
-        for named in due_now.values():
-            self.several.send_to_several(data, tuple(named))
+    def send_together(self, messages: Sequence[Addressed]) -> None:
+        for datagram in groups_together(messages):
+            due_now: dict[int, list[int]] = {}  # by copy (duplication makes a second): the robots it is due to at once
+            for recipient in dict.fromkeys(robot for _, named in datagram for robot in named):
+                for copy, delay in enumerate(self._fates()):
+                    if delay <= 0:
+                        due_now.setdefault(copy, []).append(recipient)
+                    else:
+                        self._send_later(functools.partial(self.several.send_together, only_for(datagram, {recipient})), delay)
+            for robots in due_now.values():
+                self.several.send_together(only_for(datagram, set(robots)))
+
+
+def only_for(messages: Sequence[Addressed], robots: set[int]) -> list[Addressed]:
+    """What of ``messages`` is for ``robots``: each message for any of them, naming only them.
+
+    >>> only_for([(b"a", (1, 2)), (b"b", (3,))], {2})
+    [(b'a', (2,))]
+    """
+    kept = ((data, tuple(robot for robot in named if robot in robots)) for data, named in messages)
+    return [(data, named) for data, named in kept if named]
 
 
 def with_faults(transport: Transport, faults: LiveFaults, seed: int = 0) -> FaultyTransport:

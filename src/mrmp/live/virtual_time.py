@@ -19,7 +19,10 @@ What the harness adds is what a real fleet has and a single process does not:
   ``latency`` plus a delay drawn from the faults' range, is lost or duplicated
   with the faults' probabilities (seeded), and goes to one peer or every peer,
   or (with ``multicast``, as a multicast group) to several named peers at once,
-  each of whom misses it or not on its own;
+  each of whom misses it or not on its own; over multicast the datagrams are
+  those of :class:`~mrmp.live.transport.UdpMulticastTransport`, heads and
+  all (:mod:`mrmp.live.multicast_wire`), and each robot takes in what they
+  carry for it as that transport does;
 * **a computer per robot**: a turn of a robot's main loop takes
   ``costs.turn`` seconds plus ``costs.datagram`` per datagram it took in or sent
   (:class:`ProcessingCosts`); its datagrams leave when the turn ends, and the
@@ -60,7 +63,7 @@ import os
 import random
 import threading
 import time
-from collections.abc import Iterator
+from collections.abc import Iterator, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -72,6 +75,7 @@ from mrmp.io.live_files import TraceWriter, read_json, write_json
 from mrmp.live.body import OccupancyRecorder
 from mrmp.live.driver import AgentTiming, LiveDriver
 from mrmp.live.launcher import check_tasks, run_timeout, with_desk
+from mrmp.live.multicast_wire import Addressed, datagrams_together, payloads_for, recipients_head
 from mrmp.live.process import LIVE_DRIVERS, DriverOptions, driver_kind, fleet_timing, run_referee, simulated_body
 from mrmp.live.results import live_result
 from mrmp.live.task_desk import TaskDesk
@@ -122,8 +126,9 @@ class VirtualOptions:
     latency: float = 200e-6
     """Seconds a datagram takes on a perfect network (loopback is about 50 microseconds, a wireless LAN a few ms)."""
     multicast: bool = False
-    """Whether one datagram reaches several named peers, as over multicast (the robots then send one datagram
-    where unicast sends one per peer: :attr:`~mrmp.live.driver.AgentReport.datagrams_sent`)."""
+    """Whether one datagram reaches several named peers, as over multicast (the robots then send the messages of
+    a turn for named peers together, where unicast sends one datagram per message and peer:
+    :attr:`~mrmp.live.driver.AgentReport.datagrams_sent`)."""
     costs: ProcessingCosts = field(default_factory=ProcessingCosts)
     timing: AgentTiming = field(default_factory=AgentTiming)
     timeout: float | None = None
@@ -186,10 +191,14 @@ class VirtualNetwork:
 
 
 class _Outbox:
-    """A virtual robot's datagrams of one turn, held until the turn's processing ends (:class:`~mrmp.live.driver.Sending`)."""
+    """A virtual robot's datagrams of one turn, held until the turn's processing ends (:class:`~mrmp.live.driver.Sending`).
+
+    Over multicast, each is the datagram the multicast transport would send, its head and all.
+    """
 
     def __init__(self, multicast: bool) -> None:
         self.datagrams: list[tuple[bytes, int | tuple[int, ...] | None]] = []
+        """Each datagram, and whom it reaches: one robot, several, or every one (None)."""
         self.multicast = multicast
 
     @property
@@ -200,12 +209,14 @@ class _Outbox:
         """Nothing to start: the harness sends."""
 
     def send(self, data: bytes, recipient: int | None) -> None:
+        if self.multicast:
+            data = recipients_head(() if recipient is None else (recipient,)) + data
         self.datagrams.append((data, recipient))
 
-    def send_to_several(self, data: bytes, recipients: tuple[int, ...]) -> None:
+    def send_together(self, messages: Sequence[Addressed]) -> None:
         if not self.multicast:
             raise TypeError("a unicast network does not reach several peers with one datagram")
-        self.datagrams.append((data, recipients))
+        self.datagrams.extend(datagrams_together(messages))
 
     def close(self) -> None:
         """Nothing to flush: the harness sends after every turn."""
@@ -315,7 +326,11 @@ class _VirtualFleet:
         if robot.done:
             self.to_ended += 1
             return  # its process has ended
-        robot.driver.take_datagram(data)
+        if self.options.multicast:
+            for message in payloads_for(data, recipient, len(self.robots)):
+                robot.driver.take_datagram(message)
+        else:
+            robot.driver.take_datagram(data)
         if robot.woken_by_messages and robot.wake_at > arrival:
             self._schedule(recipient, robot, max(arrival, robot.busy_until), woken_by_messages=False)
 
@@ -406,7 +421,7 @@ def run_virtual(scenario: Scenario, options: VirtualOptions) -> RunResult:
     body_issue = body_problem(scenario, live=True)
     if body_issue is not None:
         raise InputError(body_issue)
-    check_tasks(scenario, "udp", planned=False)
+    check_tasks(scenario, "multicast" if options.multicast else "udp", planned=False)
     try:
         options.results.mkdir(parents=True, exist_ok=True)
     except OSError as error:

@@ -18,7 +18,8 @@ it knows instead (``docs/protocol.md``, "Local sequencing", "Live"):
   before it starts or joins a call; the cells within 2 of those beacons are
   what a sensor would have seen;
 * beacons are not acknowledged: a robot that waits for a peer's beacon sends
-  its own to that peer again, every ``beacon_retry``, marked as *asking*
+  its own to that peer again, every ``beacon_retry`` (or at gaps doubling up
+  to ``longest_beacon_gap`` times that), marked as *asking*
   for the peer's; a robot answers such a beacon of this step, or one from a
   peer it did not send its own to, with its beacon (*pulling*). So the robot
   that needs a beacon keeps asking until it has it, and a peer that has this

@@ -165,6 +165,8 @@ class ReliablePibtRobot(LocalPibtRobot):
         self._unacknowledged: dict[int, _Unacknowledged] = {}
         self._beacon_seq = 0
         self._beacon_sent_at = 0
+        self._beacon_gap = beacon_retry
+        """How long after the beacon was last sent it is sent again (:attr:`longest_beacon_gap`)."""
         self._beacon_acks: set[int] = set()
         self._replies: list[Outgoing] = []
         self._deferred = False
@@ -182,6 +184,7 @@ class ReliablePibtRobot(LocalPibtRobot):
         self._unacknowledged = {}
         self._beacon_seq = self.seq
         self._beacon_sent_at = now
+        self._beacon_gap = self.beacon_retry
         self._beacon_acks = set()
         self._replies = []
         self._deferred = False
@@ -195,8 +198,9 @@ class ReliablePibtRobot(LocalPibtRobot):
         beacon: ``beacon_retry``)."""
         self._now = now
         out: list[Outgoing] = []
-        if not self._beacon_heard() and now - self._beacon_sent_at >= self.beacon_retry:
+        if not self._beacon_heard() and now - self._beacon_sent_at >= self._beacon_gap:
             self._beacon_sent_at = now
+            self._beacon_gap = min(2 * self._beacon_gap, self.longest_beacon_gap * self.beacon_retry)
             self.stats["retransmissions"] += 1
             out.append(Outgoing(self._beacon(), None, self.reach))
         for entry in self._unacknowledged.values():
@@ -251,6 +255,10 @@ class ReliablePibtRobot(LocalPibtRobot):
     acknowledges_beacons = True
     """Whether a beacon is acknowledged like any other message; the live brain asks for a missing beacon instead
     (:class:`~mrmp.robot.pibt_live.LivePibtRobot`)."""
+
+    longest_beacon_gap = 1
+    """In a step, the beacon is sent again ``beacon_retry`` after it was sent, then at gaps doubling up to this
+    many times ``beacon_retry`` (1: every ``beacon_retry``)."""
 
     def _acknowledge(self, message: PibtMessage) -> None:
         """Queue the acknowledgement of ``message``, with this robot's reservation (sent in :meth:`act`)."""

@@ -88,7 +88,8 @@ def test_a_lossy_crowd_of_turning_robots_is_run_and_judged_as_live(tmp_path):
 
 def test_over_multicast_a_message_for_several_peers_is_one_datagram_and_each_peer_misses_it_on_its_own(tmp_path):
     """The same lossy crossing over unicast and over a network where one datagram reaches several named peers: the
-    messages are those a fleet needs either way; on the wire, multicast puts fewer datagrams than messages."""
+    messages are those a fleet needs either way; on the wire, multicast puts fewer datagrams than messages (a turn's
+    messages for named peers go together)."""
     faults = LiveFaults(loss=0.2)
     runs = {
         multicast: run_virtual(crossing(), VirtualOptions(results=tmp_path / str(multicast), time_scale=10, faults=faults, multicast=multicast))
@@ -99,7 +100,8 @@ def test_over_multicast_a_message_for_several_peers_is_one_datagram_and_each_pee
     unicast, multicast = runs[False].network, runs[True].network
     assert unicast["datagrams_sent"] == unicast["messages_sent"]
     assert multicast["datagrams_sent"] < 0.8 * multicast["messages_sent"]
-    assert multicast["injected_lost"] > 0 and multicast["injected_sent"] == multicast["messages_sent"]  # a fate per peer
+    assert multicast["injected_lost"] > 0  # a fate per datagram and peer it reaches, a message for several peers
+    assert multicast["datagrams_sent"] < multicast["injected_sent"] <= multicast["messages_sent"]  # reaching each
 
 
 def test_a_body_the_policy_cannot_drive_live_is_refused(tmp_path):

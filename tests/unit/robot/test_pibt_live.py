@@ -299,6 +299,24 @@ def test_a_beacon_is_not_acknowledged_and_goes_again_only_to_ask_the_peers_whose
     assert [item.recipients for item in resent] == [(2,)] and c.index == 2  # only c's beacon is still missing
 
 
+@pytest.mark.parametrize("longest", [1, 2, 4])
+def test_asks_for_a_missing_beacon_come_at_gaps_doubling_up_to_the_longest(longest):
+    """A robot asks one ``beacon_retry`` after its step's beacon, then at gaps doubling up to ``longest_beacon_gap``
+    retries (a live robot over multicast asks every two: ``LONGEST_ASK_GAP_TOGETHER``)."""
+    flat, cells = line(8)
+    starts = [cells[2], cells[0]]
+    a = LivePibtRobot(0, starts[0], cells[7], flat, starts=starts, beacon_retry=10)
+    a.longest_beacon_gap = longest
+    a.begin_step(1)  # the peer's beacon never comes
+    asked = [now for now in range(0, 200) if any(isinstance(item.message, BeaconMessage) for item in a.on_tick(now))]
+    gaps = [later - earlier for earlier, later in zip(asked, asked[1:], strict=False)]
+    assert asked[0] == 10
+    assert gaps[:4] == {1: [10, 10, 10, 10], 2: [20, 20, 20, 20], 4: [20, 40, 40, 40]}[longest]
+    a.begin_step(2, now=200)  # a new step asks one beacon_retry after its beacon again
+    assert not any(isinstance(item.message, BeaconMessage) for item in a.on_tick(209))
+    assert any(isinstance(item.message, BeaconMessage) for item in a.on_tick(210))
+
+
 class DeafToAsking(LivePibtRobot):
     """Broken: answers a beacon only when it did not send its own to that peer, never because the beacon asks."""
 
