@@ -309,7 +309,7 @@ def test_asks_for_a_missing_beacon_come_at_gaps_doubling_up_to_the_longest(longe
     a.longest_beacon_gap = longest
     a.begin_step(1)  # the peer's beacon never comes
     asked = [now for now in range(0, 200) if any(isinstance(item.message, BeaconMessage) for item in a.on_tick(now))]
-    gaps = [later - earlier for earlier, later in zip(asked, asked[1:], strict=False)]
+    gaps = [later - earlier for earlier, later in itertools.pairwise(asked)]
     assert asked[0] == 10
     assert gaps[:4] == {1: [10, 10, 10, 10], 2: [20, 20, 20, 20], 4: [20, 40, 40, 40]}[longest]
     a.begin_step(2, now=200)  # a new step asks one beacon_retry after its beacon again
