@@ -159,7 +159,7 @@ def payloads_for(data: bytes, robot: int | None, fleet_size: int | None) -> list
     >>> payloads_for(b"hello", 1, 4)     # a stranger's datagram
     [b'hello']
     """
-    if len(data) >= COUNT.size and COUNT.unpack_from(data)[0] == TOGETHER:
+    if _is_together(data):
         sections = read_sections(data, fleet_size)
         if sections is None:
             return [data]
@@ -211,7 +211,7 @@ def read_sections(data: bytes, fleet_size: int | None) -> list[tuple[tuple[int, 
     >>> read_sections(recipients_head((1,)) + b"a", fleet_size=4) is None
     True
     """
-    if len(data) < COUNT.size or COUNT.unpack_from(data)[0] != TOGETHER:
+    if not _is_together(data):
         return None
     sections = []
     offset = COUNT.size
@@ -227,3 +227,8 @@ def read_sections(data: bytes, fleet_size: int | None) -> list[tuple[tuple[int, 
         sections.append((named, data[start : start + length]))
         offset = start + length
     return sections or None
+
+
+def _is_together(data: bytes) -> bool:
+    """Whether ``data`` starts as a datagram of several messages does (:data:`TOGETHER`)."""
+    return len(data) >= COUNT.size and COUNT.unpack_from(data)[0] == TOGETHER
