@@ -101,6 +101,19 @@ class Handlers:
         """The method (unbound) that takes in ``message``, or None when the brain has none for its type."""
         return self._table.get(type(message))
 
+    def table(self) -> dict[type, Callable[..., Any]]:
+        """The table itself, from message type to method (unbound), for a brain that looks types up on every message.
+
+        >>> class Echo:
+        ...     handlers = Handlers()
+        ...     @handlers.on(ClaimMessage)
+        ...     def _take_claim(self, message, now):
+        ...         return []
+        >>> [kind.__name__ for kind in Echo.handlers.table()]
+        ['ClaimMessage']
+        """
+        return self._table
+
     def copy(self) -> Handlers:
         """A copy of the table, for a subclass whose brain takes some types of message in its own way.
 

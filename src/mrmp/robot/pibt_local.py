@@ -201,6 +201,8 @@ class LocalPibtRobot(PibtRobot):
         self._before = 0.0  # distance to the goal at the start of the step
         self._nearest = 0.0  # the nearest it has been to ``_nearest_goal`` (with ``stall_from_best``)
         self._nearest_goal: int | None = None
+        self._wound_wait = self.preempts and not self.turning  # :meth:`_preempts`, read on every act
+        self._informing = self.informing.table()
 
     # -- the step ------------------------------------------------------------------
 
@@ -208,8 +210,9 @@ class LocalPibtRobot(PibtRobot):
         """Start step ``step``: forget the last step's view, announce cell, goal and priority; act next round."""
         out = super().begin_step(step)
         self._before = self.flat.distances(self.goal)[self.present]
-        reach = self.reach = min(self.radius + max(0, self.stalled - self.stall_slack), max(self.radius, self.reach_cap))
-        if reach != self.radius:
+        radius, grown = self.radius, self.stalled - self.stall_slack
+        reach = self.reach = radius if grown <= 0 else min(radius + grown, max(radius, self.reach_cap))
+        if reach != radius:
             out = [Outgoing(item.message, None, reach) for item in out]
         self._ranks = {}
         self._near = []
@@ -235,26 +238,33 @@ class LocalPibtRobot(PibtRobot):
 
     def receive_once(self, message: Message) -> bool:
         """Take in one message (see :meth:`PibtRobot.receive`); True when the robot should act on it this round."""
-        inform = self.informing.get(message)
+        inform = self._informing.get(type(message))  # :meth:`Handlers.get`, inlined: this runs for every message heard
         if inform is not None:
             return bool(inform(self, message))
         self._control.append(message)
         return True
 
     def receive_beacons(self, beacons: list[BeaconMessage]) -> None:
-        """Take in beacons: cells, goals and priorities; note the robots within 2 cells."""
-        super().receive_beacons(beacons)
+        """Take in beacons: cells, goals and priorities (:meth:`PibtRobot.receive_beacons`); note the robots within 2 cells."""
+        occupants, goals, settled = self._occupants, self._goals, self._settled
         ranks, near, listeners, waiters = self._ranks, self._near, self._listeners, self._waiters
+        y_size = self._y_size
         x, y = self.flat.cells[self.present]
         mine = self._own_rank
         above = 0
-        for message in beacons:
+        for message in beacons:  # one loop for both classes' bookkeeping: this runs for every beacon heard
             sender = message.sender
+            there_x, there_y = message.present
+            cell = there_x * y_size + there_y
+            goal_x, goal_y = message.goal
+            goal = goals[sender] = goal_x * y_size + goal_y
+            occupants[cell] = sender
+            if cell == goal:
+                settled.add(cell)
             rank = ranks[sender] = (message.elapsed, message.tie, -sender)
             near.append(sender)  # the radio brings a beacon only within its sender's reach
             if rank > mine:
                 above += 1
-            there_x, there_y = message.present
             if abs(there_x - x) + abs(there_y - y) <= RESERVE_RADIUS:
                 listeners.append(sender)
             elif rank < mine:
@@ -314,18 +324,21 @@ class LocalPibtRobot(PibtRobot):
                 del reserved[old]  # a reservation replaced (after a lost conflict or backtracking)
                 self._restore_holder(old)
         targets[sender] = cell
-        rank = self._claims[sender] = (message.root_elapsed, message.root_tie, -message.root)
+        root = message.root
+        rank = self._claims[sender] = (message.root_elapsed, message.root_tie, -root)
         final = message.final
-        waited = final and self._ranks.get(sender, NO_RANK) > self._own_rank  # it may have waited for the sender
         if final:
-            if waited and sender not in self._final:
+            waited = self._ranks.get(sender, NO_RANK) > self._own_rank  # it may have waited for the sender
+            decided = self._final
+            if waited and sender not in decided:
                 self._above -= 1
-            self._final.add(sender)
+            decided.add(sender)
             self._calls.pop(sender, None)
             if sender == self._blocked_by:
                 self._unblocked = True  # the robot of a call of higher priority it waited for decided for good
         else:
-            self._calls[sender] = message.root
+            waited = False
+            self._calls[sender] = root
         if cell == self.target and not self._confirmed and sender != self.index:
             if sender == self._waiting:
                 reserved[cell] = sender  # the robot asked to leave it stays: its answer says whether it turns to leave
@@ -414,7 +427,7 @@ class LocalPibtRobot(PibtRobot):
         """Act on this round: settle the last round's reservation, take requests and answers, maybe start."""
         out: list[Outgoing] = []
         self.wake = False
-        if self._preempts() and not self._done and (self._control or self._child_gave_up):
+        if (self._control or self._child_gave_up) and self._wound_wait and not self._done:
             self._take_wounds(out)
         if self._lost:
             self._lost = False
@@ -448,9 +461,9 @@ class LocalPibtRobot(PibtRobot):
         if self._wound is not None and (self._done or self._idle()):
             wound, self._wound = self._wound, None
             self._take_inherit_local(wound, out)  # refused when decided for good, taken when free
-        if self._idle():
+        if self.target is None and self._parent is None and self._blocked_by is None:  # idle (:meth:`_idle`), inlined
             if self._may_start():
-                self._root, self._rank = self.index, self.priority
+                self._root, self._rank = self.index, self._own_rank
                 self._begin_call(out)
             else:
                 self.stats["waits"] += 1
@@ -481,7 +494,7 @@ class LocalPibtRobot(PibtRobot):
 
     def _preempts(self) -> bool:
         """Whether this robot's calls take robots over from calls of lower priority (:attr:`preempts`; not ``turning``)."""
-        return self.preempts and not self.turning
+        return self._wound_wait
 
     def _take_wounds(self, out: list[Outgoing]) -> None:
         """Before anything else this round: give the call up when a call of higher priority wants one of its robots.
