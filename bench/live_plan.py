@@ -1,13 +1,17 @@
-"""A central LaCAM plan executed live, one robot process each, on loopback: does the fleet keep the plan's pace?
+"""A central LaCAM plan executed live by robot processes on loopback: does the fleet keep the plan's pace?
 
 Plans ``--agents`` robots of a MovingAI scenario (random-32-32-20 by default) with
-LaCAM, executes the plan live over UDP with ``--loss`` message loss at
+LaCAM, executes the plan live over ``--transport`` (UDP by default), one robot
+process each or ``--robots-per-process`` robots to a process (each with its own
+socket, driver and body), with ``--loss`` message loss at
 ``--time-scale`` times the robots' speed (optionally killing robots: ``--kill
 ID@SECONDS``), and prints, per body and time scale: robots arrived, collisions, the
 wall makespan against the plan's makespan in seconds at that speed (plan ticks x
 cell time / time scale), the plan's live execution bound at that speed and the wall
-makespan against it, moves and quarter turns, and messages per move
-(datagram-recipients, heartbeats included).
+makespan against it, moves and quarter turns, messages per move
+(each message counted once per robot it is for, heartbeats included) and
+datagrams per move (what the robots put on the network: one per recipient over
+UDP, one for several robots over multicast).
 
 Bodies (``--bodies``, comma-separated; ``docs/protocol.md``, "Body models"):
 
@@ -31,6 +35,7 @@ multiple of the plan's ticks times the cell time (for ``thesis``, also the bound
 bodies that turn in no time: what not following costs).
 
 Usage: python bench/live_plan.py [--agents 48] [--bodies thesis,turning] [--time-scales 2,5] [--loss 0.1] [--kill 3@2]
+       [--transport udp|multicast|zenoh] [--robots-per-process K]
 """
 
 from __future__ import annotations
@@ -64,6 +69,8 @@ def main() -> int:
     parser.add_argument("--time-scales", default="2")
     parser.add_argument("--loss", type=float, default=0.1)
     parser.add_argument("--kill", action="append", default=[], help="ID@SECONDS (repeatable)")
+    parser.add_argument("--transport", default="udp", help="how the robots talk: udp, multicast or zenoh")
+    parser.add_argument("--robots-per-process", type=int, default=1, help="robots hosted by one process")
     arguments = parser.parse_args()
     bodies = arguments.bodies.split(",")
     unknown = [name for name in bodies if name not in PLANNED_BODY]
@@ -71,10 +78,14 @@ def main() -> int:
         parser.error(f"--bodies: unknown {', '.join(unknown)}; use thesis, turning")
     loaded = load_movingai_scenario(arguments.map, arguments.scen, arguments.agents)
     kill = {robot: float(seconds) for robot, seconds in (text.split("@") for text in arguments.kill)}
-    print(f"{loaded.name}: {arguments.agents} robots, loss {arguments.loss}, kill {kill}")
+    hosting = LiveOptions(transport=arguments.transport, robots_per_process=arguments.robots_per_process)
+    print(
+        f"{loaded.name}: {arguments.agents} robots over {hosting.transport}, {hosting.robots_per_process} to a process,"
+        f" loss {arguments.loss}, kill {kill}"
+    )
     print(
         f"{'body':>7} {'scale':>5} {'arrived':>8} {'coll':>4} {'wall s':>7} {'plan s':>7} {'ratio':>6} {'bound s':>7}"
-        f" {'/bound':>6} {'moves':>6} {'turns':>6} {'messages':>9} {'msg/move':>8}  stop"
+        f" {'/bound':>6} {'moves':>6} {'turns':>6} {'messages':>9} {'msg/move':>8} {'dgr/move':>8}  stop"
     )
     for name in bodies:
         scenario = loaded.with_changes(policy=replace(loaded.policy, body=PLANNED_BODY[name]))
@@ -84,7 +95,7 @@ def main() -> int:
             continue
         _say_bounds(name, scenario, plan, follows=bodies_follow(scenario, LiveOptions(kill=kill)))
         for scale in [float(text) for text in arguments.time_scales.split(",")]:
-            _run(name, scenario, plan, scale, arguments.loss, kill)
+            _run(name, scenario, plan, replace(hosting, time_scale=scale, faults=LiveFaults(loss=arguments.loss), kill=kill))
     return 0
 
 
@@ -111,10 +122,11 @@ def _say_bounds(name: str, scenario: Scenario, plan: PlanningResult, follows: bo
     print(line)
 
 
-def _run(name: str, scenario: Scenario, plan: PlanningResult, scale: float, loss: float, kill: dict[str, float]) -> None:
-    """Execute ``plan`` live at ``scale`` and print its row."""
+def _run(name: str, scenario: Scenario, plan: PlanningResult, options: LiveOptions) -> None:
+    """Execute ``plan`` live as ``options`` say (time scale, faults, kills, transport, hosting) and print its row."""
     folder = Path(tempfile.mkdtemp(prefix=f"mrmp-bench-plan-{len(scenario.robots)}-"))
-    options = LiveOptions(results=folder, time_scale=scale, plan=plan, faults=LiveFaults(loss=loss), kill=kill)
+    options = replace(options, results=folder, plan=plan)
+    scale = options.time_scale
     result = run_live(scenario, options)
     arrived = sum(robot.arrived for robot in result.robots)
     moves = max(1, result.network.get("moves", 0))
@@ -125,7 +137,7 @@ def _run(name: str, scenario: Scenario, plan: PlanningResult, scale: float, loss
         f"{name:>7} {scale:>5g} {arrived:>4}/{len(result.robots):<3} {len(result.collisions):>4}"
         f" {result.time_makespan_s:>7.2f} {planned:>7.2f} {result.time_makespan_s / planned:>6.2f} {bound:>7.2f}"
         f" {result.time_makespan_s / bound:>6.2f} {moves:>6} {turns:>6} {result.messages:>9}"
-        f" {result.messages / moves:>8.1f}  {result.stop_reason}",
+        f" {result.messages / moves:>8.1f} {result.network.get('datagrams_sent', 0) / moves:>8.1f}  {result.stop_reason}",
         flush=True,
     )
 

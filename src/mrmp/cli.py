@@ -726,7 +726,7 @@ def _validate_live(scenario: Scenario, request: RunRequest) -> None:
     from mrmp.live.launcher import check_hosting, check_tasks
 
     planned = request.planner is not None
-    check_hosting(request.robots_per_process, request.transport, bool(request.kill), planned, request.ros2)  # before any plan
+    check_hosting(request.robots_per_process, request.transport, bool(request.kill), request.ros2)  # before any plan
     check_tasks(scenario, request.transport, planned)
     if request.lorr_output is not None:
         raise InputError(Problem("--lorr-output", "writes a simulated run (LoRR's output has one action a step of every robot)"))
@@ -1128,7 +1128,7 @@ def agent(
     listen_time: Annotated[float, typer.Option(help="Seconds between announcing Next and deciding.")] = 0.05,
     unsafe: Annotated[bool, typer.Option("--unsafe", help="No safety layer: the policy as written.")] = False,
     no_follow: Annotated[bool, typer.Option("--no-follow", help="A body that turns in place keeps its cell until it has arrived in the next one, so that nobody follows it in (mrmp run --live sets it when it kills robots: a body stopped mid-drive could be driven into).")] = False,
-    plan: Annotated[Path | None, typer.Option(help="Follow this robot's share of a central plan (plan-<index>.json).", show_default="none: the policy decides")] = None,
+    plan: Annotated[list[Path] | None, typer.Option(help="Follow this robot's share of a central plan (plan-<index>.json); hosting several robots, one per --robot, in the same order.", show_default="none: the policy decides")] = None,
     seed: Annotated[int, typer.Option(help="Seed of the body's and the fault injector's randomness.")] = 0,
     timeout: Annotated[float, typer.Option(help="Give up after this many seconds.")] = 600.0,
     ros2: Annotated[bool, typer.Option("--ros2", help="Publish this robot's pose and state on ROS 2 topics (DDS, domain ROS_DOMAIN_ID; the ros2 extra; docs/ros2.md).")] = False,
@@ -1155,7 +1155,8 @@ def agent(
         entry = policy_entry(scenario.policy.name)
         if entry.live_driver is None:
             raise InputError(Problem("--policy", f"{entry.name} {entry.not_live}"))
-        body_issue = body_problem(scenario, live=True, planned=plan is not None)
+        plans = plan or []
+        body_issue = body_problem(scenario, live=True, planned=bool(plans))
         if body_issue is not None:
             raise InputError(body_issue)
         domain = _ros2_domain() if ros2 else None
@@ -1171,9 +1172,12 @@ def agent(
                 raise InputError(Problem("--robot", f"no robot has the id {robot_id!r} in {scenario_path}"))
         if len(set(robot)) < len(robot):
             raise InputError(Problem("--robot", "names a robot twice"))
-        if len(robot) > 1 and (plan is not None or ros2 or drive != "simulated"):
-            raise InputError(Problem("--robot", "one robot per process with --plan, --ros2 or --drive ros2"))
-        _check_task_desk(scenario, transport, task_desk, plan is not None)
+        if len(robot) > 1 and (ros2 or drive != "simulated"):
+            raise InputError(Problem("--robot", "one robot per process with --ros2 or --drive ros2"))
+        if plans and len(plans) != len(robot):
+            reason = f"give one share per --robot, in the same order ({len(robot)} --robot, {len(plans)} --plan)"
+            raise InputError(Problem("--plan", reason))
+        _check_task_desk(scenario, transport, task_desk, bool(plans))
         transport_values = {
             "bind": bind, "peer": peer, "group": group, "interface": interface, "listen": listen, "connect": connect, "fleet": fleet,
             "task_desk": task_desk,
@@ -1203,19 +1207,19 @@ def agent(
                 listen_time=_not_negative(listen_time, "--listen-time", MAX_STEP_SECONDS),
                 timeout=_positive(timeout, "--timeout", MAX_RUN_SECONDS, "seconds"),
             ),
-            plan=plan,
             ros2_domain=domain,
             drive=drive,
             drive_domain=drive_domain,
             drive_wait=_positive(drive_wait, "--drive-wait", MAX_RUN_SECONDS, "seconds"),
         )
-        if plan is not None:
+        if plans:
             from mrmp.io.plans import read_share
 
-            read_share(plan, robot[0])  # a bad share is bad input: report it before any socket opens
+            for robot_id, share in zip(robot, plans, strict=True):
+                read_share(share, robot_id)  # a bad share is bad input: report it before any socket opens
         hosted = [
-            dataclasses.replace(common, index=ids.index(robot_id), transport=spec)
-            for robot_id, spec in zip(robot, specs, strict=True)
+            dataclasses.replace(common, index=ids.index(robot_id), transport=spec, plan=plans[number] if plans else None)
+            for number, (robot_id, spec) in enumerate(zip(robot, specs, strict=True))
         ]
         reports = run_agents(scenario, hosted)  # an address that cannot be used is bad input too
     except InputError as error:

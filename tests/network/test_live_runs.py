@@ -218,6 +218,31 @@ def test_a_turning_plan_is_driven_live_by_turning_bodies_through_loss_and_jitter
         assert robot.turns == needed, robot.id
 
 
+@pytest.mark.slow
+def test_a_plan_is_driven_by_several_robots_to_a_process_each_on_its_own_share(tmp_path):
+    """Four robots to a process, each with its own share: every robot arrives, none collides, and each makes the
+    quarter turns of its own path (a robot given another's share would not)."""
+    from mrmp.centralized.registry import plan_with
+    from mrmp.core.body import body_model
+    from mrmp.io import load_movingai_scenario
+
+    maps = Path(__file__).resolve().parents[2] / "maps"
+    loaded = load_movingai_scenario(maps / "random-32-32-20.map", maps / "random-32-32-20-random-1.scen", 12)
+    scenario = loaded.with_changes(policy=PolicyOptions(body="turning"))
+    plan = plan_with("lacam", scenario, time_limit_s=30)
+    assert plan.solved and plan.paths is not None
+    result = live(scenario, tmp_path, time_scale=20, faults=LiveFaults(loss=0.1), plan=plan, seed=2, robots_per_process=4)
+    assert result.collisions == [] and result.success, result.stop_reason
+    turning = body_model("turning")
+    for robot, spec, path in zip(result.robots, scenario.robots, plan.paths):
+        entered = [cell for tick, cell in enumerate(path) if tick == 0 or cell != path[tick - 1]]
+        facing, needed = spec.heading, 0
+        for here, there in itertools.pairwise(entered):
+            direction = Heading.between(here, there)
+            needed, facing = needed + turning.quarter_turns(facing, direction), direction
+        assert robot.turns == needed and robot.arrived and robot.steps == len(entered) - 1, robot.id
+
+
 def followings(results: Path) -> int:
     """How often a body started into a cell before the body it followed there had left it, by the referee's intervals."""
     intervals = json.loads((results / "referee.json").read_text())["intervals"]

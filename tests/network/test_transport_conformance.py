@@ -362,6 +362,6 @@ def test_a_transport_added_through_the_table_is_a_choice_until_it_is_taken_out()
 
 def test_several_robots_to_a_process_are_refused_over_a_transport_that_carries_one():
     with TRANSPORTS.added(QueueEntry()):
-        check_hosting(1, "queue", kill=False, planned=False, ros2=False)
+        check_hosting(1, "queue", kill=False, ros2=False)
         with pytest.raises(InputError, match="--robots-per-process: one robot per process over queue"):
-            check_hosting(2, "queue", kill=False, planned=False, ros2=False)
+            check_hosting(2, "queue", kill=False, ros2=False)

@@ -270,23 +270,23 @@ def _check(options: LiveOptions, ids: list[str]) -> None:
     for robot_id in options.kill:
         if robot_id not in ids:
             raise InputError(Problem("--kill", f"no robot has the id {robot_id!r}"))
-    check_hosting(options.robots_per_process, options.transport, bool(options.kill), options.plan is not None, options.ros2)
+    check_hosting(options.robots_per_process, options.transport, bool(options.kill), options.ros2)
 
 
-def check_hosting(robots_per_process: int, transport: str, kill: bool, planned: bool, ros2: bool) -> None:
+def check_hosting(robots_per_process: int, transport: str, kill: bool, ros2: bool) -> None:
     """Refuse several robots to a process where it cannot be honoured: with robots to kill (a kill ends a
-    process), a plan or ROS 2, or over a transport that carries one robot per process.
+    process) or ROS 2, or over a transport that carries one robot per process.
 
-    >>> check_hosting(4, "udp", kill=False, planned=False, ros2=False)
-    >>> check_hosting(4, "udp", kill=True, planned=False, ros2=False)  # doctest: +ELLIPSIS
+    >>> check_hosting(4, "udp", kill=False, ros2=False)
+    >>> check_hosting(4, "udp", kill=True, ros2=False)  # doctest: +ELLIPSIS
     Traceback (most recent call last):
     ...
     mrmp.core.errors.InputError: --robots-per-process: hosts one robot per process with --kill (a kill ends a ...
     """
     if robots_per_process == 1:
         return
-    if kill or planned or ros2:
-        reason = "hosts one robot per process with --kill (a kill ends a process), --planner or --ros2"
+    if kill or ros2:
+        reason = "hosts one robot per process with --kill (a kill ends a process) or --ros2"
         raise InputError(Problem("--robots-per-process", reason))
     if not TRANSPORTS.entry(transport).hosts_several:
         raise InputError(Problem("--robots-per-process", f"one robot per process over {transport}"))
@@ -364,7 +364,7 @@ def _start_fleet(options: LiveOptions, files: _RunFiles, layout: FleetLayout, se
         else:
             hosting = TRANSPORTS.entry(options.transport).hosting_arguments(layout, indices)
             transport = [f"--transport={options.transport}", *hosting]
-        plan = [f"--plan={files.shares[first]}"] if files.shares else []
+        plan = [f"--plan={files.shares[index]}" for index in indices] if files.shares else []
         agents.append(_start([*_PYTHON, "agent", *robots, *common, *plan, *transport]))
         process_of.extend(len(agents) - 1 for _ in indices)
     return _Fleet(list(layout.ids), agents, process_of, referee, started, timeout, files.done, files.results)

@@ -233,6 +233,13 @@ def test_robots_per_process_is_refused_where_it_cannot_be_honoured(arguments, re
     assert_refused(mrmp("run", EXAMPLES / "thesis-swap.yaml", *arguments), "--robots-per-process", reason)
 
 
-def test_robots_per_process_with_a_planner_is_refused_before_any_plan_is_made():
-    completed = mrmp("run", EXAMPLES / "causal-32.yaml", "--live", "--robots-per-process", "4", "--planner", "lacam")
-    assert_refused(completed, "--robots-per-process", "--planner")
+def test_robots_per_process_with_a_planner_and_a_kill_is_refused_before_any_plan_is_made():
+    completed = mrmp("run", EXAMPLES / "causal-32.yaml", "--live", "--robots-per-process", "4", "--planner", "lacam",
+                     "--kill", "r0@1")  # fmt: skip
+    assert_refused(completed, "--robots-per-process", "with --kill")
+
+
+def test_an_agent_hosting_several_robots_takes_one_share_each(tmp_path):
+    completed = mrmp("agent", "--scenario", EXAMPLES / "thesis-swap.yaml", "--robot", "A", "--robot", "B",
+                     "--plan", tmp_path / "plan-0.json", environment=without_key())  # fmt: skip
+    assert_refused(completed, "--plan", "give one share per --robot, in the same order (2 --robot, 1 --plan)")
