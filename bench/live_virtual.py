@@ -52,6 +52,7 @@ from mrmp.core import NetworkFaults
 from mrmp.core.body import body_model
 from mrmp.core.scenario import PolicyOptions, RobotSpec, Scenario
 from mrmp.io import load_movingai_scenario, load_scenario
+from mrmp.io.lifetime import interrupt_on_stop_signals
 from mrmp.live.transport import LiveFaults
 from mrmp.live.virtual_time import ProcessingCosts, VirtualOptions, run_virtual
 from mrmp.sim.local_rounds import LocalRoundsSimulator
@@ -161,6 +162,7 @@ def main() -> int:
         help="multicast: one datagram reaches several named peers (as UdpMulticastTransport)",
     )  # fmt: skip
     arguments = parser.parse_args()
+    interrupt_on_stop_signals()  # Ctrl-C or SIGTERM ends a run with what it did, and its row is printed
     if arguments.seeds < 1:
         parser.error(f"--seeds: must be at least 1, got {arguments.seeds}")
     seeds = range(arguments.seed, arguments.seed + arguments.seeds)

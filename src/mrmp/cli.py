@@ -1301,6 +1301,9 @@ def _scenario_argument(argument: Path | None, option: Path | None) -> Path:
 
 def main() -> None:
     """Entry point of the ``mrmp`` command."""
+    from mrmp.io.lifetime import interrupt_on_stop_signals
+
+    interrupt_on_stop_signals()  # SIGTERM keeps what was computed, as Ctrl-C does
     try:
         app(prog_name="mrmp")  # also under python -m mrmp: its help, and its shell completion's variable, _MRMP_COMPLETE
     except KeyboardInterrupt:

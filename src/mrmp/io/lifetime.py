@@ -61,6 +61,27 @@ STOP_SIGNALS = frozenset({signal.SIGINT, signal.SIGTERM})
 """The signals that ask a process to stop: a child started with ``hold=True`` gets them once it can answer them."""
 
 
+def interrupt_on_stop_signals() -> None:
+    """Let SIGTERM, and SIGINT even where it was ignored, interrupt this process as Ctrl-C does: a KeyboardInterrupt.
+
+    A run stopped so takes the path of Ctrl-C, which keeps what was computed
+    (a simulated run's result with the stop reason ``interrupted``, a
+    benchmark's finished runs), where SIGTERM's default action would end the
+    process with nothing written. A shell starts a background job with SIGINT
+    ignored, and Python then leaves it ignored: this makes it count again. A
+    command that stops in its own way (a live robot, the launcher) installs its
+    own handlers afterwards. Call it from the main thread.
+
+    >>> interrupt_on_stop_signals()
+    >>> signal.getsignal(signal.SIGTERM) is signal.default_int_handler
+    True
+    >>> signal.signal(signal.SIGTERM, signal.SIG_DFL) is signal.default_int_handler
+    True
+    """
+    for signum in STOP_SIGNALS:
+        signal.signal(signum, signal.default_int_handler)
+
+
 def preexec_dying_with(signum: int = signal.SIGTERM, parent: int | None = None, hold: bool = False) -> Callable[[], None]:
     """A ``preexec_fn`` for :class:`subprocess.Popen`: the child gets ``signum`` when ``parent`` (default: this process) ends.
 

@@ -113,3 +113,53 @@ def test_a_child_that_holds_its_stop_signals_answers_a_parent_death_that_came_be
 def test_without_holding_a_parent_death_during_start_up_kills_the_child_before_it_can_answer(tmp_path):
     kill_the_parent_of_a_slow_starter(tmp_path, hold=False)
     assert not (tmp_path / "answered").exists()
+
+
+def test_a_terminated_simulation_returns_what_it_computed():
+    """SIGTERM interrupts a run as Ctrl-C does (``interrupt_on_stop_signals``, which ``mrmp`` installs): the run ends
+    with what it computed, where SIGTERM's default action would end the process with nothing written."""
+    from mrmp.core import Grid, RobotSpec, Scenario
+    from mrmp.io.lifetime import interrupt_on_stop_signals
+    from mrmp.sim.simulator import LockstepSimulator
+
+    scenario = Scenario(Grid(1, 8), (RobotSpec("A", (0, 0), (0, 7)),))
+    simulator = LockstepSimulator(scenario)
+    original, steps = simulator.step, []
+
+    def step_then_terminated() -> None:
+        steps.append(1)
+        if len(steps) == 3:
+            os.kill(os.getpid(), signal.SIGTERM)
+        original()
+
+    simulator.step = step_then_terminated  # type: ignore[method-assign]
+    saved = {signum: signal.getsignal(signum) for signum in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        interrupt_on_stop_signals()
+        result = simulator.run()
+    finally:
+        for signum, handler in saved.items():
+            signal.signal(signum, handler)
+    assert result.stop_reason == "interrupted" and len(steps) == 3 and result.robots[0].path[-1] == (0, 2)  # two steps made
+
+
+def test_sigint_interrupts_a_process_started_with_it_ignored():
+    """A shell starts a background job with SIGINT ignored; once the handlers are installed, SIGINT counts again."""
+    program = textwrap.dedent(
+        """
+        import os, signal
+        from mrmp.io.lifetime import interrupt_on_stop_signals
+        before = signal.getsignal(signal.SIGINT) is signal.SIG_IGN
+        interrupt_on_stop_signals()
+        try:
+            os.kill(os.getpid(), signal.SIGINT)
+            signal.pause()
+        except KeyboardInterrupt:
+            print("ignored before:", before, "interrupted")
+        """
+    )
+    completed = subprocess.run(
+        [sys.executable, "-c", program], capture_output=True, text=True, timeout=60,
+        preexec_fn=lambda: signal.signal(signal.SIGINT, signal.SIG_IGN),
+    )  # fmt: skip
+    assert completed.stdout.strip() == "ignored before: True interrupted", completed.stderr
