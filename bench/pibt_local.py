@@ -23,6 +23,11 @@ network: the sequenced driver's link layer retransmits until every message
 arrives; the robots of local sequencing acknowledge, retransmit and abandon
 steps themselves.
 
+``--alternate`` times the two orders by stepping them alternately instead, one
+step of each in turn in one process, so that both meet the same drifts of a
+shared machine's speed: one line per case, ms per step of each and their ratio
+(the decisions are the same as in the separate runs).
+
 ``--scale`` runs every map and N of ``bench/pibt_scale.py`` (every instance:
 each ``-random-*.scen``, or its seeded random instances; the thesis
 scenarios first) instead of ``--only``. ``--reach-cap`` and ``--stall-slack``
@@ -34,13 +39,15 @@ runs one order only.
 
 Usage: python bench/pibt_local.py [--maps DIR] [--only random-32-32-20:100,empty-32-32:400 | --scale] [--limit TICKS]
        [--radius R] [--loss P] [--duplicate P] [--delay-max TICKS] [--reach-cap R] [--stall-slack S]
-       [--driver-radius R] [--order driver|local] [--stall-from-best]
+       [--driver-radius R] [--order driver|local] [--stall-from-best] [--alternate]
 """
 
 from __future__ import annotations
 
 import argparse
+import gc
 import sys
+import time
 from pathlib import Path
 
 from mrmp.core import NetworkFaults, PolicyOptions, Scenario
@@ -90,6 +97,7 @@ def main() -> int:
     parser.add_argument(
         "--stall-from-best", action="store_true", help="a stall is a step that sets no new record of nearness to the goal"
     )
+    parser.add_argument("--alternate", action="store_true", help="time the two orders stepped alternately, one step each")
     arguments = parser.parse_args()
 
     class Robot(LocalPibtRobot):
@@ -102,6 +110,10 @@ def main() -> int:
 
     simulators = [(label, simulator) for label, simulator in (("driver", RoundsSimulator), ("local", Local))]
     simulators = [(label, simulator) for label, simulator in simulators if arguments.order in (None, label)]
+    if arguments.alternate:
+        for name, scenario in cases(arguments):
+            alternate(f"{name}:{len(scenario.robots)}", scenario.with_changes(seed=0), dict(simulators), arguments)
+        return 0
     print(
         f"{'map':<30} {'N':>5} {'order':>6} {'success':>7} {'SoC/LB':>7} {'mksp':>5} {'ms/step':>8} {'x drv':>6} {'rnd/step':>8}"
         f" {'msg/r/s':>7} {'wait':>6} {'withdr':>7} {'refuse':>7} {'passed':>7} {'abort':>7} {'block':>7}"
@@ -151,6 +163,39 @@ def main() -> int:
                 flush=True,
             )
     return 0
+
+
+def alternate(case: str, scenario: Scenario, simulators: dict[str, type[RoundsSimulator]], arguments: argparse.Namespace) -> None:
+    """Step the driver's run and local sequencing's alternately, one step each, and print their ms per step and ratio."""
+    runs = {}
+    for label, simulator in simulators.items():
+        radius = arguments.driver_radius if label == "driver" else arguments.radius
+        run = simulator(scenario.with_changes(policy=PolicyOptions(name="pibt", radius=radius, sequencing=label)))
+        run.referee.check_start([spec.start for spec in scenario.robots], [spec.heading for spec in scenario.robots])
+        runs[label] = run
+    spent = dict.fromkeys(runs, 0.0)
+    steps = dict.fromkeys(runs, 0)
+
+    def over(run: RoundsSimulator) -> bool:
+        return all(robot.at_goal for robot in run.robots) or run.tick >= run.max_ticks
+
+    collecting = gc.isenabled()
+    gc.disable()  # as the runs themselves do
+    try:
+        while not all(over(run) for run in runs.values()):
+            for label, run in runs.items():
+                if not over(run):
+                    started = time.perf_counter()
+                    run.step()
+                    spent[label] += time.perf_counter() - started
+                    steps[label] += 1
+    finally:
+        if collecting:
+            gc.enable()
+    per_step = {label: 1000 * spent[label] / max(1, steps[label]) for label in runs}
+    line = " ".join(f"{label} {per_step[label]:.2f} ms/step over {steps[label]} steps" for label in runs)
+    ratio = f", local / driver {per_step['local'] / per_step['driver']:.2f}" if len(runs) == 2 else ""
+    print(f"{case}: stepped alternately: {line}{ratio}", flush=True)
 
 
 if __name__ == "__main__":
