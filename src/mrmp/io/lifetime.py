@@ -30,6 +30,7 @@ Examples
 
 from __future__ import annotations
 
+import contextlib
 import ctypes
 import os
 import select
@@ -37,7 +38,7 @@ import signal
 import sys
 import threading
 import time
-from collections.abc import Callable
+from collections.abc import Callable, Iterator
 
 _PR_SET_PDEATHSIG = 1
 """prctl(2)'s option number for the parent-death signal (``<linux/prctl.h>``)."""
@@ -80,6 +81,51 @@ def interrupt_on_stop_signals() -> None:
     """
     for signum in STOP_SIGNALS:
         signal.signal(signum, signal.default_int_handler)
+
+
+@contextlib.contextmanager
+def interrupted_once() -> Iterator[Callable[[], None]]:
+    """Within: the first stop signal (:data:`STOP_SIGNALS`) interrupts, a ``KeyboardInterrupt``, while the work is
+    interruptible; any other is noted and left. Yields what to call once the work left is writing what was done.
+
+    A run stopped by a signal writes what it did; a second signal (a shell's
+    ``kill`` of a job and of the program that started it, a second Ctrl-C)
+    would otherwise end it while it writes, with nothing written. The
+    handlers before are restored on leaving. Outside the main thread, where
+    Python sets no handler, it changes nothing.
+
+    >>> with interrupted_once() as writing:
+    ...     try:
+    ...         os.kill(os.getpid(), signal.SIGTERM)
+    ...         time.sleep(1)
+    ...     except KeyboardInterrupt:
+    ...         writing()
+    ...         os.kill(os.getpid(), signal.SIGTERM)  # noted, left: the writing goes on
+    ...     print("written")
+    written
+    """
+    state = {"interruptible": True}
+
+    def writing() -> None:
+        state["interruptible"] = False
+
+    if threading.current_thread() is not threading.main_thread():
+        yield writing
+        return
+
+    def stop(signum: int, frame: object) -> None:
+        if state["interruptible"]:
+            state["interruptible"] = False
+            raise KeyboardInterrupt
+
+    saved = {signum: signal.getsignal(signum) for signum in STOP_SIGNALS}
+    for signum in STOP_SIGNALS:
+        signal.signal(signum, stop)
+    try:
+        yield writing
+    finally:
+        for signum, handler in saved.items():
+            signal.signal(signum, handler if handler is not None else signal.SIG_DFL)
 
 
 def preexec_dying_with(signum: int = signal.SIGTERM, parent: int | None = None, hold: bool = False) -> Callable[[], None]:

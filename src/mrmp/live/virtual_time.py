@@ -63,7 +63,7 @@ import os
 import random
 import threading
 import time
-from collections.abc import Iterator, Sequence
+from collections.abc import Callable, Iterator, Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
 
@@ -71,6 +71,7 @@ from mrmp.core.errors import InputError, Problem
 from mrmp.core.result import RunResult
 from mrmp.core.scenario import Scenario
 from mrmp.core.seeds import Stream, derive_seed
+from mrmp.io.lifetime import interrupted_once
 from mrmp.io.live_files import TraceWriter, read_json, write_json
 from mrmp.live.body import OccupancyRecorder
 from mrmp.live.driver import AgentTiming, LiveDriver
@@ -285,8 +286,9 @@ class _VirtualFleet:
         """The virtual time: what every driver's clock reads."""
         return self.now
 
-    def run(self) -> None:
-        """Run every robot until each has stopped, the virtual timeout passes, or Ctrl-C (what was done is kept)."""
+    def run(self, writing: Callable[[], None] = lambda: None) -> None:
+        """Run every robot until each has stopped, the virtual timeout passes, or Ctrl-C (what was done is kept);
+        ``writing`` is called once the loop is over (the reports are filled in from then on)."""
         for robot in self.robots:
             robot.driver.begin_fleet_wait(0.0)
         end = self.timing.timeout + self.timing.start_wait + 1.0
@@ -312,6 +314,7 @@ class _VirtualFleet:
                     self._turn(index, robot)
         except KeyboardInterrupt:
             unfinished = "interrupted"
+        writing()
         for robot in self.robots:
             if not robot.done:
                 robot.driver.report.stop_reason = unfinished
@@ -428,9 +431,16 @@ def run_virtual(scenario: Scenario, options: VirtualOptions) -> RunResult:
         raise InputError(Problem("--results", f"cannot make {options.results}: {error.strerror}")) from None
     for stale in (*options.results.glob("agent-*.json"), *options.results.glob("trace-*.jsonl"), options.results / "tasks.json"):
         stale.unlink(missing_ok=True)
+    with interrupted_once() as writing:  # a second stop signal does not cut the writing of what was done short
+        return _run_and_judge(scenario, options, writing)
+
+
+def _run_and_judge(scenario: Scenario, options: VirtualOptions, writing: Callable[[], None]) -> RunResult:
+    """:func:`run_virtual` from the fleet's start: run it, then (``writing`` called: no longer interruptible) write
+    every report, have the referee judge and return the result."""
     started = time.process_time()
     fleet = _VirtualFleet(scenario, options)
-    fleet.run()
+    fleet.run(writing)
     reports = fleet.finish()
     start_time = min(float(report["started_at"]) for report in reports)
     run_referee(scenario, options.results, start_time, None, lambda text: None, stop=threading.Event())

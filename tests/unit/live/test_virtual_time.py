@@ -169,3 +169,39 @@ def test_a_live_robot_ranks_its_moves_by_its_guided_tables(tmp_path):
         assert result.success and result.collisions == [], result.stop_reason
         rows[guidance] = {cell[0] for cell in believed_paths(tmp_path / guidance, 1)[0]}
     assert rows == {"none": {1}, "crisscross": {0, 1}}
+
+
+def test_a_second_stop_signal_does_not_cut_the_writing_short(tmp_path, monkeypatch):
+    """A real SIGTERM stops the run; another, while the reports are written, is left: every report, the referee's
+    verdict and the result are still there (a shell's ``kill`` of a job reaches both it and what started it)."""
+    import os
+    import signal
+
+    from mrmp.io.lifetime import interrupt_on_stop_signals
+    from mrmp.live import virtual_time
+
+    turn, finish = virtual_time._VirtualFleet._turn, virtual_time._VirtualFleet.finish
+    turns = iter(range(10**9))
+
+    def terminated_later(self, index, robot):
+        if next(turns) == 100:
+            os.kill(os.getpid(), signal.SIGTERM)
+        turn(self, index, robot)
+
+    def terminated_again(self):
+        os.kill(os.getpid(), signal.SIGTERM)
+        return finish(self)
+
+    monkeypatch.setattr(virtual_time._VirtualFleet, "_turn", terminated_later)
+    monkeypatch.setattr(virtual_time._VirtualFleet, "finish", terminated_again)
+    saved = {signum: signal.getsignal(signum) for signum in (signal.SIGINT, signal.SIGTERM)}
+    try:
+        interrupt_on_stop_signals()  # as mrmp and bench/live_virtual.py have it
+        result = run_virtual(crossing(), VirtualOptions(results=tmp_path, time_scale=10))
+        assert signal.getsignal(signal.SIGTERM) is signal.default_int_handler  # restored on leaving
+    finally:
+        for signum, handler in saved.items():
+            signal.signal(signum, handler)
+    assert result.stop_reason == "interrupted" and result.collisions == []
+    reports = [json.loads((tmp_path / f"agent-{index}.json").read_text()) for index in range(len(CROSS))]
+    assert {report["stop_reason"] for report in reports} == {"interrupted"} and (tmp_path / "referee.json").exists()
