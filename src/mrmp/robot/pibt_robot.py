@@ -340,6 +340,8 @@ class PibtRobot:
         The effect of one :meth:`receive` call per beacon, without the checks
         for stale messages and second copies, which a perfect network never
         delivers: the simulator delivers the beacon round this way.
+        :meth:`LocalPibtRobot.receive_beacons <mrmp.robot.pibt_local.LocalPibtRobot.receive_beacons>` does the
+        same bookkeeping in its own loop (for speed): keep the two alike.
         """
         occupants, goals, settled = self._occupants, self._goals, self._settled
         y_size = self.flat.y_size  # the flat index (FlatGrid.index), inlined: this runs for every beacon heard
