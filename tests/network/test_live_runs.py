@@ -191,12 +191,25 @@ def test_lacam_plan_for_sixteen_robots_with_delays_and_loss(tmp_path):
     assert result.network["injected_lost"] > 0
 
 
+def planned_moves_and_turns(path, heading):
+    """The moves of a plan's path for a turning body that starts facing ``heading``, and the quarter turns they
+    need, each the shorter way."""
+    from mrmp.core.body import body_model
+
+    turning = body_model("turning")
+    entered = [cell for tick, cell in enumerate(path) if tick == 0 or cell != path[tick - 1]]
+    facing, needed = heading, 0
+    for here, there in itertools.pairwise(entered):
+        direction = Heading.between(here, there)
+        needed, facing = needed + turning.quarter_turns(facing, direction), direction
+    return len(entered) - 1, needed
+
+
 @pytest.mark.slow
 def test_a_turning_plan_is_driven_live_by_turning_bodies_through_loss_and_jitter(tmp_path):
     """A LaCAM plan for turning bodies (LoRR's MAPF_T) executed live by bodies that turn in place: every robot
     arrives, none collides, and each makes exactly the quarter turns its plan's cells need, the shorter way."""
     from mrmp.centralized.registry import plan_with
-    from mrmp.core.body import body_model
     from mrmp.io import load_movingai_scenario
 
     maps = Path(__file__).resolve().parents[2] / "maps"
@@ -208,14 +221,8 @@ def test_a_turning_plan_is_driven_live_by_turning_bodies_through_loss_and_jitter
     result = live(scenario, tmp_path, time_scale=20, faults=faults, jitter=0.3, plan=plan, seed=3)
     assert result.collisions == [] and result.success, result.stop_reason
     assert result.body == "turning" and result.network["injected_lost"] > 0
-    turning = body_model("turning")
     for robot, spec, path in zip(result.robots, scenario.robots, plan.paths):
-        entered = [cell for tick, cell in enumerate(path) if tick == 0 or cell != path[tick - 1]]
-        facing, needed = spec.heading, 0
-        for here, there in itertools.pairwise(entered):
-            direction = Heading.between(here, there)
-            needed, facing = needed + turning.quarter_turns(facing, direction), direction
-        assert robot.turns == needed, robot.id
+        assert robot.turns == planned_moves_and_turns(path, spec.heading)[1], robot.id
 
 
 @pytest.mark.slow
@@ -223,7 +230,6 @@ def test_a_plan_is_driven_by_several_robots_to_a_process_each_on_its_own_share(t
     """Four robots to a process, each with its own share: every robot arrives, none collides, and each makes the
     quarter turns of its own path (a robot given another's share would not)."""
     from mrmp.centralized.registry import plan_with
-    from mrmp.core.body import body_model
     from mrmp.io import load_movingai_scenario
 
     maps = Path(__file__).resolve().parents[2] / "maps"
@@ -233,14 +239,9 @@ def test_a_plan_is_driven_by_several_robots_to_a_process_each_on_its_own_share(t
     assert plan.solved and plan.paths is not None
     result = live(scenario, tmp_path, time_scale=20, faults=LiveFaults(loss=0.1), plan=plan, seed=2, robots_per_process=4)
     assert result.collisions == [] and result.success, result.stop_reason
-    turning = body_model("turning")
     for robot, spec, path in zip(result.robots, scenario.robots, plan.paths):
-        entered = [cell for tick, cell in enumerate(path) if tick == 0 or cell != path[tick - 1]]
-        facing, needed = spec.heading, 0
-        for here, there in itertools.pairwise(entered):
-            direction = Heading.between(here, there)
-            needed, facing = needed + turning.quarter_turns(facing, direction), direction
-        assert robot.turns == needed and robot.arrived and robot.steps == len(entered) - 1, robot.id
+        moves, turns = planned_moves_and_turns(path, spec.heading)
+        assert robot.turns == turns and robot.arrived and robot.steps == moves, robot.id
 
 
 def followings(results: Path) -> int:

@@ -70,7 +70,7 @@ def interrupt_on_stop_signals() -> None:
     benchmark's finished runs), where SIGTERM's default action would end the
     process with nothing written. A shell starts a background job with SIGINT
     ignored, and Python then leaves it ignored: this makes it count again. A
-    command that stops in its own way (a live robot, the launcher) installs its
+    command that stops in its own way (a live robot, the referee) installs its
     own handlers afterwards. Call it from the main thread.
 
     >>> interrupt_on_stop_signals()
